@@ -1,0 +1,68 @@
+"""Errors and warnings shared by the whole toolkit (``modal`` and ``balancer``).
+
+Every exception subclasses a built-in as well (python-control's pattern), so
+callers may catch either ``ModalError`` or the familiar ``ValueError``.
+Messages name the file, the field and what was expected.
+"""
+from __future__ import annotations
+
+import warnings
+
+__all__ = [
+    "ModalError",
+    "FRFValidationError",
+    "FormatError",
+    "IdentificationError",
+    "ParameterError",
+    "ArchiveError",
+    "SceneError",
+    "ModalWarning",
+    "ResolutionWarning",
+    "QualityWarning",
+    "warn",
+]
+
+
+class ModalError(Exception):
+    """Base class of every error raised by this toolkit."""
+
+
+class FRFValidationError(ModalError, ValueError):
+    """An FRF's frequency axis or response is not acceptable."""
+
+
+class FormatError(ModalError, ValueError):
+    """A file cannot be read: names the file, the field or line, and what was expected."""
+
+
+class IdentificationError(ModalError, RuntimeError):
+    """Identification cannot produce an estimate (for example: no mode in the band)."""
+
+
+class ParameterError(ModalError, ValueError):
+    """A physical or numerical parameter is out of its valid range."""
+
+
+class ArchiveError(ModalError, ValueError):
+    """An HDF5 result archive is missing, damaged or of an unknown schema version."""
+
+
+class SceneError(ModalError, ValueError):
+    """A scene file is invalid: names the file, the key and what was expected."""
+
+
+class ModalWarning(UserWarning):
+    """Base class of the toolkit's warnings."""
+
+
+class ResolutionWarning(ModalWarning):
+    """The frequency resolution is too coarse for an estimate to be sound."""
+
+
+class QualityWarning(ModalWarning):
+    """An estimate was produced but fails a quality check (flagged in the result)."""
+
+
+def warn(message: str, category: type[Warning] = ModalWarning, stacklevel: int = 3) -> None:
+    """Issue a toolkit warning pointing at the caller's caller."""
+    warnings.warn(message, category, stacklevel=stacklevel)

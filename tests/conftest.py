@@ -1,0 +1,33 @@
+"""Shared fixtures. Guards against the unrelated PyPI ``modal`` shadowing ours."""
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+
+os.environ.setdefault("MPLBACKEND", "Agg")
+
+import modal  # noqa: E402
+
+if getattr(modal, "__toolkit_id__", None) != "modalbal":  # pragma: no cover
+    raise pytest.UsageError(
+        "the imported `modal` is not this toolkit's (another distribution, probably the "
+        "Modal Labs cloud client, shadows it); use a virtual environment of its own"
+    )
+
+ROOT = Path(__file__).resolve().parent.parent
+SYNTHETIC = ROOT / "data" / "synthetic"
+SHARED = ROOT.parent / "shared"
+
+
+@pytest.fixture
+def synthetic_dir() -> Path:
+    return SYNTHETIC
+
+
+@pytest.fixture
+def shared_dir() -> Path:
+    if not SHARED.is_dir():
+        pytest.skip("../shared/ (reference data) is not beside the checkout")
+    return SHARED
