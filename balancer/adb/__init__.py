@@ -1,0 +1,60 @@
+"""Automatic ball balancer (ADB) on a planar Jeffcott rotor (Chung & Ro model).
+
+Entry points: :class:`ADBParameters`, :func:`stable_speed_intervals`, :func:`simulate`.
+SI units and radians throughout; nondimensional groups use ``omega_n = sqrt(k / (M + n m))``.
+"""
+from __future__ import annotations
+
+from .equilibria import (
+    Equilibrium,
+    balanced_ball_angles,
+    balanced_state,
+    find_equilibria,
+    symmetric_spacing_rad,
+    unbalanced_states,
+)
+from .linear import EigenAnalysis, eigen_analysis
+from .parameters import ADBParameters, ParameterBatch, ParameterStd, identified_std
+from .stability import (
+    BalancedStability,
+    RouthHurwitzResult,
+    SpeedIntervals,
+    StabilityMap,
+    ThresholdSensitivity,
+    balanced_stability,
+    characteristic_polynomial,
+    linearised_matrices,
+    routh_hurwitz,
+    routh_hurwitz_n2,
+    stability_map,
+    stable_speed_intervals,
+    threshold_sensitivity,
+)
+
+__all__ = [
+    "ADBParameters",
+    "ParameterBatch",
+    "ParameterStd",
+    "identified_std",
+    "Equilibrium",
+    "balanced_ball_angles",
+    "balanced_state",
+    "find_equilibria",
+    "symmetric_spacing_rad",
+    "unbalanced_states",
+    "EigenAnalysis",
+    "eigen_analysis",
+    "BalancedStability",
+    "RouthHurwitzResult",
+    "SpeedIntervals",
+    "StabilityMap",
+    "ThresholdSensitivity",
+    "balanced_stability",
+    "characteristic_polynomial",
+    "linearised_matrices",
+    "routh_hurwitz",
+    "routh_hurwitz_n2",
+    "stability_map",
+    "stable_speed_intervals",
+    "threshold_sensitivity",
+]

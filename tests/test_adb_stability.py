@@ -1,0 +1,226 @@
+"""Equilibria and linear stability: reference case of issue 4 and the paper's findings.
+
+Reference numbers come from the issue and from the research note's independent script
+(``adb.md`` section 2 "Findings" and section 5); they are reproduced, not tuned.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from balancer.adb import (
+    ADBParameters,
+    ParameterBatch,
+    ParameterStd,
+    balanced_ball_angles,
+    balanced_stability,
+    balanced_state,
+    characteristic_polynomial,
+    find_equilibria,
+    routh_hurwitz,
+    routh_hurwitz_n2,
+    stability_map,
+    stable_speed_intervals,
+    symmetric_spacing_rad,
+    threshold_sensitivity,
+)
+from balancer.adb.equations import rotating_frame_jacobian
+from balancer.adb.linear import MARGINAL, STABLE, UNSTABLE, eigen_analysis
+from modal.errors import ParameterError
+
+S1 = ADBParameters(M=1.0, m=0.02, n=2, R=0.05, e=0.5e-3, k=1e4, c=20.0, D=1e-3)
+WN = S1.natural_frequency_rad_s
+XTOL = 1e-3  # the issue's tolerance on threshold values quoted to 3-4 digits
+
+
+def test_reference_threshold_and_angles():
+    result = stable_speed_intervals(S1, 60 * WN)
+    assert WN == pytest.approx(98.058, abs=5e-4)
+    assert len(result) == 1
+    low, high = result[0]
+    assert low / WN == pytest.approx(1.3956, abs=XTOL)
+    assert result.reaches_speed_max and high == pytest.approx(60 * WN)
+    # arccos(-a/2) with a = 0.5: 104.4775 deg; the issue quotes 104.5
+    angles = np.degrees(balanced_ball_angles(S1))
+    assert np.allclose(sorted(angles), [-104.5, 104.5], atol=0.05)
+    assert list(result) == [result[0]]
+
+
+def test_stable_just_above_unstable_just_below_threshold():
+    low = stable_speed_intervals(S1, 10 * WN, xtol_ratio=1e-12).lowest_stable_speed_rad_s
+    # Brent's boundary to 1e-12 omega_n; step 1e-6 omega_n is far outside that and the
+    # growth rate there (~1e-7 omega_n) is far above the rounding bound (~1e-12).
+    check = balanced_stability(S1, [low - 1e-6 * WN, low + 1e-6 * WN])
+    assert list(check.stability_class) == [UNSTABLE, STABLE]
+
+
+def test_routh_hurwitz_agrees_with_eigenvalues_at_every_speed():
+    ratios = np.concatenate([np.linspace(0.1, 3.0, 59), [0.95, 1.05, 1.3956488, 5.0, 20.0, 60.0]])
+    eig = balanced_stability(S1, ratios * WN)
+    for ratio, values, code in zip(ratios, eig.eigenvalues_per_s, eig.stability_class):
+        if code == MARGINAL:
+            continue
+        rh = routh_hurwitz_n2(S1, ratio * WN)
+        assert rh.regular
+        assert rh.sign_changes == int(np.sum(values.real > 0)), ratio
+        assert rh.stable == (code == STABLE)
+        assert np.all(rh.hurwitz_minors > 0) == (code == STABLE)
+
+
+def test_characteristic_polynomial_has_the_eigenvalues_as_roots():
+    # Coefficients from an FFT of sampled determinants (no eigen-solver); compare the
+    # polynomial's roots with the eigenvalues; roots of a degree-8 polynomial with O(1)
+    # coefficients are accurate to ~1e-12 when simple.
+    speed = 2.0 * WN
+    coeffs = characteristic_polynomial(S1, speed)
+    roots = np.sort_complex(np.roots(coeffs))
+    eig = np.sort_complex(balanced_stability(S1, [speed]).eigenvalues_per_s[0] / WN)
+    assert np.max(np.abs(roots - eig)) < 1e-9
+    # every coefficient positive at Omega = 1.05, yet unstable (adb.md section 5)
+    rh = routh_hurwitz_n2(S1, 1.05 * WN)
+    assert np.all(rh.coefficients > 0) and not rh.stable and rh.sign_changes == 2
+
+
+def test_routh_simple_polynomials():
+    assert routh_hurwitz([1, 3, 3, 1]).stable  # (s+1)^3
+    assert routh_hurwitz([1, -1, 2]).sign_changes == 2
+    assert not routh_hurwitz([1, 0, 1]).regular  # roots on the imaginary axis
+    with pytest.raises(ParameterError):
+        routh_hurwitz([0.0, 1.0])
+
+
+# research note table (section 5): lower bound of the stable interval, scanned to 60 omega_n
+@pytest.mark.parametrize(
+    "name, changes, threshold",
+    [
+        ("S2", dict(n=5), 1.604),
+        ("S3", dict(c=2.0), 1.711),
+        ("S4", dict(D=2e-2), 1.006),
+        ("S5", dict(D=1e-4), 1.754),
+        ("S6", dict(n=3), 1.461),
+    ],
+)
+def test_literature_sets_thresholds(name, changes, threshold):
+    p = S1.replace(**changes)
+    result = stable_speed_intervals(p, 60 * p.natural_frequency_rad_s)
+    assert len(result) == 1 and result.reaches_speed_max
+    assert result.intervals_ratio[0, 0] == pytest.approx(threshold, abs=XTOL)
+
+
+def test_no_balancing_below_the_natural_frequency():
+    # Finding 1 (Thearle; Lee & Van Moorhem): every stable interval starts above omega_n.
+    rng = np.random.default_rng(4)
+    for _ in range(24):
+        n = int(rng.integers(2, 6))
+        p = ADBParameters.from_nondimensional(
+            n=n, mass_ratio=float(rng.uniform(0.005, 0.6 / (n + 1))),
+            unbalance_ratio=float(rng.uniform(0.05, 0.95 * n)),
+            damping_ratio=float(10 ** rng.uniform(-2.5, -0.5)), drag_ratio=float(10 ** rng.uniform(-2, 1)),
+        )
+        result = balanced_stability(p, np.linspace(0.01, 1.0, 300) * p.natural_frequency_rad_s)
+        assert not np.any(result.stability_class == STABLE)
+
+
+def test_drag_lowers_threshold_and_low_drag_never_balances():
+    # Finding 2: raising beta lowers the threshold (S5 -> S1 -> S4); finding 3: S7 (beta/zeta =
+    # 0.010 below kappa = 0.016) is unstable at every speed up to 60 omega_n.
+    thresholds = [stable_speed_intervals(S1.replace(D=d), 20 * WN).intervals_ratio[0, 0] for d in (1e-4, 1e-3, 2e-2)]
+    assert thresholds[0] > thresholds[1] > thresholds[2] > 1.0
+    s7 = stable_speed_intervals(S1.replace(D=5e-6), 60 * WN, speed_min_rad_s=0.02 * WN, grid_points=3000)
+    assert len(s7) == 0 and s7.lowest_stable_speed_rad_s == math.inf
+
+
+def test_split_stable_region_for_heavy_balls():
+    # Finding 4: n = 2, mu = 0.1, a = 0.3, zeta = beta = 0.01 -> [1.184, 1.468] U [2.737, >= 100]
+    p = ADBParameters.from_nondimensional(n=2, mass_ratio=0.1, unbalance_ratio=0.3, damping_ratio=0.01, drag_ratio=0.01)
+    result = stable_speed_intervals(p, 100 * p.natural_frequency_rad_s, grid_points=4000)
+    assert len(result) == 2 and result.reaches_speed_max
+    assert np.allclose(result.intervals_ratio[0], [1.184, 1.468], atol=XTOL)
+    assert result.intervals_ratio[1, 0] == pytest.approx(2.737, abs=XTOL)
+
+
+def test_unbalanced_states_at_half_speed():
+    # adb.md section 2: at Omega = 0.5 the only stable state has both balls on the heavy
+    # side (q = +2) with r = 0.0153 R (Green et al. 2006 report the same).
+    found = find_equilibria(S1, 0.5 * WN)
+    stable = [eq for eq in found if eq.stability == "stable"]
+    assert len(stable) == 1
+    assert stable[0].kind == "unbalanced" and stable[0].balls_on_deflection_side == 2
+    assert stable[0].rotor_offset_m / S1.R == pytest.approx(0.0153, abs=5e-5)
+    # the q = 0 state is the plain rotor's response
+    plain = [eq for eq in found if eq.balls_on_deflection_side == 1]
+    Om, zeta, eps = 0.5, S1.damping_ratio, S1.eccentricity_ratio
+    expected = eps * Om**2 / math.hypot(1 - Om**2, 2 * zeta * Om)
+    assert plain[0].rotor_offset_m / S1.R == pytest.approx(expected, rel=1e-12)
+
+
+@pytest.mark.parametrize("n", [3, 5])
+def test_family_members_and_zero_eigenvalues(n):
+    p = S1.replace(n=n)
+    symmetric = balanced_ball_angles(p)
+    spacing = np.diff(np.sort(np.mod(symmetric, 2 * np.pi)))
+    assert np.allclose(spacing, symmetric_spacing_rad(n, p.unbalance_ratio), atol=1e-12)
+    free = [2.0] if n == 3 else 0.3 + np.array([0.0, 2.0, 4.0]) * np.pi / 3  # leave |S| <= 2
+    other = balanced_ball_angles(p, free_angles_rad=free)
+    for angles in (symmetric, other):
+        assert abs(p.unbalance_ratio + np.sum(np.exp(1j * angles))) < 1e-13
+    # the balanced family gives n - 2 exact zero eigenvalues (to rounding) in the full Jacobian
+    J = rotating_frame_jacobian(balanced_state(p)[None], ParameterBatch.from_parameters(p), 3 * p.natural_frequency_rad_s)
+    full = eigen_analysis(J, n, p.R, p.natural_frequency_rad_s)
+    assert np.sum(np.abs(full.eigenvalues_per_s) / p.natural_frequency_rad_s < 1e-10) == n - 2
+    if n == 5:  # three free balls together at the heavy side: |S| = a + 3 > 2, no completion
+        with pytest.raises(ParameterError, match="free_angles_rad"):
+            balanced_ball_angles(p, free_angles_rad=np.zeros(n - 2))
+    with pytest.raises(ParameterError, match="residual"):
+        balanced_state(p, np.zeros(n))
+
+
+def test_undamped_system_is_marginal():
+    # c = D = 0: gyroscopic, conservative linearisation; a stable balanced state has all
+    # eigenvalues on the imaginary axis, so it must be classified marginal, not stable.
+    p = S1.replace(c=0.0, D=0.0)
+    result = balanced_stability(p, [2 * WN, 5 * WN])
+    assert list(result.stability_class) == [MARGINAL, MARGINAL]
+    assert np.all(np.abs(result.max_real_part_per_s) <= result.rounding_bound_per_s)
+
+
+def test_stability_map_matches_pointwise_analysis():
+    speeds = np.linspace(0.3, 4, 40) * WN
+    drags = np.geomspace(1e-6, 0.1, 30)
+    screened = stability_map(S1, speeds, "D", drags)
+    full = stability_map(S1, speeds, "D", drags, condition_cap=None)
+    assert screened.stability_class.shape == (30, 40)
+    assert np.array_equal(screened.stability_class, full.stability_class)
+    row = balanced_stability(S1.replace(D=drags[7]), speeds)
+    assert np.array_equal(screened.stability_class[7], row.stability_class)
+    # same matrices, same LAPACK routine family: growth rates agree to rounding
+    assert np.allclose(screened.max_real_part_per_s[7], row.max_real_part_per_s, rtol=1e-9, atol=1e-9 * WN)
+    counts = stability_map(S1, speeds, "n", [2, 3, 5]).class_counts
+    assert counts["stable"] > 0 and counts["unstable"] > 0
+    with pytest.raises(ParameterError, match="parameter"):
+        stability_map(S1, speeds, "zeta", [0.1])
+
+
+def test_threshold_sensitivity_to_identified_parameters():
+    std = ParameterStd(k=200.0, c=1.0, M=0.01)
+    sens = threshold_sensitivity(S1, std, 10 * WN)
+    assert sens.threshold_rad_s / WN == pytest.approx(1.3956, abs=XTOL)
+    # A larger, one-sided step reproduces the central derivative to first order in the step
+    # (relative step 1e-2 -> ~1e-2 relative error).
+    step = 0.01 * S1.c
+    moved = stable_speed_intervals(S1.replace(c=S1.c + step), 10 * WN, xtol_ratio=1e-12).lowest_stable_speed_rad_s
+    assert (moved - sens.threshold_rad_s) / step == pytest.approx(sens.derivative_c, rel=0.05)
+    expected = math.sqrt((sens.derivative_k * 200) ** 2 + sens.derivative_c**2 + (sens.derivative_M * 0.01) ** 2)
+    assert sens.std_rad_s == pytest.approx(expected, rel=1e-12)
+
+
+def test_balancing_required_for_stability_questions():
+    heavy = S1.replace(e=0.05)
+    with pytest.raises(ParameterError, match="n\\*m\\*R"):
+        stable_speed_intervals(heavy, 10 * WN)
+    with pytest.raises(ParameterError, match="speed_max_rad_s"):
+        stable_speed_intervals(S1, math.nan)
+    # equilibria still exist without balancing: only unbalanced ones
+    assert all(eq.kind == "unbalanced" for eq in find_equilibria(heavy, 2 * WN))
