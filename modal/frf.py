@@ -1,0 +1,256 @@
+"""The frequency response function (FRF) container.
+
+An :class:`FRF` holds one or many channels of a measured or synthetic FRF on a
+common, strictly increasing frequency axis in Hz, together with its kind
+(receptance, mobility or accelerance), optional point ids and units.
+It validates on construction and is immutable; conversions return new objects.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from typing import Literal
+
+import numpy as np
+
+from .errors import FRFValidationError, ModalWarning, warn
+from .units import TWO_PI
+
+__all__ = ["FRF", "FRF_KINDS", "KIND_POWER", "DEFAULT_UNITS", "kind_factor"]
+
+Kind = Literal["receptance", "mobility", "accelerance"]
+FRF_KINDS: tuple[str, ...] = ("receptance", "mobility", "accelerance")
+#: H_kind(ω) = (iω)**p · receptance(ω): the power p of each kind.
+KIND_POWER = {"receptance": 0, "mobility": 1, "accelerance": 2}
+DEFAULT_UNITS = {"receptance": "m/N", "mobility": "m/s/N", "accelerance": "m/s^2/N"}
+
+
+def kind_factor(omega_rad_s: np.ndarray, kind: str) -> np.ndarray:
+    """Factor (iω)**p that turns a receptance into an FRF of ``kind``.
+
+    Parameters
+    ----------
+    omega_rad_s : ndarray
+        Angular frequency, rad/s.
+    kind : {"receptance", "mobility", "accelerance"}
+    """
+    power = KIND_POWER[kind]
+    if power == 0:
+        return np.ones_like(omega_rad_s, dtype=complex)
+    return (1j * np.asarray(omega_rad_s)) ** power
+
+
+def _as_point_ids(value, n_channels: int, name: str, source: str) -> tuple[str, ...] | None:
+    if value is None:
+        return None
+    if isinstance(value, (str, int, np.integer)):
+        value = [value] * n_channels if n_channels == 1 else [value]
+    ids = tuple(str(v) for v in value)
+    if len(ids) != n_channels:
+        raise FRFValidationError(
+            f"{source}: field '{name}' has {len(ids)} point ids, expected one per channel ({n_channels})"
+        )
+    return ids
+
+
+@dataclass(frozen=True, eq=False)
+class FRF:
+    """Frequency response function on a common frequency axis.
+
+    Parameters
+    ----------
+    frequency_hz : array_like, shape (n_freq,)
+        Frequency lines in Hz, finite, non-negative and distinct. Unsorted input
+        is sorted (with a warning); duplicates, NaN and Inf are rejected.
+    response : array_like, shape (n_freq,) or (n_channels, n_freq)
+        Complex FRF values, in the unit given by ``units``.
+    kind : {"receptance", "mobility", "accelerance"}
+        Displacement/force (m/N), velocity/force (m/s/N) or acceleration/force
+        (m/s²/N).
+    response_points, reference_points : sequence of str, optional
+        One id per channel (for example ``"101+Z"``). A channel whose response
+        and reference points are equal is a driving point.
+    units : str, optional
+        Unit of ``response``; defaults to the SI unit of ``kind``.
+    source : str
+        Where the data came from (file name); used in error messages.
+
+    Attributes
+    ----------
+    n_channels, n_freq : int
+    omega_rad_s : ndarray
+        Angular frequency, rad/s.
+    """
+
+    frequency_hz: np.ndarray
+    response: np.ndarray
+    kind: Kind = "receptance"
+    response_points: tuple[str, ...] | None = None
+    reference_points: tuple[str, ...] | None = None
+    units: str | None = None
+    source: str = "<array>"
+    _single: bool = field(default=False, repr=False)
+
+    def __post_init__(self) -> None:
+        src = self.source
+        if self.kind not in FRF_KINDS:
+            raise FRFValidationError(
+                f"{src}: field 'kind' is {self.kind!r}, expected one of {', '.join(FRF_KINDS)}"
+            )
+        try:
+            freq = np.array(self.frequency_hz, dtype=float)
+        except (TypeError, ValueError) as exc:
+            raise FRFValidationError(f"{src}: field 'frequency_hz' is not numeric ({exc})") from None
+        try:
+            resp = np.array(self.response, dtype=complex)
+        except (TypeError, ValueError) as exc:
+            raise FRFValidationError(f"{src}: field 'response' is not numeric ({exc})") from None
+        if freq.ndim != 1:
+            raise FRFValidationError(f"{src}: field 'frequency_hz' must be 1-D, got shape {freq.shape}")
+        if freq.size < 2:
+            raise FRFValidationError(f"{src}: field 'frequency_hz' has {freq.size} lines, expected at least 2")
+        single = resp.ndim == 1
+        if single:
+            resp = resp[np.newaxis, :]
+        if resp.ndim != 2 or resp.shape[1] != freq.size:
+            raise FRFValidationError(
+                f"{src}: field 'response' has shape {np.shape(self.response)}, expected "
+                f"({freq.size},) or (n_channels, {freq.size}) to match 'frequency_hz'"
+            )
+        if resp.shape[0] == 0:
+            raise FRFValidationError(f"{src}: field 'response' has no channels")
+        bad = ~np.isfinite(freq)
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            raise FRFValidationError(
+                f"{src}: field 'frequency_hz' has a non-finite value ({freq[i]}) at line {i}; expected finite Hz"
+            )
+        if (freq < 0).any():
+            i = int(np.flatnonzero(freq < 0)[0])
+            raise FRFValidationError(
+                f"{src}: field 'frequency_hz' has a negative value ({freq[i]}) at line {i}; expected >= 0 Hz"
+            )
+        bad = ~np.isfinite(resp)
+        if bad.any():
+            ch, i = (int(v) for v in np.argwhere(bad)[0])
+            raise FRFValidationError(
+                f"{src}: field 'response' has a non-finite value at channel {ch}, line {i} "
+                f"({freq[i]} Hz); expected finite complex numbers"
+            )
+        steps = np.diff(freq)
+        if (steps <= 0).any():
+            order = np.argsort(freq, kind="stable")
+            sorted_freq = freq[order]
+            dup = np.flatnonzero(np.diff(sorted_freq) == 0)
+            if dup.size:
+                raise FRFValidationError(
+                    f"{src}: field 'frequency_hz' has duplicate lines ({sorted_freq[dup[0]]} Hz); "
+                    "expected distinct frequencies"
+                )
+            warn(f"{src}: frequency lines were not increasing; sorted them", ModalWarning, stacklevel=4)
+            freq = sorted_freq
+            resp = resp[:, order]
+        freq.setflags(write=False)
+        resp.setflags(write=False)
+        n_ch = resp.shape[0]
+        object.__setattr__(self, "frequency_hz", freq)
+        object.__setattr__(self, "response", resp[0] if single else resp)
+        object.__setattr__(self, "_single", single)
+        object.__setattr__(self, "response_points", _as_point_ids(self.response_points, n_ch, "response_points", src))
+        object.__setattr__(self, "reference_points", _as_point_ids(self.reference_points, n_ch, "reference_points", src))
+        if self.units is None:
+            object.__setattr__(self, "units", DEFAULT_UNITS[self.kind])
+
+    # ------------------------------------------------------------------ views
+    @property
+    def n_freq(self) -> int:
+        """Number of frequency lines."""
+        return self.frequency_hz.size
+
+    @property
+    def n_channels(self) -> int:
+        """Number of channels (1 for a single FRF)."""
+        return 1 if self._single else self.response.shape[0]
+
+    @property
+    def channels(self) -> np.ndarray:
+        """Response as a 2-D array ``(n_channels, n_freq)`` (a view)."""
+        return self.response[np.newaxis, :] if self._single else self.response
+
+    @property
+    def omega_rad_s(self) -> np.ndarray:
+        """Angular frequency of each line, rad/s."""
+        return self.frequency_hz * TWO_PI
+
+    @property
+    def magnitude(self) -> np.ndarray:
+        """|H| in the unit of ``units``."""
+        return np.abs(self.response)
+
+    @property
+    def phase_rad(self) -> np.ndarray:
+        """Phase of H in radians, in (−π, π]."""
+        return np.angle(self.response)
+
+    def is_driving_point(self) -> np.ndarray:
+        """Boolean per channel: response point equals reference point.
+
+        A single-channel FRF given without point ids is taken as a driving point
+        (:func:`modal.identify` says so in its flags).
+        """
+        if self.response_points is None or self.reference_points is None:
+            return np.full(self.n_channels, self.n_channels == 1)
+        return np.array([r == q for r, q in zip(self.response_points, self.reference_points)])
+
+    # ------------------------------------------------------------ transforms
+    def as_kind(self, kind: Kind) -> "FRF":
+        """Exact conversion to another FRF kind (multiplies by (iω)**Δp).
+
+        Converting a line at 0 Hz to a lower kind (for example accelerance to
+        receptance) divides by zero and is refused.
+        """
+        if kind not in FRF_KINDS:
+            raise FRFValidationError(f"kind must be one of {', '.join(FRF_KINDS)}, got {kind!r}")
+        delta = KIND_POWER[kind] - KIND_POWER[self.kind]
+        if delta == 0:
+            return self
+        iw = 1j * self.omega_rad_s
+        if delta < 0 and np.any(iw == 0):
+            raise FRFValidationError(
+                f"{self.source}: cannot convert {self.kind} to {kind}: the line at 0 Hz would divide by zero"
+            )
+        resp = self.response * iw ** delta
+        units = DEFAULT_UNITS[kind] if self.units == DEFAULT_UNITS[self.kind] else None
+        return replace(self, response=resp, kind=kind, units=units)
+
+    def cropped(self, f_low_hz: float, f_high_hz: float) -> "FRF":
+        """The lines with ``f_low_hz <= f <= f_high_hz``."""
+        keep = (self.frequency_hz >= f_low_hz) & (self.frequency_hz <= f_high_hz)
+        if keep.sum() < 2:
+            raise FRFValidationError(
+                f"{self.source}: band {f_low_hz}–{f_high_hz} Hz holds {int(keep.sum())} lines, expected at least 2"
+            )
+        return replace(self, frequency_hz=self.frequency_hz[keep], response=self.response[..., keep])
+
+    def channel(self, index: int) -> "FRF":
+        """A single-channel FRF of channel ``index``."""
+        pts = lambda ids: None if ids is None else (ids[index],)  # noqa: E731
+        return replace(
+            self,
+            response=self.channels[index],
+            response_points=pts(self.response_points),
+            reference_points=pts(self.reference_points),
+        )
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, FRF):
+            return NotImplemented
+        return (
+            self.kind == other.kind
+            and self.units == other.units
+            and self.response_points == other.response_points
+            and self.reference_points == other.reference_points
+            and np.array_equal(self.frequency_hz, other.frequency_hz)
+            and np.array_equal(self.response, other.response)
+        )
+
+    __hash__ = None  # type: ignore[assignment]

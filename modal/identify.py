@@ -1,0 +1,309 @@
+"""``identify``: from an FRF to every mode's ωn, ζ, modal constant and k, c, m."""
+from __future__ import annotations
+
+import numpy as np
+
+from .circlefit import circle_fit_curve
+from .errors import IdentificationError, QualityWarning, ResolutionWarning, warn
+from .frf import FRF, KIND_POWER
+from .halfpower import half_power_curve
+from .model import mode_basis
+from .nls import fit_modes
+from .peaks import ModeBand, bands_from_hz, estimate_noise_std, find_modes
+from .results import FLAG_TEXT, IdentificationResult, ModeResult, ModeStd, physical_parameters
+from .units import TWO_PI
+
+__all__ = ["identify", "METHODS"]
+
+METHODS = ("nls", "circle", "halfpower")
+#: chi-square above which the model is flagged as not explaining the data
+CHI2_LIMIT = 3.0
+#: relative standard error of ζ above which an estimate is flagged
+REL_STD_LIMIT = 0.1
+#: channels (strongest first) used for the NLS start values
+START_CHANNELS = 8
+_RESOLUTION_FLAGS = {"resolution_limited", "missing_crossing", "too_few_points"}
+
+
+def _combine(values, stds, weights):
+    """Robust combination over channels: weighted median, and its standard error.
+
+    Channels whose estimate failed (NaN) are ignored. The weighted median keeps
+    one poor channel (a node of the mode, a peak outside the band) from
+    dragging the shared pole.
+    """
+    values, stds, weights = (np.asarray(a, float) for a in (values, stds, weights))
+    ok = np.isfinite(values) & np.isfinite(weights) & (weights > 0)
+    if not ok.any():
+        ok = np.isfinite(values)
+        weights = np.ones_like(values)
+    if not ok.any():
+        return np.nan, np.nan
+    v, w, s = values[ok], weights[ok], stds[ok]
+    order = np.argsort(v)
+    cum = np.cumsum(w[order])
+    median = float(v[order][np.searchsorted(cum, 0.5 * cum[-1])])
+    good = np.isfinite(s)
+    if not good.any():
+        return median, np.nan
+    # inverse-variance combination of the channel errors, times the median's 1.25 efficiency loss
+    std = float(1.2533 / np.sqrt(np.sum(1.0 / np.maximum(s[good], 1e-300) ** 2)))
+    return median, std
+
+
+def _linear_constants(omega, h, power, wn, zeta):
+    """Modal constant per channel for a given pole, with a band offset; and its variance."""
+    phi = mode_basis(omega, wn, zeta, power)[0]
+    Phi = np.column_stack([phi, np.ones_like(phi)])
+    coef, *_ = np.linalg.lstsq(Phi, h.T, rcond=None)
+    res = h.T - Phi @ coef
+    dof = max(omega.size - 2, 1)
+    noise_var = np.sum(np.abs(res) ** 2, axis=0) / dof
+    gram_inv = np.linalg.inv(Phi.conj().T @ Phi)
+    return coef[0], noise_var * np.real(gram_inv[0, 0]), float(np.linalg.norm(res) ** 2)
+
+
+def _mode_arrays(frf, band: ModeBand):
+    keep = (frf.frequency_hz >= band.low_hz) & (frf.frequency_hz <= band.high_hz)
+    return frf.omega_rad_s[keep], frf.channels[:, keep]
+
+
+def _sdof_estimates(frf, band, power, noise, method, channels=None):
+    """Per-channel half-power or circle estimates, combined into one pole.
+
+    ``channels`` restricts the pole estimate to a subset (the modal constants
+    of the others stay NaN); by default every channel is used.
+    """
+    omega, h = _mode_arrays(frf, band)
+    n_ch = h.shape[0]
+    use = range(n_ch) if channels is None else channels
+    wn = np.full(n_ch, np.nan)
+    zeta = np.full(n_ch, np.nan)
+    s_wn = np.full(n_ch, np.nan)
+    s_z = np.full(n_ch, np.nan)
+    const = np.full(n_ch, np.nan, dtype=complex)
+    flags: set[str] = set()
+    quality = []
+    for ch in use:
+        if method == "halfpower":
+            est = half_power_curve(omega, h[ch], power, noise[ch])
+            wn[ch], zeta[ch], s_wn[ch], s_z[ch] = est.omega_n, est.damping_ratio, est.std_omega_n, est.std_damping_ratio
+            quality.append(est.n_above)
+            above = np.abs(h[ch]) >= np.abs(h[ch]).max() / np.sqrt(2)
+            phi = mode_basis(omega[above], est.omega_n, est.damping_ratio, power)[0]
+            const[ch] = np.vdot(phi, h[ch][above]) / np.vdot(phi, phi)
+        else:
+            if np.any(omega == 0) and power == 2:
+                omega_c, h_c = omega[omega > 0], h[ch][omega > 0]
+            else:
+                omega_c, h_c = omega, h[ch]
+            mobility = h_c * (1j * omega_c) ** (1 - power)
+            try:
+                est = circle_fit_curve(omega_c, mobility, noise[ch] * np.max(np.abs(omega_c)) ** (1 - power))
+            except ValueError:
+                flags.add("too_few_points")
+                continue
+            wn[ch], zeta[ch], s_wn[ch], s_z[ch] = est.omega_n, est.damping_ratio, est.std_omega_n, est.std_damping_ratio
+            const[ch] = est.modal_constant
+            quality.append(est.damping_pair_spread)
+        flags.update(est.flags)
+    weights = _channel_weights(frf, band, noise)
+    wn_c, s_wn_c = _combine(wn, s_wn, weights)
+    z_c, s_z_c = _combine(zeta, s_z, weights)
+    if not np.isfinite(wn_c):
+        # nothing usable: report the peak line, flagged
+        wn_c = float(omega[np.argmax(np.abs(h).max(axis=0))])
+        z_c = float(np.min(np.diff(omega)) / (2 * wn_c)) if omega.size > 1 else np.nan
+        flags.add("too_few_points")
+    q = float(np.nanmedian(quality)) if len(quality) and np.isfinite(quality).any() else np.nan
+    return wn_c, z_c, s_wn_c, s_z_c, const, flags, q
+
+
+def _channel_weights(frf, band, noise):
+    """Signal-to-noise power of each channel at the mode's peak line."""
+    i = int(np.argmin(np.abs(frf.frequency_hz - band.peak_hz)))
+    peak = np.abs(frf.channels[:, i])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(noise > 0, (peak / noise) ** 2, peak**2)
+
+
+def _regions(bands: list[ModeBand], freq):
+    """Lines in any band, and a region index per line (overlapping bands merge)."""
+    keep = np.zeros(freq.size, bool)
+    for b in bands:
+        keep |= (freq >= b.low_hz) & (freq <= b.high_hz)
+    idx = np.flatnonzero(keep)
+    region = np.zeros(idx.size, int)
+    breaks = np.flatnonzero(np.diff(idx) > 1)
+    for br in breaks:
+        region[br + 1:] += 1
+    return keep, region
+
+
+def _start_pole(frf, band, power, noise):
+    """Best start of (ωn, ζ) among half-power and circle, by residual with A solved linearly."""
+    omega, h = _mode_arrays(frf, band)
+    weights = _channel_weights(frf, band, noise)
+    strongest = np.argsort(weights)[::-1][:START_CHANNELS]
+    candidates = []
+    for method in ("halfpower", "circle"):
+        with np.errstate(all="ignore"):
+            import warnings
+
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                wn, zeta, *_ = _sdof_estimates(frf, band, power, noise, method, channels=strongest)
+        if np.isfinite(wn) and np.isfinite(zeta) and wn > 0 and zeta > 0:
+            candidates.append((wn, zeta))
+    if not candidates:
+        i = np.argmax(np.abs(h).max(axis=0))
+        candidates.append((omega[i], max(np.min(np.diff(omega)) / omega[i], 1e-6)))
+    best = min(candidates, key=lambda c: _linear_constants(omega, h[strongest], power, *c)[2])
+    return best
+
+
+def _physical(frf, wn, zeta, const, cov, driving, flags):
+    (k, c, m), (sk, sc, sm) = physical_parameters(wn, zeta, const, cov)
+    const = np.asarray(const)
+    if driving.any():
+        dp_phase = np.abs(np.angle(const[driving]))
+        if np.any(dp_phase > np.deg2rad(10)) and np.all(const[driving].real > 0):
+            flags.add("complex_mode")
+        if np.any(const[driving].real <= 0):
+            flags.add("non_positive_constant")
+    undefined = ~driving | (const.real <= 0)
+    for arr in (k, c, m, sk, sc, sm):
+        arr[undefined] = np.nan
+    if (~driving).any():
+        flags.add("not_driving_point")
+    return (k, c, m), (sk, sc, sm)
+
+
+def identify(frf: FRF, method: str = "nls", bands_hz=None, *, noise_std=None, driving_point=None,
+             min_prominence_db: float = 6.0, max_modes: int | None = None) -> IdentificationResult:
+    """Identify every mode of an FRF.
+
+    Parameters
+    ----------
+    frf : FRF
+        One or many channels (poles are shared by all channels).
+    method : {"nls", "circle", "halfpower"}
+        ``"nls"`` (default): complex nonlinear least squares of all modes
+        together, started from the better of half-power and circle fit.
+        ``"circle"``: Kennedy–Pancu circle fit on the mobility.
+        ``"halfpower"``: half-power bandwidth with exact inversion.
+    bands_hz : list of (f_low, f_high), optional
+        One band per mode, Hz. Default: found from the peaks, each ±3
+        half-power widths, clipped halfway to its neighbours.
+    noise_std : float or array_like over channels, optional
+        Known noise σ (E|n|² = σ²) in the FRF's unit; default estimated from
+        second differences of the data.
+    driving_point : bool or array_like of bool, optional
+        Overrides which channels are driving points (k, c, m defined).
+    min_prominence_db : float
+        Peak detection threshold when ``bands_hz`` is not given.
+    max_modes : int, optional
+        Keep at most this many (strongest) peaks.
+
+    Returns
+    -------
+    IdentificationResult
+        ``result.modes[i]`` has ``natural_frequency_hz``, ``damping_ratio``,
+        ``modal_constant``, ``stiffness_n_per_m``, ``damping_n_s_per_m``,
+        ``mass_kg``, ``std`` (standard errors under the same names) and
+        ``flags``; arrays over channels for multi-channel FRFs.
+
+    Warns
+    -----
+    ResolutionWarning
+        An estimate is resolution-limited (fewer than 3 lines above −3 dB, a
+        missing crossing); it is returned flagged.
+    QualityWarning
+        Any other flag (band-edge peak, poor model fit, large uncertainty).
+    """
+    if not isinstance(frf, FRF):
+        raise TypeError(f"identify() expects a modal.FRF, got {type(frf).__name__}")
+    if method not in METHODS:
+        raise IdentificationError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
+    power = KIND_POWER[frf.kind]
+    n_ch = frf.n_channels
+    estimated_noise = estimate_noise_std(frf)
+    bands = bands_from_hz(frf, bands_hz) if bands_hz is not None else find_modes(
+        frf, min_prominence_db=min_prominence_db, max_modes=max_modes, noise_std=estimated_noise)
+    if noise_std is None:
+        noise = estimated_noise
+    else:
+        noise = np.broadcast_to(np.asarray(noise_std, float), (n_ch,)).copy()
+        if not np.all(np.isfinite(noise)) or np.any(noise < 0):
+            raise IdentificationError(f"noise_std must be finite and >= 0, got {noise_std!r}")
+    if driving_point is None:
+        driving = frf.is_driving_point()
+    else:
+        driving = np.broadcast_to(np.asarray(driving_point, bool), (n_ch,)).copy()
+    assumed = driving_point is None and n_ch == 1 and frf.response_points is None
+
+    per_mode = []  # (wn, zeta, const (n_ch,), cov (n_ch,4,4) or None, std_wn, std_z, flags, quality, chi2)
+    if method in ("halfpower", "circle"):
+        for band in bands:
+            wn, zeta, s_wn, s_z, const, flags, q = _sdof_estimates(frf, band, power, noise, method)
+            cov = np.zeros((n_ch, 4, 4))
+            cov[:, 0, 0], cov[:, 1, 1] = s_wn**2, s_z**2
+            omega, h = _mode_arrays(frf, band)
+            _, var_a, _ = _linear_constants(omega, h, power, wn, zeta) if np.isfinite(wn) and np.isfinite(zeta) else (None, np.full(n_ch, np.nan), None)
+            cov[:, 2, 2] = cov[:, 3, 3] = var_a / 2
+            per_mode.append((wn, zeta, const, cov, s_wn, s_z, flags, q, np.nan))
+    else:
+        starts = [_start_pole(frf, band, power, noise) for band in bands]
+        keep, region = _regions(bands, frf.frequency_hz)
+        fit = fit_modes(frf.omega_rad_s[keep], frf.channels[:, keep], power,
+                        [s[0] for s in starts], [s[1] for s in starts], region=region)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            chi2_ch = fit.noise_var / np.where(estimated_noise > 0, estimated_noise, np.nan) ** 2
+        chi2 = float(np.nanmedian(chi2_ch)) if np.isfinite(chi2_ch).any() else np.nan
+        for r, band in enumerate(bands):
+            flags: set[str] = set()
+            if not fit.converged:
+                flags.add("did_not_converge")
+            if np.isfinite(chi2) and chi2 > CHI2_LIMIT:
+                flags.add("model_inadequate")
+            cov = fit.mode_cov[r]
+            s_wn = float(np.sqrt(max(cov[0, 0, 0], 0))) if np.isfinite(cov[0, 0, 0]) else np.nan
+            s_z = float(np.sqrt(max(cov[0, 1, 1], 0))) if np.isfinite(cov[0, 1, 1]) else np.nan
+            wn, zeta = float(fit.omega_n[r]), float(fit.damping_ratio[r])
+            if not (band.low_hz <= wn / TWO_PI <= band.high_hz):
+                flags.add("band_edge_peak")
+            per_mode.append((wn, zeta, fit.modal_constant[r], cov, s_wn, s_z, flags, chi2, chi2))
+
+    modes = []
+    for band, (wn, zeta, const, cov, s_wn, s_z, flags, quality, chi2) in zip(bands, per_mode):
+        flags = set(flags)
+        const = np.asarray(const, complex)
+        if np.isfinite(s_z) and np.isfinite(zeta) and zeta > 0 and s_z / zeta > REL_STD_LIMIT:
+            flags.add("high_uncertainty")
+        if assumed:
+            flags.add("driving_point_assumed")
+        omega_b, _ = _mode_arrays(frf, band)
+        spacing = float(np.median(np.diff(omega_b))) if omega_b.size > 1 else np.nan
+        lines_per_bw = 2 * zeta * wn / spacing if spacing > 0 else np.nan
+        others = [b.peak_hz for b in bands if b is not band and band.low_hz < b.peak_hz < band.high_hz]
+        if others:
+            flags.add("close_modes")
+        (k, c, m), (sk, sc, sm) = _physical(frf, wn, zeta, const, cov, driving, flags)
+        s_const = np.sqrt(np.maximum(cov[:, 2, 2] + cov[:, 3, 3], 0))
+        single = frf.response.ndim == 1
+        sq = (lambda a: a.reshape(-1)[0].item()) if single else (lambda a: np.asarray(a))
+        std = ModeStd(s_wn / TWO_PI, s_z, sq(s_const), sq(sk), sq(sc), sq(sm))
+        flags_t = tuple(sorted(flags))
+        mode = ModeResult(
+            natural_frequency_hz=wn / TWO_PI, damping_ratio=zeta, modal_constant=sq(const),
+            stiffness_n_per_m=sq(k), damping_n_s_per_m=sq(c), mass_kg=sq(m), std=std, flags=flags_t,
+            method=method, band_hz=(band.low_hz, band.high_hz), n_lines=int(omega_b.size),
+            lines_per_bandwidth=lines_per_bw, chi2=chi2, driving_point=sq(driving), quality=quality,
+        )
+        modes.append(mode)
+        serious = set(flags_t) - {"driving_point_assumed", "not_driving_point"}
+        if serious:
+            category = ResolutionWarning if serious & _RESOLUTION_FLAGS else QualityWarning
+            reasons = "; ".join(f"{f}: {FLAG_TEXT[f]}" for f in sorted(serious))
+            warn(f"{frf.source}: {method} mode near {wn / TWO_PI:.6g} Hz is flagged ({reasons})", category)
+    return IdentificationResult(tuple(modes), method, frf.kind, n_ch, noise_std=estimated_noise)

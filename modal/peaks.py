@@ -1,0 +1,129 @@
+"""Noise level, mode indicator, automatic peak detection and fitting bands."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.signal import find_peaks
+
+from .errors import IdentificationError
+from .frf import FRF
+
+__all__ = ["estimate_noise_std", "mode_indicator", "find_modes", "ModeBand", "bands_from_hz"]
+
+
+def estimate_noise_std(frf: FRF) -> np.ndarray:
+    """Noise standard deviation per channel (E|n|² = σ²), from second differences.
+
+    For white noise the second difference has E|Δ²n|² = 6σ² and, being
+    circular Gaussian, |Δ²n|² has median 6σ² ln 2. The median over the whole
+    axis ignores the few lines where the signal itself curves (resonances).
+    Noise-free data give the (small) curvature floor instead of zero.
+    """
+    h = frf.channels
+    if h.shape[1] < 5:
+        return np.abs(h).max(axis=1) * np.nan
+    d2 = h[:, 2:] - 2 * h[:, 1:-1] + h[:, :-2]
+    power = d2.real**2 + d2.imag**2
+    mid = power.shape[1] // 2
+    median = np.partition(power, mid, axis=1)[:, mid]
+    return np.sqrt(median / (6 * np.log(2)))
+
+
+def mode_indicator(frf: FRF) -> np.ndarray:
+    """RMS over channels of |H| normalised by each channel's maximum (1-D, n_freq)."""
+    mag = np.abs(frf.channels)
+    peak = mag.max(axis=1, keepdims=True)
+    peak[peak == 0] = 1.0
+    return np.sqrt(np.mean((mag / peak) ** 2, axis=0))
+
+
+@dataclass(frozen=True)
+class ModeBand:
+    """A peak and its fitting band."""
+
+    peak_hz: float
+    low_hz: float
+    high_hz: float
+    half_power_width_hz: float
+    user_given: bool = False
+
+
+def _half_power_width(freq, ind, i):
+    level = ind[i] / np.sqrt(2)
+    lo = i
+    while lo > 0 and ind[lo] >= level:
+        lo -= 1
+    hi = i
+    while hi < ind.size - 1 and ind[hi] >= level:
+        hi += 1
+    return freq[hi] - freq[lo]
+
+
+def find_modes(frf: FRF, min_prominence_db: float = 6.0, noise_factor: float = 10.0,
+               bandwidths: float = 3.0, max_modes: int | None = None,
+               noise_std: np.ndarray | None = None) -> list[ModeBand]:
+    """Find resonance peaks and give each a fitting band.
+
+    A peak of the mode indicator counts when it stands ``min_prominence_db``
+    above its surroundings and ``noise_factor`` times above the noise level.
+    Its band is ±``bandwidths`` half-power widths (at least ±5 lines), clipped
+    halfway to the neighbouring peaks and to the data.
+    """
+    freq = frf.frequency_hz
+    ind = mode_indicator(frf)
+    noise = estimate_noise_std(frf) if noise_std is None else noise_std
+    peak_mag = np.abs(frf.channels).max(axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        noise_rel = float(np.sqrt(np.nanmean((noise / peak_mag) ** 2)))
+    floor = noise_factor * noise_rel if np.isfinite(noise_rel) else 0.0
+    db = 20 * np.log10(np.maximum(ind, np.finfo(float).tiny))
+    idx, props = find_peaks(db, prominence=min_prominence_db)
+    keep = ind[idx] > floor
+    idx = idx[keep]
+    if max_modes is not None and idx.size > max_modes:
+        strongest = np.argsort(ind[idx])[::-1][:max_modes]
+        idx = np.sort(idx[strongest])
+    if idx.size == 0:
+        raise IdentificationError(
+            f"{frf.source}: no resonance peak found ({min_prominence_db} dB prominence, "
+            f"{noise_factor}x above noise); give the bands explicitly"
+        )
+    out = []
+    df_min = np.min(np.diff(freq))
+    for j, i in enumerate(idx):
+        width = max(_half_power_width(freq, ind, i), df_min)
+        half = max(bandwidths * width, 5 * df_min)
+        low, high = freq[i] - half, freq[i] + half
+        if j > 0:
+            low = max(low, 0.5 * (freq[idx[j - 1]] + freq[i]))
+        if j < idx.size - 1:
+            high = min(high, 0.5 * (freq[idx[j + 1]] + freq[i]))
+        out.append(ModeBand(float(freq[i]), float(max(low, freq[0])), float(min(high, freq[-1])), float(width)))
+    return out
+
+
+def bands_from_hz(frf: FRF, bands_hz) -> list[ModeBand]:
+    """Turn user bands ``[(f_low, f_high), ...]`` (Hz) into :class:`ModeBand` objects."""
+    out = []
+    try:
+        pairs = [(float(a), float(b)) for a, b in bands_hz]
+    except (TypeError, ValueError):
+        raise IdentificationError(
+            f"bands_hz must be a list of (f_low, f_high) pairs in Hz, got {bands_hz!r}"
+        ) from None
+    ind = mode_indicator(frf)
+    freq = frf.frequency_hz
+    for low, high in pairs:
+        if not (np.isfinite(low) and np.isfinite(high) and low < high):
+            raise IdentificationError(f"band ({low}, {high}) Hz: expected finite f_low < f_high")
+        inside = np.flatnonzero((freq >= low) & (freq <= high))
+        if inside.size < 3:
+            raise IdentificationError(
+                f"{frf.source}: band ({low}, {high}) Hz holds {inside.size} lines; expected at least 3 "
+                f"(data cover {freq[0]:g}–{freq[-1]:g} Hz)"
+            )
+        i = inside[np.argmax(ind[inside])]
+        width = max(_half_power_width(freq, ind, i), np.min(np.diff(freq)))
+        out.append(ModeBand(float(freq[i]), low, high, float(width), user_given=True))
+    return sorted(out, key=lambda b: b.peak_hz)

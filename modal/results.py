@@ -1,0 +1,209 @@
+"""Result dataclasses of identification and the physical parameters k, c, m.
+
+One :class:`ModeResult` per mode. For a multi-channel FRF the pole
+(``natural_frequency_hz``, ``damping_ratio``) is shared by all channels and is a
+float; the modal constant, k, c and m are arrays over channels.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field, fields
+from typing import Iterator
+
+import numpy as np
+
+from .units import TWO_PI
+
+__all__ = ["ModeStd", "ModeResult", "IdentificationResult", "physical_parameters", "FLAG_TEXT"]
+
+#: Every quality flag with the reason it is raised.
+FLAG_TEXT = {
+    "resolution_limited": "fewer than 3 lines above the half-power level: damping is below what the lines resolve",
+    "missing_crossing": "a half-power (-3 dB) crossing is missing in the band",
+    "band_edge_peak": "the peak lies at the edge of the band: the band does not contain the resonance",
+    "too_few_points": "too few lines near resonance for this method",
+    "damping_pair_spread": "circle fit: the damping estimates from point pairs disagree by more than 10 %",
+    "model_inadequate": "residual is much larger than the noise (chi-square): the model does not explain the data (close modes, missing mode, nonlinearity)",
+    "high_uncertainty": "standard error of the damping ratio exceeds 10 % of its value",
+    "did_not_converge": "least-squares refinement did not converge; the start values are reported",
+    "driving_point_assumed": "single-channel FRF without point ids: taken as a driving point",
+    "not_driving_point": "transfer FRF (response point differs from reference): k, c, m are not defined for it",
+    "complex_mode": "modal constant of a driving point is far from real (phase > 10 deg): k, c, m are approximate",
+    "non_positive_constant": "driving-point modal constant has a negative real part: k, c, m not defined",
+    "close_modes": "another mode lies within this mode's fitting band",
+}
+
+
+@dataclass(frozen=True)
+class ModeStd:
+    """Standard errors (one sigma) under the same names as :class:`ModeResult`.
+
+    ``modal_constant`` is the standard error of the complex value,
+    sqrt(var Re + var Im). NaN where a quantity is not defined (then the
+    result says why in its flags).
+    """
+
+    natural_frequency_hz: float
+    damping_ratio: float
+    modal_constant: np.ndarray | float
+    stiffness_n_per_m: np.ndarray | float
+    damping_n_s_per_m: np.ndarray | float
+    mass_kg: np.ndarray | float
+
+
+@dataclass(frozen=True)
+class ModeResult:
+    """One identified mode.
+
+    Attributes
+    ----------
+    natural_frequency_hz : float
+        Undamped natural frequency, Hz.
+    damping_ratio : float
+        Viscous damping ratio ζ (dimensionless).
+    modal_constant : complex or ndarray of complex
+        Receptance modal constant A (1/kg) per channel, whatever the FRF kind:
+        ``H_receptance ≈ A / (ωn² − ω² + 2iζωnω)``.
+    stiffness_n_per_m, damping_n_s_per_m, mass_kg : float or ndarray
+        k = m ωn², c = 2 ζ m ωn, m = 1/|A| for driving-point channels; NaN
+        for transfer channels (flag ``not_driving_point``).
+    std : ModeStd
+        Standard errors of all the above.
+    flags : tuple of str
+        Quality flags; see :data:`FLAG_TEXT`. Empty when the estimate is sound.
+    method : str
+        ``"nls"``, ``"circle"`` or ``"halfpower"``.
+    band_hz : tuple of float
+        Frequency band (Hz) the mode was fitted on.
+    n_lines : int
+        Lines in the band.
+    lines_per_bandwidth : float
+        Lines per half-power bandwidth 2ζfn (resolution; < 3 is coarse).
+    chi2 : float
+        Residual variance over the independently estimated noise variance
+        (≈ 1 when the model explains the data; NaN when not computed).
+    driving_point : bool or ndarray of bool
+        Per channel: whether k, c, m are defined.
+    quality : float
+        Method-specific quality measure (circle: relative spread of the
+        damping-pair estimates; NLS: chi2; half-power: lines above −3 dB).
+    """
+
+    natural_frequency_hz: float
+    damping_ratio: float
+    modal_constant: np.ndarray | complex
+    stiffness_n_per_m: np.ndarray | float
+    damping_n_s_per_m: np.ndarray | float
+    mass_kg: np.ndarray | float
+    std: ModeStd
+    flags: tuple[str, ...] = ()
+    method: str = ""
+    band_hz: tuple[float, float] = (float("nan"), float("nan"))
+    n_lines: int = 0
+    lines_per_bandwidth: float = float("nan")
+    chi2: float = float("nan")
+    driving_point: np.ndarray | bool = True
+    quality: float = float("nan")
+
+    @property
+    def omega_n_rad_s(self) -> float:
+        """Natural frequency in rad/s."""
+        return self.natural_frequency_hz * TWO_PI
+
+    @property
+    def ok(self) -> bool:
+        """True when the estimate carries no flag other than informational ones."""
+        info = {"driving_point_assumed", "not_driving_point"}
+        return not (set(self.flags) - info)
+
+
+@dataclass(frozen=True)
+class IdentificationResult:
+    """All modes identified from one FRF by one method.
+
+    Iterating gives the :class:`ModeResult` objects in order of frequency.
+    """
+
+    modes: tuple[ModeResult, ...]
+    method: str
+    kind: str
+    n_channels: int
+    noise_std: np.ndarray = field(default_factory=lambda: np.zeros(0))
+
+    def __iter__(self) -> Iterator[ModeResult]:
+        return iter(self.modes)
+
+    def __len__(self) -> int:
+        return len(self.modes)
+
+    def __getitem__(self, index: int) -> ModeResult:
+        return self.modes[index]
+
+    def rows(self) -> list[dict]:
+        """One plain dict per mode and channel (JSON-ready; keys as the fields)."""
+        out = []
+        names = ("modal_constant", "stiffness_n_per_m", "damping_n_s_per_m", "mass_kg")
+        for number, mode in enumerate(self.modes, start=1):
+            for ch in range(self.n_channels):
+                def pick(value, ch=ch):
+                    arr = np.asarray(value)
+                    return arr.reshape(-1)[ch] if arr.ndim else arr[()]
+
+                row = {
+                    "mode": number,
+                    "channel": ch,
+                    "method": mode.method,
+                    "natural_frequency_hz": float(mode.natural_frequency_hz),
+                    "damping_ratio": float(mode.damping_ratio),
+                }
+                for name in names:
+                    row[name] = complex(pick(getattr(mode, name))) if name == "modal_constant" else float(pick(getattr(mode, name)))
+                row["std"] = {f.name: float(pick(getattr(mode.std, f.name))) for f in fields(ModeStd)}
+                row["flags"] = list(mode.flags)
+                row["band_hz"] = [float(b) for b in mode.band_hz]
+                row["driving_point"] = bool(pick(mode.driving_point))
+                row["chi2"] = float(mode.chi2)
+                out.append(row)
+        return out
+
+
+def physical_parameters(omega_n, damping_ratio, modal_constant, cov=None):
+    """k, c, m and their standard errors from (ωn, ζ, A) of a driving point.
+
+    m = 1/|A|, k = m ωn², c = 2 ζ m ωn.
+
+    Parameters
+    ----------
+    omega_n : float
+        Natural frequency, rad/s.
+    damping_ratio : float
+    modal_constant : complex or ndarray of complex
+        Receptance modal constant(s), 1/kg.
+    cov : ndarray, shape (..., 4, 4), optional
+        Covariance of (ωn, ζ, Re A, Im A) per channel.
+
+    Returns
+    -------
+    (k, c, m), (std_k, std_c, std_m) : tuples of ndarray
+    """
+    A = np.asarray(modal_constant, dtype=complex)
+    a = np.abs(A)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        m = 1.0 / a
+    k = m * omega_n**2
+    c = 2.0 * damping_ratio * m * omega_n
+    if cov is None:
+        nan = np.full(A.shape, np.nan)
+        return (k, c, m), (nan, nan.copy(), nan.copy())
+    with np.errstate(divide="ignore", invalid="ignore"):
+        da_dre, da_dim = A.real / a, A.imag / a
+        # gradients with respect to (ωn, ζ, Re A, Im A)
+        zeros = np.zeros(A.shape)
+        g_m = np.stack([zeros, zeros, -m**2 * da_dre, -m**2 * da_dim], axis=-1)
+        g_k = np.stack([2 * m * omega_n + zeros, zeros, -k * m * da_dre, -k * m * da_dim], axis=-1)
+        g_c = np.stack([2 * damping_ratio * m + zeros, 2 * m * omega_n + zeros,
+                        -c * m * da_dre, -c * m * da_dim], axis=-1)
+
+    def sd(g):
+        return np.sqrt(np.maximum(np.einsum("...i,...ij,...j->...", g, cov, g), 0.0))
+
+    return (k, c, m), (sd(g_k), sd(g_c), sd(g_m))
