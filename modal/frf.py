@@ -43,7 +43,7 @@ def _as_point_ids(value, n_channels: int, name: str, source: str) -> tuple[str, 
     if value is None:
         return None
     if isinstance(value, (str, int, np.integer)):
-        value = [value] * n_channels if n_channels == 1 else [value]
+        value = [value] * n_channels  # one id for every channel (a common reference)
     ids = tuple(str(v) for v in value)
     if len(ids) != n_channels:
         raise FRFValidationError(
