@@ -369,3 +369,19 @@ def test_plot_on_given_axes():
         drive_report.plot_shear(_shaft_1(), ax="not an axes")
     with pytest.raises(ParameterError, match=r"axes has 1 entries"):
         drive_report.plot_shaft_diagrams(_shaft_1(), [ax])
+
+
+def test_docs_worked_example_runs(capsys):
+    # The code block in docs/drive.md must run as printed and give the numbers the doc quotes.
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parent.parent / "docs" / "drive.md").read_text(encoding="utf-8")
+    block = text.split("```python\n", 1)[1].split("```", 1)[0]
+    namespace: dict = {}
+    exec(compile(block, "docs/drive.md", "exec"), namespace)  # noqa: S102 - our own documentation
+    handover = namespace["handover"]
+    assert handover.speed_rad_s == pytest.approx(81.158, abs=5e-4)
+    assert handover.stiffness_n_per_m == pytest.approx(403.2e3, abs=50.0)
+    assert handover.critical.critical_speed_rpm == pytest.approx(2010.4, abs=0.05)
+    assert isinstance(namespace["figure"], Figure)
+    assert "first critical speed" in capsys.readouterr().out
