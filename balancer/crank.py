@@ -63,6 +63,7 @@ __all__ = [
     "two_mass_split",
     "slider_crank_from_components",
     "balance_fraction",
+    "counterweight_mass",
     "counterweight_moment",
     "shaking_force",
     "shaking_harmonics",
@@ -354,6 +355,23 @@ def _counterweight_moment(mech: SliderCrank, counterweight_mass_kg, counterweigh
             f"counterweight_radius_m = {radius!r}: expected 0 <= r_c <= crank_radius_m = "
             f"{mech.crank_radius_m!r} (the counterweight sits within the crank radius)")
     return mass * radius
+
+
+def counterweight_mass(mech: SliderCrank, k: float) -> float:
+    """The papers' counterweight mass ``m_c = m_rot + k m_rec`` [kg] (seed 000 eq. 8).
+
+    Parameters
+    ----------
+    mech : SliderCrank
+    k : float
+        Fraction of the reciprocating mass, in ``[0, 1]`` (seed 000 eq. 15).
+
+    Returns
+    -------
+    float
+    """
+    fraction = _finite_float("k", k, minimum=0.0, maximum=1.0)
+    return mech.rotating_mass_kg + fraction * mech.reciprocating_mass_kg
 
 
 def counterweight_moment(mech: SliderCrank, balance_fraction_value: float) -> float:

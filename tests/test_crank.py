@@ -20,6 +20,7 @@ from balancer.crank import (
     PAPER_RULES,
     SliderCrank,
     balance_fraction,
+    counterweight_mass,
     counterweight_on_curve,
     evaluate_balance_fraction,
     evaluate_counterweight,
@@ -53,6 +54,8 @@ def seed004() -> SliderCrank:
 
 
 def _mass(mech: SliderCrank, k: float) -> float:
+    # written out here rather than calling counterweight_mass, so the table
+    # test does not depend on the function it could be checking
     return mech.rotating_mass_kg + k * mech.reciprocating_mass_kg
 
 
@@ -168,6 +171,17 @@ def test_seed000_table_on_the_papers_one_degree_grid(seed000):
         got = max_shaking_force(seed000, SPEED_000_RPM, _mass(seed000, 0.6218), radius_mm * 1e-3,
                                 crank_angles_rad=DEG_GRID)
         assert got == pytest.approx(force_n, abs=5e-5), radius_mm
+
+
+def test_seed000_abstract_ratio_is_a_typo(seed000):
+    # The abstract's r_c/r = 0.9473 with k = 0.6218 gives 115.1 N (reference
+    # note, 1 decimal), 5.6 N above the table's own optimum 109.5247 N at
+    # r_c/r = 11.583/11.9 = 0.97336, so the abstract cannot be the table's point.
+    m_c = counterweight_mass(seed000, 0.6218)
+    abstract = max_shaking_force(seed000, SPEED_000_RPM, m_c, 0.9473 * R_000_M,
+                                 crank_angles_rad=DEG_GRID)
+    assert abstract == pytest.approx(115.1, abs=0.05)
+    assert abstract > 109.5247 + 5.0
 
 
 def test_exact_maximum_is_never_below_a_grid_maximum(seed000):
@@ -419,6 +433,8 @@ def test_bad_call_arguments_raise(seed000):
         counterweight_on_curve(seed000, opt, radius_m=0.001)
     with pytest.raises(ParameterError, match="give k or radius_m"):
         counterweight_on_curve(seed000, opt, k=0.7, radius_m=0.01)
+    with pytest.raises(ParameterError, match=r"k = 1\.2: expected a value <= 1\.0"):
+        counterweight_mass(seed000, 1.2)
     with pytest.raises(ParameterError, match="rod_cg_to_crank_pin_m = 0.06"):
         two_mass_split(0.05, 0.044, 0.06)
     assert crank.OBJECTIVES == ("max", "rms", "max_x", "max_y")
