@@ -1,0 +1,134 @@
+"""Write-then-read round trips of every FRF file format (issue 3)."""
+from __future__ import annotations
+
+import os
+
+import numpy as np
+import pytest
+
+from modal.frf import FRF
+from modal.io import read_frf, sniff_format, write_frf
+from modal.synthetic import add_noise, modal_frf
+
+
+def _frf(n_channels: int, kind: str = "accelerance", points: bool = True, n_lines: int = 401) -> FRF:
+    freq = np.linspace(2.0, 400.0, n_lines)
+    rng = np.random.default_rng(n_channels)
+    const = rng.standard_normal((n_channels, 3)) + 0.1j * rng.standard_normal((n_channels, 3))
+    frf = modal_frf(freq, [40.0, 130.0, 310.0], [0.01, 0.02, 0.015], const if n_channels > 1 else const[0],
+                    kind=kind,
+                    response_points=[f"{101 + i}+Z" for i in range(n_channels)] if points else None,
+                    reference_points=["1-Y"] * n_channels if points else None)
+    return add_noise(frf, 0.02, seed=n_channels)
+
+
+def _awkward_frf() -> FRF:
+    """Values whose decimal text is long or extreme: exact round trips must keep every bit."""
+    rng = np.random.default_rng(7)
+    freq = np.sort(rng.uniform(0.0, 1e4, 300))
+    mant = rng.standard_normal((2, 300)) + 1j * rng.standard_normal((2, 300))
+    scale = 10.0 ** rng.integers(-300, 300, (2, 300))
+    resp = mant * scale
+    resp[0, :3] = [0.0, -0.0 + 1j * 5e-324, 1.7976931348623157e308 - 2.2250738585072014e-308j]
+    return FRF(freq, resp, kind="mobility", response_points=["a", "b"], reference_points=["c", "d"])
+
+
+def _assert_same(got: FRF, want: FRF, rtol: float | None = None) -> None:
+    assert got.kind == want.kind
+    assert got.units == want.units
+    assert got.response_points == want.response_points
+    assert got.reference_points == want.reference_points
+    assert got.response.shape == want.response.shape
+    if rtol is None:  # bit-exact
+        assert got.frequency_hz.tobytes() == want.frequency_hz.tobytes()
+        assert got.response.tobytes() == want.response.tobytes()
+    else:
+        np.testing.assert_allclose(got.frequency_hz, want.frequency_hz, rtol=rtol, atol=0)
+        scale = np.abs(want.channels).max(axis=1, keepdims=True)
+        err = np.abs(got.channels - want.channels) / scale
+        assert err.max() <= rtol, err.max()
+
+
+# ----------------------------------------------------------------- CSV
+@pytest.mark.parametrize("n_channels", [1, 3])
+def test_canonical_csv_round_trip_is_bit_exact(tmp_path, n_channels):
+    frf = _frf(n_channels)
+    path = tmp_path / "h.csv"
+    write_frf(frf, path)
+    got = read_frf(path)
+    _assert_same(got, frf)
+    assert got == frf
+    assert got.source == str(path)
+
+
+def test_canonical_csv_keeps_extreme_values_bit_exact(tmp_path):
+    frf = _awkward_frf()
+    write_frf(frf, tmp_path / "x.csv")
+    _assert_same(read_frf(tmp_path / "x.csv"), frf)
+
+
+def test_canonical_csv_without_points(tmp_path):
+    frf = _frf(2, kind="receptance", points=False)
+    write_frf(frf, tmp_path / "np.csv")
+    got = read_frf(tmp_path / "np.csv")
+    assert got.response_points is None and got.reference_points is None
+    _assert_same(got, frf)
+
+
+def test_canonical_csv_layout(tmp_path):
+    frf = _frf(2)
+    write_frf(frf, tmp_path / "h.csv")
+    lines = (tmp_path / "h.csv").read_text().splitlines()
+    assert lines[0] == "# format: modalbal-frf-csv 1"
+    assert "# kind: accelerance" in lines
+    assert "# units: m/s^2/N" in lines
+    assert "# frequency_unit: Hz" in lines
+    assert '# response_points: ["101+Z", "102+Z"]' in lines
+    assert "frequency_hz,re_0,im_0,re_1,im_1" in lines
+    assert sniff_format(tmp_path / "h.csv") == "text"
+
+
+def test_failed_write_leaves_target_untouched_and_no_temporary_files(tmp_path, monkeypatch):
+    frf = _frf(1)
+    target = tmp_path / "h.csv"
+    target.write_text("old content\n")
+    import modal.io.csv as csv_mod
+
+    def exploding_repr(x):  # fails after the writer has written part of the file
+        raise OSError("disk full")
+
+    monkeypatch.setattr(csv_mod, "repr", exploding_repr, raising=False)
+    with pytest.raises(OSError, match="disk full"):
+        write_frf(frf, target)
+    monkeypatch.undo()
+    assert target.read_text() == "old content\n"
+    assert os.listdir(tmp_path) == ["h.csv"]
+    write_frf(frf, target)
+    assert os.listdir(tmp_path) == ["h.csv"]
+    assert read_frf(target) == frf
+
+
+def test_atomic_path_renames_only_on_success(tmp_path):
+    from modal.io._atomic import atomic_path
+
+    target = tmp_path / "t.bin"
+    with pytest.raises(RuntimeError):
+        with atomic_path(target) as tmp:
+            tmp.write_bytes(b"half")
+            raise RuntimeError("crash")
+    assert not target.exists() and os.listdir(tmp_path) == []
+    with atomic_path(target) as tmp:
+        assert tmp.parent == tmp_path
+        tmp.write_bytes(b"whole")
+    assert target.read_bytes() == b"whole" and os.listdir(tmp_path) == ["t.bin"]
+
+
+def test_several_files_combine_into_channels(tmp_path):
+    frf = _frf(3)
+    paths = []
+    for i in range(3):
+        paths.append(tmp_path / f"c{i}.csv")
+        write_frf(frf.channel(i), paths[-1])
+    got = read_frf(paths)
+    assert got.n_channels == 3
+    _assert_same(got, frf)
