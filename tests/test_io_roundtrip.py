@@ -132,3 +132,74 @@ def test_several_files_combine_into_channels(tmp_path):
     got = read_frf(paths)
     assert got.n_channels == 3
     _assert_same(got, frf)
+
+
+# ----------------------------------------------------------------- HDF5
+@pytest.mark.parametrize("n_channels", [1, 3])
+def test_hdf5_round_trip_is_bit_exact(tmp_path, n_channels):
+    frf = _frf(n_channels)
+    write_frf(frf, tmp_path / "h.h5")
+    assert sniff_format(tmp_path / "h.h5") == "hdf5"
+    _assert_same(read_frf(tmp_path / "h.h5"), frf)
+    awkward = _awkward_frf()
+    write_frf(awkward, tmp_path / "x.hdf5")
+    _assert_same(read_frf(tmp_path / "x.hdf5"), awkward)
+    assert set(os.listdir(tmp_path)) == {"h.h5", "x.hdf5"}  # no temporary files left
+
+
+def test_hdf5_layout_is_nexus_style_with_units(tmp_path):
+    import h5py
+
+    import modal
+    from modal.io.hdf5 import SCHEMA_VERSION
+
+    frf = _frf(2)
+    write_frf(frf, tmp_path / "h.h5")
+    with h5py.File(tmp_path / "h.h5", "r") as fh:
+        assert fh.attrs["schema"] == "modalbal-archive"
+        assert fh.attrs["schema_version"] == SCHEMA_VERSION == "1.0"
+        assert fh.attrs["software_version"] == modal.__version__
+        assert fh.attrs["created"].endswith("Z")
+        g = fh["frf/0"]
+        assert g.attrs["NX_class"] == "NXdata" and g.attrs["signal"] == "response"
+        assert list(g.attrs["axes"]) == [".", "frequency_hz"]
+        assert g["frequency_hz"].dtype == np.float64 and g["frequency_hz"].attrs["units"] == "Hz"
+        assert g["response"].dtype == np.complex128 and g["response"].attrs["units"] == "m/s^2/N"
+        assert g.attrs["kind"] == "accelerance"
+        assert list(g.attrs["response_points"]) == ["101+Z", "102+Z"]
+
+
+def test_hdf5_group_functions_are_reusable_inside_other_files(tmp_path):
+    import h5py
+
+    from modal.io.hdf5 import read_frf_group, write_frf_group
+
+    a, b = _frf(1), _frf(2, kind="mobility", points=False)
+    with h5py.File(tmp_path / "arch.h5", "w") as fh:
+        write_frf_group(fh.create_group("frf/a"), a)
+        write_frf_group(fh.create_group("frf/b"), b)
+        fh.create_group("identification")
+    with h5py.File(tmp_path / "arch.h5", "r") as fh:
+        _assert_same(read_frf_group(fh["frf/a"], "arch.h5"), a)
+        _assert_same(read_frf_group(fh["frf/b"], "arch.h5"), b)
+
+
+def test_hdf5_keeps_a_one_row_two_dimensional_response(tmp_path):
+    frf = _frf(1)
+    two_d = FRF(frf.frequency_hz, frf.response[np.newaxis, :], kind=frf.kind)
+    write_frf(two_d, tmp_path / "h.h5")
+    got = read_frf(tmp_path / "h.h5")
+    assert got.response.shape == (1, frf.n_freq) and got == two_d
+
+
+def test_hdf5_dataset_hint_picks_one_of_several_groups(tmp_path):
+    import h5py
+
+    from modal.io.hdf5 import write_frf_group, write_root_attrs
+
+    a, b = _frf(1), _frf(2)
+    with h5py.File(tmp_path / "two.h5", "w") as fh:
+        write_root_attrs(fh)
+        write_frf_group(fh.create_group("frf/a"), a)
+        write_frf_group(fh.create_group("frf/b"), b)
+    _assert_same(read_frf(tmp_path / "two.h5", dataset="b"), b)

@@ -157,15 +157,15 @@ def hint_points(hints: dict[str, Any], n_channels: int, src: str):
 
 def build_frf(frequency_hz: np.ndarray, response: np.ndarray, kind: str, src: str, *,
               response_points=None, reference_points=None, units: str | None = None,
-              hints: dict[str, Any] | None = None) -> FRF:
-    """Make the :class:`FRF`: one channel becomes a 1-D response, points/units hints override.
+              hints: dict[str, Any] | None = None, squeeze: bool = True) -> FRF:
+    """Make the :class:`FRF`: one channel becomes a 1-D response (if ``squeeze``), hints override.
 
     The FRF model validates (NaN, Inf, duplicates → FRFValidationError; unsorted
     lines are sorted with a ModalWarning).
     """
     hints = hints or {}
     resp = np.asarray(response)
-    if resp.ndim == 2 and resp.shape[0] == 1:
+    if squeeze and resp.ndim == 2 and resp.shape[0] == 1:
         resp = resp[0]
     n_ch = 1 if resp.ndim == 1 else resp.shape[0]
     rsp_hint, ref_hint = hint_points(hints, n_ch, src)
