@@ -114,6 +114,8 @@ class CorrectionTable:
             raise ParameterError(f"CorrectionTable {self.variable!r}: x = {self.x} must be strictly increasing")
         if np.any(f <= 0.0):
             raise ParameterError(f"CorrectionTable {self.variable!r}: factor = {self.factor} must all be > 0")
+        object.__setattr__(self, "x", tuple(float(v) for v in x))
+        object.__setattr__(self, "factor", tuple(float(v) for v in f))
 
     def lookup(self, value: float) -> float:
         """Factor at ``value`` (linear interpolation); raises
@@ -249,7 +251,11 @@ def next_standard_size(value: float, series: Sequence[float], name: str = "value
     ParameterError
         If every member of the series is smaller than ``value``.
     """
-    sizes = np.sort(np.asarray(series, dtype=float))
+    value = _finite(name, value, "(size)")
+    try:
+        sizes = np.sort(np.asarray(series, dtype=float))
+    except (TypeError, ValueError):
+        raise ParameterError(f"standard series for {name} = {series!r}; expected a sequence of sizes") from None
     if sizes.ndim != 1 or sizes.size == 0 or not np.all(np.isfinite(sizes)):
         raise ParameterError(f"standard series for {name} = {series!r}; expected a non-empty sequence of finite sizes")
     candidates = sizes[sizes >= value * (1.0 - 1e-9)]
@@ -502,8 +508,8 @@ def belt_stage(
     else:
         rating, required, minimum_count = 0.0, 0.0, 1
     if belt_count is not None:
-        if isinstance(belt_count, bool) or int(belt_count) != belt_count or belt_count < 1:
-            raise ParameterError(f"belt_count = {belt_count!r}; expected a whole number >= 1")
+        if not isinstance(belt_count, (int, np.integer)) or isinstance(belt_count, bool) or belt_count < 1:
+            raise ParameterError(f"belt_count = {belt_count!r}; expected an int >= 1 (a whole number of belts)")
         if belt_count < minimum_count:
             raise ParameterError(
                 f"belt_count = {belt_count} is below the {required:.4g} belts the rating requires; "
@@ -641,6 +647,7 @@ def belt_drive(motor_speed_rpm: float, power_w: float, stages: Sequence[BeltStag
     BeltDrive
         The stages and the output speed.
     """
+    stages = tuple(stages)
     if len(stages) == 0:
         raise ParameterError("stages = []; expected at least one BeltStageSpec")
     speed_rpm = _positive("motor_speed_rpm", motor_speed_rpm, "rpm")

@@ -252,9 +252,6 @@ def drive_report(*, drive: BeltDrive | None = None, stages: Sequence[BeltStage] 
 
 
 # --------------------------------------------------------------------------- plots
-_PLANES = ("vertical", "horizontal")
-
-
 def _axes(ax: Axes | None) -> tuple[Figure, Axes]:
     if ax is None:
         figure = Figure()
@@ -264,10 +261,21 @@ def _axes(ax: Axes | None) -> tuple[Figure, Axes]:
     return ax.get_figure(), ax
 
 
-def _markers(ax: Axes, analysis: ShaftAnalysis) -> None:
+def _draw_planes(ax: Axes, analysis: ShaftAnalysis, position_m: np.ndarray, vertical: np.ndarray,
+                 horizontal: np.ndarray) -> None:
+    """Both planes' curves, the zero line and the bearings (triangles), x in mm."""
+    ax.plot(position_m * 1e3, vertical, label="vertical plane")
+    ax.plot(position_m * 1e3, horizontal, label="horizontal plane")
     ax.axhline(0.0, color="0.5", linewidth=0.8)
     for x in (analysis.geometry.bearing_a_m, analysis.geometry.bearing_b_m):
         ax.plot([x * 1e3], [0.0], marker="^", color="k", linestyle="none")
+
+
+def _label(ax: Axes, ylabel: str, title: str) -> None:
+    ax.set_xlabel("position (mm)")
+    ax.set_ylabel(ylabel)
+    ax.set_title(title)
+    ax.legend()
 
 
 def plot_shear(analysis: ShaftAnalysis, ax: Axes | None = None) -> Figure:
@@ -286,14 +294,8 @@ def plot_shear(analysis: ShaftAnalysis, ax: Axes | None = None) -> Figure:
     """
     figure, ax = _axes(ax)
     diagram = shaft_diagram(analysis)
-    x_mm = diagram.position_m * 1e3
-    ax.plot(x_mm, diagram.shear_vertical_n, label="vertical plane")
-    ax.plot(x_mm, diagram.shear_horizontal_n, label="horizontal plane")
-    _markers(ax, analysis)
-    ax.set_xlabel("position (mm)")
-    ax.set_ylabel("shear force (N)")
-    ax.set_title("Shear force")
-    ax.legend()
+    _draw_planes(ax, analysis, diagram.position_m, diagram.shear_vertical_n, diagram.shear_horizontal_n)
+    _label(ax, "shear force (N)", "Shear force")
     return figure
 
 
@@ -313,16 +315,10 @@ def plot_moment(analysis: ShaftAnalysis, ax: Axes | None = None) -> Figure:
     """
     figure, ax = _axes(ax)
     diagram = shaft_diagram(analysis)
-    x_mm = diagram.position_m * 1e3
-    ax.plot(x_mm, diagram.moment_vertical_n_m, label="vertical plane")
-    ax.plot(x_mm, diagram.moment_horizontal_n_m, label="horizontal plane")
-    ax.plot(x_mm, diagram.moment_resultant_n_m, color="k", linestyle="--", label="resultant")
+    _draw_planes(ax, analysis, diagram.position_m, diagram.moment_vertical_n_m, diagram.moment_horizontal_n_m)
+    ax.plot(diagram.position_m * 1e3, diagram.moment_resultant_n_m, color="k", linestyle="--", label="resultant")
     ax.plot([analysis.max_moment_position_m * 1e3], [analysis.max_moment_n_m], marker="o", color="k", linestyle="none")
-    _markers(ax, analysis)
-    ax.set_xlabel("position (mm)")
-    ax.set_ylabel("bending moment (N m)")
-    ax.set_title(f"Bending moment (max {analysis.max_moment_n_m:.4g} N m)")
-    ax.legend()
+    _label(ax, "bending moment (N m)", f"Bending moment (max {analysis.max_moment_n_m:.4g} N m)")
     return figure
 
 

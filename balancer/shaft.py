@@ -28,7 +28,7 @@ import numpy as np
 from modal.errors import ParameterError
 from modal.units import rad_s_to_rpm, rpm_to_rad_s
 
-from .drive import next_standard_size
+from .drive import _finite, _non_negative, _positive, next_standard_size
 
 __all__ = [
     "STANDARD_SHAFT_DIAMETERS_M",
@@ -72,30 +72,6 @@ STEEL_YOUNGS_MODULUS_PA = 205e9
 STEEL_DENSITY_KG_M3 = 7850.0
 
 
-def _finite(name: str, value: float, unit: str) -> float:
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        raise ParameterError(f"{name} = {value!r} is not a number; expected a value in {unit}") from None
-    if not math.isfinite(number):
-        raise ParameterError(f"{name} = {number} {unit} is not finite; expected a finite value")
-    return number
-
-
-def _positive(name: str, value: float, unit: str) -> float:
-    number = _finite(name, value, unit)
-    if number <= 0.0:
-        raise ParameterError(f"{name} = {number} {unit} must be > 0")
-    return number
-
-
-def _non_negative(name: str, value: float, unit: str) -> float:
-    number = _finite(name, value, unit)
-    if number < 0.0:
-        raise ParameterError(f"{name} = {number} {unit} must be >= 0")
-    return number
-
-
 # --------------------------------------------------------------------------- inputs
 @dataclass(frozen=True, slots=True)
 class PointLoad:
@@ -122,7 +98,8 @@ class PointLoad:
         (``vertical = F cos``, ``horizontal = F sin``), at ``position_m`` m."""
         magnitude = _finite("magnitude_n", magnitude_n, "N")
         angle_rad = math.radians(_finite("angle_from_vertical_deg", angle_from_vertical_deg, "deg"))
-        return cls(float(position_m), magnitude * math.cos(angle_rad), magnitude * math.sin(angle_rad), name)
+        position = _finite("position_m", position_m, "m")
+        return cls(position, magnitude * math.cos(angle_rad), magnitude * math.sin(angle_rad), name)
 
 
 @dataclass(frozen=True, slots=True)
@@ -273,6 +250,8 @@ def analyse_shaft(geometry: ShaftGeometry, loads: Sequence[PointLoad], torque_n_
     mv = _moments(all_x, all_v, stations)
     mh = _moments(all_x, all_h, stations)
     mr = np.hypot(mv, mh)
+    for array in (all_x, all_v, all_h, stations, mv, mh, mr):
+        array.flags.writeable = False
     peak = int(np.argmax(mr))
     return ShaftAnalysis(
         geometry=geometry,

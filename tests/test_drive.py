@@ -265,7 +265,7 @@ def test_bad_stage_input(kwargs, pattern):
 def test_bad_catalogue_input():
     with pytest.raises(ParameterError, match=r"belt_count = 1 is below the 1\.9.* belts"):
         belt_stage(**STAGE_B, **STAGE_B_CATALOGUE, belt_count=1)
-    with pytest.raises(ParameterError, match=r"belt_count = 1\.5; expected a whole number"):
+    with pytest.raises(ParameterError, match=r"belt_count = 1\.5; expected an int >= 1"):
         belt_stage(**STAGE_A, belt_count=1.5)
     with pytest.raises(ParameterError, match=r"tension_sum_factor = 1\.0 must be > 1"):
         belt_stage(**STAGE_A, tension_sum_factor=1.0)
