@@ -14,8 +14,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg
-from scipy.optimize import least_squares
 
 __all__ = ["CircleEstimate", "fit_circle", "circle_fit_curve"]
 
@@ -36,8 +34,8 @@ def fit_circle(x: np.ndarray, y: np.ndarray) -> tuple[float, float, float]:
     zbar = z.mean()
     N = np.array([[8 * zbar, 0, 0, 2], [0, 1, 0, 0], [0, 0, 1, 0], [2, 0, 0, 0]], dtype=float)
     best = None
-    try:
-        vals, vecs = scipy.linalg.eig(M, N)
+    try:  # N is invertible for Hyper: M a = η N a  ⇔  N⁻¹M a = η a
+        vals, vecs = np.linalg.eig(np.linalg.solve(N, M))
         for k in range(4):
             if not np.isfinite(vals[k]) or abs(vals[k].imag) > 1e-9 * (1 + abs(vals[k].real)):
                 continue
@@ -103,6 +101,43 @@ def _angle_jac(params, w):
     return np.column_stack([common * dt_dwr, common * dt_dzeta, np.ones_like(w)])
 
 
+def _levenberg_marquardt(p0, xs, theta, max_iter=100):
+    """Least squares of the angle model (3 parameters), Marquardt-scaled LM."""
+    p = p0.astype(float).copy()
+    r = _angle_model(p, xs) - theta
+    cost = r @ r
+    lam = 1e-3
+    for _ in range(max_iter):
+        J = _angle_jac(p, xs)
+        JtJ, g = J.T @ J, J.T @ r
+        d = np.diag(JtJ).copy()
+        d[d <= 0] = 1e-300
+        improved = False
+        for _ in range(30):
+            try:
+                step = np.linalg.solve(JtJ + lam * np.diag(d), -g)
+            except np.linalg.LinAlgError:
+                lam *= 10
+                continue
+            trial = p + step
+            if trial[0] > 0 and trial[1] > 0:
+                r_new = _angle_model(trial, xs) - theta
+                c_new = r_new @ r_new
+                if np.isfinite(c_new) and c_new <= cost:
+                    improved = True
+                    break
+            lam *= 4
+        if not improved:
+            break
+        rel = np.max(np.abs(step) / np.maximum(np.abs(trial), 1e-300))
+        p, r, cost = trial, r_new, c_new
+        lam = max(lam / 3, 1e-12)
+        if rel < 1e-14:
+            break
+    ok = bool(np.all(np.isfinite(p)) and p[0] > 0 and p[1] > 0)
+    return p, r, _angle_jac(p, xs), ok
+
+
 def circle_fit_curve(omega: np.ndarray, mobility: np.ndarray, noise_std: float) -> CircleEstimate:
     """Circle fit of the strongest mode in a band, on one channel of mobility.
 
@@ -160,18 +195,17 @@ def circle_fit_curve(omega: np.ndarray, mobility: np.ndarray, noise_std: float) 
         spread = np.nan
     x_r = x_r / (1 - zeta0**2 / 2)  # max sweep rate lies at ωr(1 − ζ²/2)
     p0 = np.array([x_r, zeta0, theta_r])
-    fit = least_squares(lambda p: _angle_model(p, xs) - theta, p0, jac=lambda p: _angle_jac(p, xs),
-                        method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=200)
-    x_n, zeta, psi = fit.x
-    if not (np.isfinite(zeta) and zeta > 0 and np.isfinite(x_n) and x_n > 0):
+    params, residual, jac, ok = _levenberg_marquardt(p0, xs, theta)
+    x_n, zeta, psi = params
+    if not ok:
         x_n, zeta, psi = p0
         flags.append("did_not_converge")
     std_x = std_z = np.nan
     dof = xs.size - 3
-    if dof > 0:
-        s2 = float(np.sum(fit.fun**2) / dof)
+    if dof > 0 and ok:
+        s2 = float(np.sum(residual**2) / dof)
         try:
-            cov = s2 * np.linalg.inv(fit.jac.T @ fit.jac)
+            cov = s2 * np.linalg.inv(jac.T @ jac)
             std_x, std_z = np.sqrt(max(cov[0, 0], 0)), np.sqrt(max(cov[1, 1], 0))
         except np.linalg.LinAlgError:
             pass

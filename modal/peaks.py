@@ -4,7 +4,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.signal import find_peaks
 
 from .errors import IdentificationError
 from .frf import FRF
@@ -70,6 +69,8 @@ def find_modes(frf: FRF, min_prominence_db: float = 6.0, noise_factor: float = 1
     Its band is ±``bandwidths`` half-power widths (at least ±5 lines), clipped
     halfway to the neighbouring peaks and to the data.
     """
+    from scipy.signal import find_peaks  # imported here: scipy.signal takes a second to import
+
     freq = frf.frequency_hz
     ind = mode_indicator(frf)
     noise = estimate_noise_std(frf) if noise_std is None else noise_std

@@ -6,7 +6,6 @@ complex Gaussian, either relative to max |H| of each channel or per line.
 from __future__ import annotations
 
 import numpy as np
-import scipy.linalg
 
 from .errors import ParameterError
 from .frf import FRF, kind_factor
@@ -159,7 +158,7 @@ def modal_parameters_of_matrices(mass, damping, stiffness):
     M, C, K = (np.atleast_2d(np.asarray(a, dtype=float)) for a in (mass, damping, stiffness))
     n = M.shape[0]
     A = np.block([[np.zeros((n, n)), np.eye(n)], [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
-    lam = scipy.linalg.eigvals(A)
+    lam = np.linalg.eigvals(A)
     lam = lam[lam.imag > 0]
     lam = lam[np.argsort(np.abs(lam))]
     return np.abs(lam), -lam.real / np.abs(lam)

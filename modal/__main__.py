@@ -1,0 +1,6 @@
+"""``python -m modal``: see :mod:`modal.cli`."""
+import sys
+
+from .cli import main
+
+sys.exit(main())

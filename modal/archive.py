@@ -1,0 +1,291 @@
+"""HDF5 result archives: any result dataclass in, the same dataclass out.
+
+Layout (documented in the README)::
+
+    /                     @schema="modalbal-archive" @schema_version="1.0"
+                          @software_version @created (ISO 8601, UTC)
+    /scene                string dataset: the scene text, verbatim (when given)
+    /<item>/              one group per stage or result, @inputs_hash when given
+        <field>           datasets with a ``units`` attribute derived from the
+                          field name (``_hz`` → Hz, ``_n_per_m`` → N/m, …)
+
+Every node carries ``@__type__`` (``dataclass`` with ``@__class__``, ``ndarray``,
+``float``, ``str``, ``tuple``, ``dict``, ``none``, ``frf``…) so that
+:func:`read_archive` rebuilds the same Python objects; arrays come back bit for
+bit. Nothing is pickled, and only classes of ``modal`` and ``balancer`` are
+rebuilt. Files are written to a temporary file beside the target, closed,
+reopened and checked, then renamed over it.
+"""
+from __future__ import annotations
+
+import dataclasses
+import datetime as _dt
+import importlib
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import h5py
+import numpy as np
+
+from .errors import ArchiveError
+
+__all__ = ["SCHEMA", "SCHEMA_VERSION", "Archive", "write_archive", "read_archive", "write_node", "read_node",
+           "units_of"]
+
+SCHEMA = "modalbal-archive"
+SCHEMA_VERSION = "1.0"
+_ALLOWED_MODULES = ("modal.", "balancer.")
+_COMPRESS_BYTES = 16384  # gzip+shuffle only where it pays: arrays above 16 kB
+
+# longest suffix first
+_UNIT_SUFFIXES = [
+    ("_n_s_per_m", "N s/m"), ("_n_m_s", "N m s"), ("_n_per_m", "N/m"), ("_kg_m2", "kg m^2"), ("_kg_m", "kg m"),
+    ("_rad_s", "rad/s"), ("_m_s", "m/s"), ("_hz", "Hz"), ("_rpm", "rpm"), ("_kg", "kg"), ("_rad", "rad"),
+    ("_deg", "deg"), ("_mm", "mm"), ("_pa", "Pa"), ("_mpa", "MPa"), ("_n_m", "N m"), ("_w", "W"), ("_kw", "kW"),
+    ("_n", "N"), ("_m", "m"), ("_s", "s"),
+]
+
+
+def units_of(name: str) -> str | None:
+    """Unit implied by a field name's suffix (``stiffness_n_per_m`` → ``N/m``), or None."""
+    lower = name.lower()
+    for suffix, unit in _UNIT_SUFFIXES:
+        if lower.endswith(suffix):
+            return unit
+    return None
+
+
+@dataclass(frozen=True)
+class Archive:
+    """Content of an archive file."""
+
+    items: dict[str, Any]
+    attrs: dict[str, str]
+    scene_text: str | None = None
+    inputs_hash: dict[str, str] = field(default_factory=dict)
+
+    def __getitem__(self, name: str) -> Any:
+        return self.items[name]
+
+
+def _set_units(node, name: str) -> None:
+    unit = units_of(name)
+    if unit is not None:
+        node.attrs["units"] = unit
+
+
+def write_node(parent: h5py.Group, name: str, obj: Any) -> None:
+    """Write ``obj`` as child ``name`` of ``parent`` (recursively)."""
+    from .frf import FRF
+
+    if isinstance(obj, FRF):
+        from .io.hdf5 import write_frf_group
+
+        group = parent.create_group(name)
+        write_frf_group(group, obj)
+        group.attrs["__type__"] = "frf"
+        return
+    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
+        group = parent.create_group(name)
+        cls = type(obj)
+        group.attrs["__type__"] = "dataclass"
+        group.attrs["__class__"] = f"{cls.__module__}:{cls.__qualname__}"
+        for f in dataclasses.fields(obj):
+            write_node(group, f.name, getattr(obj, f.name))
+        return
+    if obj is None:
+        parent.create_group(name).attrs["__type__"] = "none"
+        return
+    if isinstance(obj, (bool, np.bool_)):
+        ds = parent.create_dataset(name, data=np.bool_(obj))
+        ds.attrs["__type__"] = "bool"
+        return
+    if isinstance(obj, (int, float, complex)) and not isinstance(obj, np.generic):
+        kind = type(obj).__name__
+        ds = parent.create_dataset(name, data=obj)
+        ds.attrs["__type__"] = kind
+        _set_units(ds, name)
+        return
+    if isinstance(obj, np.generic):
+        ds = parent.create_dataset(name, data=obj)
+        ds.attrs["__type__"] = "npscalar"
+        _set_units(ds, name)
+        return
+    if isinstance(obj, str):
+        ds = parent.create_dataset(name, data=obj, dtype=h5py.string_dtype())
+        ds.attrs["__type__"] = "str"
+        return
+    if isinstance(obj, np.ndarray):
+        if obj.dtype.kind in "US":
+            ds = parent.create_dataset(name, data=obj.astype(object), dtype=h5py.string_dtype())
+            ds.attrs["__type__"] = "str_array"
+            return
+        if obj.dtype.kind == "O":
+            raise ArchiveError(f"archive: field '{name}' is an object array; expected numbers or strings")
+        kwargs = {}
+        if obj.nbytes > _COMPRESS_BYTES and obj.ndim >= 1:
+            kwargs = {"compression": "gzip", "compression_opts": 4, "shuffle": True}
+        ds = parent.create_dataset(name, data=obj, **kwargs)
+        ds.attrs["__type__"] = "ndarray"
+        _set_units(ds, name)
+        return
+    if isinstance(obj, (tuple, list)):
+        group = parent.create_group(name)
+        group.attrs["__type__"] = type(obj).__name__
+        group.attrs["__len__"] = len(obj)
+        for i, item in enumerate(obj):
+            write_node(group, str(i), item)
+        return
+    if isinstance(obj, dict):
+        group = parent.create_group(name)
+        group.attrs["__type__"] = "dict"
+        for i, (key, item) in enumerate(obj.items()):
+            if not isinstance(key, str):
+                raise ArchiveError(f"archive: dict '{name}' has a key of type {type(key).__name__}; expected str")
+            write_node(group, f"k{i}", item)
+            group[f"k{i}"].attrs["__key__"] = key
+        return
+    raise ArchiveError(f"archive: cannot store field '{name}' of type {type(obj).__name__}")
+
+
+def _class_from(path: str):
+    module_name, _, qualname = path.partition(":")
+    if not module_name.startswith(_ALLOWED_MODULES):
+        raise ArchiveError(f"archive names class {path!r}; only classes of modal and balancer are rebuilt")
+    try:
+        obj = importlib.import_module(module_name)
+        for part in qualname.split("."):
+            obj = getattr(obj, part)
+    except (ImportError, AttributeError):
+        raise ArchiveError(f"archive names class {path!r}, which this version of the toolkit does not have") from None
+    return obj
+
+
+def read_node(node) -> Any:
+    """Rebuild the Python object stored at an HDF5 node by :func:`write_node`."""
+    kind = node.attrs.get("__type__")
+    if isinstance(kind, bytes):
+        kind = kind.decode()
+    if kind == "frf":
+        from .io.hdf5 import read_frf_group
+
+        return read_frf_group(node, source=node.file.filename)
+    if kind == "dataclass":
+        cls = _class_from(str(node.attrs["__class__"]))
+        values = {name: read_node(node[name]) for name in node.keys()}
+        init = {f.name: values[f.name] for f in dataclasses.fields(cls) if f.init and f.name in values}
+        obj = cls(**init)
+        for f in dataclasses.fields(cls):
+            if not f.init and f.name in values:
+                object.__setattr__(obj, f.name, values[f.name])
+        return obj
+    if kind == "none":
+        return None
+    if kind in ("bool",):
+        return bool(node[()])
+    if kind in ("int", "float", "complex"):
+        return {"int": int, "float": float, "complex": complex}[kind](node[()])
+    if kind == "npscalar":
+        return node[()]
+    if kind == "str":
+        value = node[()]
+        return value.decode() if isinstance(value, bytes) else str(value)
+    if kind == "str_array":
+        return np.array([v.decode() if isinstance(v, bytes) else v for v in node[()].ravel()]).reshape(node.shape)
+    if kind == "ndarray":
+        return node[()]
+    if kind in ("tuple", "list"):
+        items = [read_node(node[str(i)]) for i in range(int(node.attrs["__len__"]))]
+        return tuple(items) if kind == "tuple" else items
+    if kind == "dict":
+        children = sorted(node.keys(), key=lambda k: int(k[1:]))
+        return {str(node[c].attrs["__key__"]): read_node(node[c]) for c in children}
+    raise ArchiveError(f"{node.file.filename}: node {node.name} has unknown type {kind!r}")
+
+
+def _check_schema(f: h5py.File, src: str) -> None:
+    schema = f.attrs.get("schema")
+    version = str(f.attrs.get("schema_version", ""))
+    if schema != SCHEMA:
+        raise ArchiveError(f"{src}: attribute 'schema' is {schema!r}; expected {SCHEMA!r} (not an archive of this toolkit)")
+    major = version.split(".")[0]
+    if major != SCHEMA_VERSION.split(".")[0]:
+        raise ArchiveError(
+            f"{src}: attribute 'schema_version' is {version!r}; this toolkit reads major version "
+            f"{SCHEMA_VERSION.split('.')[0]} (upgrade the toolkit to read it)"
+        )
+
+
+def write_archive(path: str | os.PathLike, items: dict[str, Any], scene_text: str | None = None,
+                  inputs_hash: dict[str, str] | None = None, created: str | None = None) -> Path:
+    """Write result objects to an HDF5 archive, crash-safely.
+
+    Parameters
+    ----------
+    path : path-like
+        Target file; replaced atomically.
+    items : dict
+        Top-level name → result (dataclass, FRF, array, number, string, …).
+    scene_text : str, optional
+        Scene file text, stored verbatim under ``/scene``.
+    inputs_hash : dict, optional
+        Stage name → hash of its inputs, stored as ``@inputs_hash``.
+    created : str, optional
+        ISO 8601 creation time; default now (UTC).
+    """
+    from . import __version__
+    from .io._atomic import atomic_path
+
+    path = Path(path)
+    hashes = inputs_hash or {}
+
+    def verify(tmp: Path) -> None:
+        with h5py.File(tmp, "r") as f:
+            _check_schema(f, str(path))
+            missing = [name for name in items if name not in f]
+            if missing:
+                raise ArchiveError(f"{path}: verification after writing found no group {missing[0]!r}")
+
+    with atomic_path(path, verify=verify) as tmp:
+        with h5py.File(tmp, "w", track_order=True) as f:
+            f.attrs["schema"] = SCHEMA
+            f.attrs["schema_version"] = SCHEMA_VERSION
+            f.attrs["software_version"] = __version__
+            f.attrs["created"] = created or _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
+            if scene_text is not None:
+                f.create_dataset("scene", data=scene_text, dtype=h5py.string_dtype())
+            for name, obj in items.items():
+                if name == "scene":
+                    raise ArchiveError("archive: item name 'scene' is reserved for the scene text")
+                write_node(f, name, obj)
+                if name in hashes:
+                    f[name].attrs["inputs_hash"] = hashes[name]
+    return path
+
+
+def read_archive(path: str | os.PathLike) -> Archive:
+    """Read an archive written by :func:`write_archive` back into the same objects."""
+    src = str(path)
+    if not Path(path).is_file():
+        raise ArchiveError(f"{src}: no such archive file")
+    try:
+        f = h5py.File(path, "r")
+    except OSError as exc:
+        raise ArchiveError(f"{src}: not a readable HDF5 file ({exc})") from None
+    with f:
+        _check_schema(f, src)
+        attrs = {k: str(v) for k, v in f.attrs.items()}
+        scene = None
+        if "scene" in f:
+            value = f["scene"][()]
+            scene = value.decode() if isinstance(value, bytes) else str(value)
+        items, hashes = {}, {}
+        for name in f.keys():
+            if name == "scene":
+                continue
+            items[name] = read_node(f[name])
+            if "inputs_hash" in f[name].attrs:
+                hashes[name] = str(f[name].attrs["inputs_hash"])
+    return Archive(items=items, attrs=attrs, scene_text=scene, inputs_hash=hashes)

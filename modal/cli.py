@@ -1,0 +1,123 @@
+"""Command line: ``python -m modal fit PATH`` (console script ``modalbal``).
+
+Exit codes: 0 success, 1 unreadable input or failed identification (one line
+on stderr naming the file, the field and what was expected), 2 usage error.
+Results go to stdout (a table, or one JSON document with ``--json``); logs and
+warnings go to stderr.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from .errors import ModalError
+from .frf import FRF_KINDS
+
+__all__ = ["main", "build_parser"]
+
+
+def _complex_to_json(value):
+    if isinstance(value, complex):
+        return {"re": value.real, "im": value.imag}
+    if isinstance(value, float) and not np.isfinite(value):
+        return None
+    return value
+
+
+def _jsonable(obj):
+    if isinstance(obj, dict):
+        return {k: _jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_jsonable(v) for v in obj]
+    return _complex_to_json(obj)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="python -m modal", description="Experimental modal analysis.")
+    sub = parser.add_subparsers(dest="command", required=True)
+    fit = sub.add_parser("fit", help="identify the modes of an FRF file",
+                         description="Identify natural frequency, damping, modal constant and k, c, m of every mode.")
+    fit.add_argument("path", help="FRF file (UFF 58/58b, CSV, MAT, HDF5)")
+    fit.add_argument("--method", choices=["nls", "circle", "halfpower", "all"], default="nls",
+                     help="identification method (default: nls, the least-squares refinement)")
+    fit.add_argument("--band", nargs=2, type=float, action="append", metavar=("FMIN", "FMAX"),
+                     help="fitting band of one mode in Hz (repeat for several modes); default: automatic")
+    fit.add_argument("--kind", choices=FRF_KINDS, help="FRF kind when the file does not say")
+    fit.add_argument("--frequency-axis", dest="frequency_axis", choices=["hz", "rad/s", "cpm"],
+                     help="unit of the file's frequency column when it does not say")
+    fit.add_argument("--json", action="store_true", help="print one JSON document on stdout")
+    fit.add_argument("--plot", metavar="OUT.png", help="write a figure of the fit")
+    fit.add_argument("--archive", metavar="OUT.h5", help="write the FRF and results to an HDF5 archive")
+    return parser
+
+
+def _showwarning(message, category, filename, lineno, file=None, line=None):
+    print(f"warning: {message}", file=sys.stderr)
+
+
+def _fit(args) -> int:
+    from .identify import identify
+    from .io import read_frf
+
+    hints = {k: v for k, v in (("kind", args.kind), ("frequency_axis", args.frequency_axis)) if v is not None}
+    frf = read_frf(args.path, **hints)
+    methods = ["nls", "circle", "halfpower"] if args.method == "all" else [args.method]
+    results = [identify(frf, method, bands_hz=args.band) for method in methods]
+    points = None
+    if frf.response_points is not None:
+        refs = frf.reference_points or ("?",) * frf.n_channels
+        points = [f"{r} / {q}" for r, q in zip(frf.response_points, refs)]
+    if args.json:
+        rows = [row for result in results for row in result.rows()]
+        doc = {"file": str(args.path), "kind": frf.kind, "n_channels": frf.n_channels,
+               "methods": methods, "modes": rows}
+        json.dump(_jsonable(doc), sys.stdout, indent=1, allow_nan=False)
+        sys.stdout.write("\n")
+    else:
+        from .report import format_table
+
+        print(f"{args.path}: {frf.n_channels} channel(s), {frf.n_freq} lines, "
+              f"{frf.frequency_hz[0]:g}–{frf.frequency_hz[-1]:g} Hz, {frf.kind}")
+        for result in results:
+            print()
+            print(format_table(result, points))
+    if args.plot:
+        from .io._atomic import atomic_path
+        from .plots import plot_fit
+
+        fig = plot_fit(frf, results[0])
+        with atomic_path(args.plot) as tmp:
+            fig.savefig(tmp, dpi=110, format=Path(args.plot).suffix.lstrip(".") or "png")
+        print(f"plot: {args.plot}", file=sys.stderr)
+    if args.archive:
+        from .archive import write_archive
+
+        write_archive(args.archive, {"frf": frf, **{f"identify_{r.method}": r for r in results}})
+        print(f"archive: {args.archive}", file=sys.stderr)
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the command line; returns the exit code."""
+    parser = build_parser()
+    args = parser.parse_args(argv)  # exits with 2 on a usage error
+    warnings.showwarning = _showwarning
+    try:
+        if args.command == "fit":
+            return _fit(args)
+    except ModalError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 1
+    except OSError as exc:
+        print(f"error: {exc.filename or args.path}: {exc.strerror or exc}", file=sys.stderr)
+        return 1
+    return 2
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,43 @@
+"""Plain-text tables of identification results (for the command line and reports)."""
+from __future__ import annotations
+
+import numpy as np
+
+from .results import IdentificationResult
+
+__all__ = ["format_table"]
+
+
+def _pm(value: float, std: float, fmt: str) -> str:
+    if not np.isfinite(value):
+        return "n/a"
+    if np.isfinite(std):
+        return f"{value:{fmt}} ± {std:.2g}"
+    return f"{value:{fmt}}"
+
+
+def format_table(result: IdentificationResult, point_ids: list[str] | None = None) -> str:
+    """A readable table of modes per channel.
+
+    Columns: frequency (Hz), damping (%), modal constant (1/kg), k (N/m),
+    c (N s/m), m (kg), each with its standard error, and the flags.
+    """
+    rows = result.rows()
+    lines = [f"method: {result.method}   kind: {result.kind}   modes: {len(result)}   channels: {result.n_channels}"]
+    header = f"{'mode':>4}  {'f_n [Hz]':>22}  {'zeta [%]':>20}  {'A [1/kg]':>26}  {'k [N/m]':>20}  {'c [N s/m]':>20}  {'m [kg]':>20}  flags"
+    for ch in range(result.n_channels):
+        label = f"channel {ch}" + (f" ({point_ids[ch]})" if point_ids else "")
+        lines += ["", label, header]
+        for row in (r for r in rows if r["channel"] == ch):
+            std = row["std"]
+            A = row["modal_constant"]
+            a_text = f"{A.real:.4g}{A.imag:+.3g}j" if np.isfinite(abs(A)) else "n/a"
+            flags = ",".join(f for f in row["flags"] if f != "driving_point_assumed") or "-"
+            lines.append(
+                f"{row['mode']:>4}  {_pm(row['natural_frequency_hz'], std['natural_frequency_hz'], '.6g'):>22}  "
+                f"{_pm(100 * row['damping_ratio'], 100 * std['damping_ratio'], '.4g'):>20}  {a_text:>26}  "
+                f"{_pm(row['stiffness_n_per_m'], std['stiffness_n_per_m'], '.5g'):>20}  "
+                f"{_pm(row['damping_n_s_per_m'], std['damping_n_s_per_m'], '.4g'):>20}  "
+                f"{_pm(row['mass_kg'], std['mass_kg'], '.5g'):>20}  {flags}"
+            )
+    return "\n".join(lines)
