@@ -279,7 +279,26 @@ def slider_crank_from_components(crank_radius_m: float, rod_length_m: float, rod
                                  series: str = "leading") -> SliderCrank:
     """Build a :class:`SliderCrank` from component masses via :func:`two_mass_split`.
 
-    Parameters are those of :func:`two_mass_split` and :class:`SliderCrank`.
+    Parameters
+    ----------
+    crank_radius_m : float
+        Crank radius ``r`` [m].
+    rod_length_m : float
+        Pin-centre distance ``l`` [m], > ``r``.
+    rod_mass_kg : float
+        Rod mass ``m_G`` [kg].
+    rod_cg_to_crank_pin_m : float
+        ``a``, rod centre of gravity to crank pin [m].
+    crank_pin_mass_kg : float
+        ``m_A``, crank mass reduced to the crank pin [kg].
+    piston_mass_kg : float
+        ``m_B``, piston plus wrist pin [kg].
+    rod_inertia_about_cg_kg_m2 : float
+        ``J_G`` [kg m^2]; gives ``J_AB = J_G - m_G a b``.
+    harmonics : tuple of int or "exact"
+        See :class:`SliderCrank`.
+    series : {"leading", "fourier"}
+        See :class:`SliderCrank`.
 
     Returns
     -------
