@@ -119,19 +119,17 @@ def _speed_rad_s(speed_rpm) -> float:
     return float(rpm_to_rad_s(speed))
 
 
-def _angles(crank_angles_rad) -> np.ndarray:
+def _angles(values, name: str = "crank_angles_rad", unit: str = "rad") -> np.ndarray:
+    """A finite, non-empty 1-D float array (crank angles by default)."""
     try:
-        angles = np.asarray(crank_angles_rad, dtype=float)
+        array = np.asarray(values, dtype=float)
     except (TypeError, ValueError):
-        raise ParameterError(
-            f"crank_angles_rad = {crank_angles_rad!r}: expected an array of angles in rad"
-        ) from None
-    if angles.ndim > 1 or angles.size == 0:
-        raise ParameterError(
-            f"crank_angles_rad has shape {angles.shape}: expected a non-empty 1-D array")
-    if not np.all(np.isfinite(angles)):
-        raise ParameterError("crank_angles_rad contains NaN or infinity: expected finite angles")
-    return np.atleast_1d(angles)
+        raise ParameterError(f"{name} = {values!r}: expected an array of numbers in {unit}") from None
+    if array.ndim > 1 or array.size == 0:
+        raise ParameterError(f"{name} has shape {array.shape}: expected a non-empty 1-D array")
+    if not np.all(np.isfinite(array)):
+        raise ParameterError(f"{name} contains NaN or infinity: expected finite values in {unit}")
+    return np.atleast_1d(array)
 
 
 # --------------------------------------------------------------------------- mechanism
@@ -713,8 +711,7 @@ def _evaluate_moment(mech: SliderCrank, omega: float, moment: float) -> Counterw
     y_max = _refined_max(lambda t: _force_xy(mech, omega, moment, t)[1])[0]
     y_min = -_refined_max(lambda t: -_force_xy(mech, omega, moment, t)[1])[0]
     unbalanced = _objective_value(mech, omega, 0.0, "max")
-    alpha = ((moment / mech.crank_radius_m - mech.rotating_mass_kg) / mech.reciprocating_mass_kg
-             if mech.reciprocating_mass_kg > 0 else float("inf") if moment > 0 else 0.0)
+    alpha = (moment / mech.crank_radius_m - mech.rotating_mass_kg) / mech.reciprocating_mass_kg
     return CounterweightEvaluation(
         balance_fraction=float(alpha), counterweight_moment_kg_m=moment, max_force_n=peak,
         max_force_angle_rad=float(angles[0]),
@@ -731,6 +728,7 @@ def evaluate_counterweight(mech: SliderCrank, speed_rpm: float, counterweight_ma
     Parameters
     ----------
     mech : SliderCrank
+        Needs ``reciprocating_mass_kg > 0`` (the result reports ``alpha``).
     speed_rpm : float
         Crank speed [rev/min], > 0.
     counterweight_mass_kg : float
@@ -742,6 +740,7 @@ def evaluate_counterweight(mech: SliderCrank, speed_rpm: float, counterweight_ma
     -------
     CounterweightEvaluation
     """
+    _require_reciprocating(mech)
     omega = _speed_rad_s(speed_rpm)
     moment = _counterweight_moment(mech, counterweight_mass_kg, counterweight_radius_m)
     return _evaluate_moment(mech, omega, moment)
@@ -1070,8 +1069,8 @@ def grid_search_counterweight(mech: SliderCrank, speed_rpm: float, k_values, rad
     """
     omega = _speed_rad_s(speed_rpm)
     theta = _angles(crank_angles_rad)
-    ks = _angles(k_values)
-    radii = _angles(radius_values_m)
+    ks = _angles(k_values, "k_values", "units of m_rec")
+    radii = _angles(radius_values_m, "radius_values_m", "m")
     if radii.min() < 0 or radii.max() > mech.crank_radius_m * (1 + 1e-12):
         raise ParameterError(
             f"radius_values_m spans [{radii.min()!r}, {radii.max()!r}]: expected values in "

@@ -467,7 +467,14 @@ def harmonic_response(system: MountedBody, speed_rad_s: float, orders, force_n, 
     omega = float(speed_rad_s)
     if not (math.isfinite(omega) and omega > 0):
         raise ParameterError(f"speed_rad_s = {speed_rad_s!r}: expected a finite value > 0")
-    order_arr = np.atleast_1d(np.asarray(orders, dtype=int))
+    try:
+        order_values = np.atleast_1d(np.asarray(orders, dtype=float))
+    except (TypeError, ValueError):
+        raise ParameterError(f"orders = {orders!r}: expected positive integer orders") from None
+    if (order_values.ndim != 1 or not np.all(np.isfinite(order_values))
+            or np.any(order_values < 1) or np.any(order_values != np.round(order_values))):
+        raise ParameterError(f"orders = {orders!r}: expected a 1-D array of positive integers")
+    order_arr = order_values.astype(int)
     force = np.atleast_2d(np.asarray(force_n, dtype=complex))
     couple = (np.zeros_like(force) if couple_n_m is None
               else np.atleast_2d(np.asarray(couple_n_m, dtype=complex)))

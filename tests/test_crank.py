@@ -431,6 +431,12 @@ def test_bad_call_arguments_raise(seed000):
         counterweight_on_curve(seed000, opt, k=0.2)
     with pytest.raises(ParameterError, match="radius_m = 0.001: needs k"):
         counterweight_on_curve(seed000, opt, radius_m=0.001)
+    with pytest.raises(ParameterError, match="k_values contains NaN"):
+        grid_search_counterweight(seed000, 2950.0, [0.5, float("nan")], [0.01], [0.0])
+    with pytest.raises(ParameterError, match="radius_values_m spans"):
+        grid_search_counterweight(seed000, 2950.0, [0.5], [0.02], [0.0])
+    with pytest.raises(ParameterError, match="reciprocating_mass_kg = 0.0"):
+        evaluate_counterweight(SliderCrank(0.01, 0.05, 0.1, 0.0), 2950.0)
     with pytest.raises(ParameterError, match="give k or radius_m"):
         counterweight_on_curve(seed000, opt, k=0.7, radius_m=0.01)
     with pytest.raises(ParameterError, match=r"k = 1\.2: expected a value <= 1\.0"):

@@ -345,3 +345,5 @@ def test_undamped_resonance_raises(body):
         harmonic_response(system, 0, [1], [[1.0, 0, 0]])
     with pytest.raises(ParameterError, match="force_n has shape"):
         harmonic_response(system, 100.0, [1, 2], [[1.0, 0, 0]])
+    with pytest.raises(ParameterError, match=r"orders = \[1\.5\]: expected"):
+        harmonic_response(system, 100.0, [1.5], [[1.0, 0, 0]])
