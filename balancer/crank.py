@@ -907,7 +907,12 @@ def optimal_counterweight(mech: SliderCrank, speed_rpm: float, objective: Object
         if phi(bound) < phi(alpha):
             alpha = bound
     if objective == "max":
-        alpha, method = _polish_equal_peak(mech, omega, alpha, lower, upper, method)
+        polished, how = _polish_equal_peak(mech, omega, alpha, lower, upper, method)
+        # keep the root only if it is at least as good (it is the optimum when
+        # the two peaks move in opposite directions with alpha, as they must
+        # when both are active at the minimum of a convex maximum)
+        if phi(polished) <= phi(alpha) * (1.0 + 1e-14):
+            alpha, method = polished, how
     moment = (m_rot + alpha * m_rec) * r
     _, angles, peaks = _refined_max(lambda t: np.hypot(*_force_xy(mech, omega, moment, t)))
     active = peaks >= peaks[0] * (1.0 - 1e-7)
@@ -929,7 +934,7 @@ def _polish_equal_peak(mech: SliderCrank, omega: float, alpha: float, lower: flo
     m_rot, m_rec, r = mech.rotating_mass_kg, mech.reciprocating_mass_kg, mech.crank_radius_m
     moment = (m_rot + alpha * m_rec) * r
     _, angles, peaks = _refined_max(lambda t: np.hypot(*_force_xy(mech, omega, moment, t)))
-    if peaks.size < 2 or peaks[1] < peaks[0] * (1.0 - 1e-6):
+    if peaks.size < 2 or peaks[1] < peaks[0] * (1.0 - 1e-5):
         return alpha, method
     angle_a, angle_b = angles[0], angles[1]
     half_width = 0.25 * abs(angle_a - angle_b)
