@@ -203,3 +203,86 @@ def test_hdf5_dataset_hint_picks_one_of_several_groups(tmp_path):
         write_frf_group(fh.create_group("frf/a"), a)
         write_frf_group(fh.create_group("frf/b"), b)
     _assert_same(read_frf(tmp_path / "two.h5", dataset="b"), b)
+
+
+# ----------------------------------------------------------------- UFF 58 / 58b
+def _even_frf(n_channels: int, kind: str = "accelerance") -> FRF:
+    """An FRF on 2 + 0.25 k Hz: an axis UFF's 6-digit minimum and increment rebuild exactly."""
+    frf = _frf(n_channels, kind=kind)
+    freq = 2.0 + 0.25 * np.arange(frf.n_freq)
+    return FRF(freq, frf.response, kind=kind, response_points=frf.response_points,
+               reference_points=frf.reference_points)
+
+
+@pytest.mark.parametrize("n_channels", [1, 3])
+@pytest.mark.parametrize("kind", ["receptance", "mobility", "accelerance"])
+def test_uff58_ascii_round_trip(tmp_path, n_channels, kind):
+    frf = _even_frf(n_channels, kind)
+    write_frf(frf, tmp_path / "h.uff")
+    assert sniff_format(tmp_path / "h.uff") == "uff"
+    got = read_frf(tmp_path / "h.uff")
+    # The ASCII dataset 58 stores double ordinates as Fortran E20.12 fields (pyuff: '%20.11e'),
+    # i.e. 12 significant digits: each real and imaginary part is rounded by at most 5e-12 of
+    # itself. That is the format's limit, not 1e-12; the axis is rebuilt exactly from min + k*inc.
+    _assert_same(got, frf, rtol=5.000001e-12)
+    assert np.array_equal(got.frequency_hz, frf.frequency_hz)
+    rel = np.abs(got.channels.real - frf.channels.real) / np.abs(frf.channels.real)
+    assert rel.max() <= 5.000001e-12
+
+
+@pytest.mark.parametrize("n_channels", [1, 3])
+@pytest.mark.parametrize("axis", ["even", "uneven"])
+def test_uff58b_binary_round_trip_is_bit_exact(tmp_path, n_channels, axis):
+    frf = _even_frf(n_channels) if axis == "even" else _frf(n_channels)  # linspace: not 6-digit even
+    write_frf(frf, tmp_path / "h.uff", format="uff58b")
+    assert b"    58b" in (tmp_path / "h.uff").read_bytes()[:20]
+    got = read_frf(tmp_path / "h.uff")
+    _assert_same(got, frf)  # doubles in the binary records (uneven axis: each x stored as a double)
+
+
+def test_uff58b_keeps_extreme_values_bit_exact(tmp_path):
+    frf = _awkward_frf()
+    frf = FRF(frf.frequency_hz, frf.response, kind=frf.kind, response_points=["1+X", "2-RZ"],
+              reference_points=["3+Y", "3+Y"])
+    write_frf(frf, tmp_path / "x.unv", format="uff58b")
+    _assert_same(read_frf(tmp_path / "x.unv"), frf)
+
+
+def test_uff58_ascii_warns_when_the_axis_cannot_be_kept(tmp_path):
+    from modal.errors import ModalWarning
+
+    frf = _frf(1)  # linspace(2, 400, 401): step 0.995, fine; make it uneven with long decimals
+    freq = np.sort(np.random.default_rng(3).uniform(1.0, 400.0, frf.n_freq))
+    frf = FRF(freq, frf.response, kind="accelerance")
+    with pytest.warns(ModalWarning, match="6 significant digits"):
+        write_frf(frf, tmp_path / "h.uff")
+    got = read_frf(tmp_path / "h.uff")
+    np.testing.assert_allclose(got.frequency_hz, freq, rtol=5.000001e-6, atol=0)
+
+
+def test_uff_without_points_reads_back_without_points(tmp_path):
+    frf = _even_frf(2)
+    frf = FRF(frf.frequency_hz, frf.response, kind="mobility")
+    write_frf(frf, tmp_path / "h.uff", format="uff58b")
+    got = read_frf(tmp_path / "h.uff")
+    assert got.response_points is None and got.reference_points is None
+    assert got.units == "m/s/N"
+
+
+@pytest.mark.parametrize("node,direction,text", [
+    (101, 3, "101+Z"), (7, -5, "7-RY"), (1, 1, "1+X"), (2, -2, "2-Y"), (12, 6, "12+RZ"), (5, 0, "5"),
+])
+def test_point_id_helpers_are_inverse(node, direction, text):
+    from modal.io.uff import format_point, parse_point
+
+    assert format_point(node, direction) == text
+    assert parse_point(text) == (node, direction)
+    assert parse_point(text.lower()) == (node, direction)
+
+
+def test_parse_point_refuses_other_ids():
+    from modal.io.uff import parse_point
+
+    for bad in ("a", "101+W", "+Z", "101 Z", ""):
+        with pytest.raises(ValueError):
+            parse_point(bad)
