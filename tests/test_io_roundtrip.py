@@ -286,3 +286,62 @@ def test_parse_point_refuses_other_ids():
     for bad in ("a", "101+W", "+Z", "101 Z", ""):
         with pytest.raises(ValueError):
             parse_point(bad)
+
+
+# ----------------------------------------------------------------- MATLAB
+@pytest.mark.parametrize("n_channels", [1, 3])
+@pytest.mark.parametrize("fmt,signature", [("mat", "mat5"), ("mat73", "mat73")])
+def test_mat_round_trip_is_bit_exact(tmp_path, n_channels, fmt, signature):
+    frf = _frf(n_channels, kind="mobility")
+    write_frf(frf, tmp_path / "h.mat", format=fmt)
+    assert sniff_format(tmp_path / "h.mat") == signature
+    _assert_same(read_frf(tmp_path / "h.mat"), frf)
+
+
+@pytest.mark.parametrize("fmt", ["mat", "mat73"])
+def test_mat_keeps_extreme_values_and_no_points(tmp_path, fmt):
+    frf = _awkward_frf()
+    write_frf(frf, tmp_path / "x.mat", format=fmt)
+    _assert_same(read_frf(tmp_path / "x.mat"), frf)
+    bare = _frf(2, points=False)
+    write_frf(bare, tmp_path / "y.mat", format=fmt)
+    _assert_same(read_frf(tmp_path / "y.mat"), bare)
+
+
+def test_mat73_header_is_what_matlab_and_scipy_expect(tmp_path):
+    from scipy.io.matlab import matfile_version
+
+    write_frf(_frf(1), tmp_path / "h.mat", format="mat73")
+    head = (tmp_path / "h.mat").read_bytes()[:128]
+    assert head.startswith(b"MATLAB 7.3 MAT-file") and head[124:128] == b"\x00\x02IM"
+    assert matfile_version(str(tmp_path / "h.mat")) == (2, 0)
+
+
+def test_mat_v5_with_other_names_and_channels_in_rows(tmp_path):
+    import scipy.io
+
+    frf = _frf(3)
+    scipy.io.savemat(tmp_path / "user.mat", {"w": frf.omega_rad_s[np.newaxis, :], "Hxy": frf.channels,
+                                             "note": "from a user"})
+    got = read_frf(tmp_path / "user.mat", variables={"frequency": "w", "response": "Hxy"},
+                   frequency_axis="rad/s", kind="accelerance")
+    np.testing.assert_allclose(got.frequency_hz, frf.frequency_hz, rtol=1e-15)
+    assert np.array_equal(got.response, frf.response)
+    assert got.kind == "accelerance" and got.response_points is None
+
+
+def test_mat_v73_written_like_matlab_with_default_names(tmp_path):
+    """A v7.3 file made directly with h5py as MATLAB lays it out: f (1 x n), H (n x 2), transposed."""
+    import h5py
+
+    frf = _frf(2)
+    with h5py.File(tmp_path / "m.mat", "w", userblock_size=512) as fh:
+        ds = fh.create_dataset("f", data=frf.frequency_hz[:, np.newaxis])  # MATLAB 1 x n
+        ds.attrs["MATLAB_class"] = np.bytes_("double")
+        comp = np.empty((2, frf.n_freq), dtype=[("real", "<f8"), ("imag", "<f8")])  # MATLAB n x 2
+        comp["real"], comp["imag"] = frf.channels.real, frf.channels.imag
+        fh.create_dataset("H", data=comp).attrs["MATLAB_class"] = np.bytes_("double")
+    with open(tmp_path / "m.mat", "r+b") as fh:
+        fh.write(b"MATLAB 7.3 MAT-file, Platform: GLNXA64".ljust(116) + b"\0" * 8 + b"\0\x02IM")
+    got = read_frf(tmp_path / "m.mat", kind="accelerance")
+    assert np.array_equal(got.frequency_hz, frf.frequency_hz) and np.array_equal(got.response, frf.response)
