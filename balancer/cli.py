@@ -1,0 +1,67 @@
+"""Command line: ``python -m balancer run SCENE.toml [--out A.h5] [--plots DIR] [--archive EARLIER.h5] [--json]``.
+
+Exit codes: 0 success, 1 bad scene or input (one line on stderr naming the
+file, the key and what was expected), 2 usage error. The summary (or JSON with
+``--json``) goes to stdout; progress and warnings go to stderr.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+import warnings
+
+from modal.errors import ModalError
+
+__all__ = ["main"]
+
+
+def _clean(obj):
+    if isinstance(obj, dict):
+        return {k: _clean(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_clean(v) for v in obj]
+    if isinstance(obj, complex):
+        return {"re": obj.real, "im": obj.imag}
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return None
+    return obj
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="python -m balancer", description="Balancing studies fed by modal identification.")
+    sub = parser.add_subparsers(dest="command", required=True)
+    run = sub.add_parser("run", help="run a scene end to end")
+    run.add_argument("scene", help="scene TOML file")
+    run.add_argument("--out", metavar="ARCHIVE.h5", help="archive to write (default out/<scene name>.h5)")
+    run.add_argument("--plots", metavar="DIR", help="folder for the plots")
+    run.add_argument("--archive", metavar="EARLIER.h5", help="earlier archive of the scene: reuse unchanged stages")
+    run.add_argument("--json", action="store_true", help="print one JSON document on stdout")
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the command line; returns the exit code."""
+    args = build_parser().parse_args(argv)
+    warnings.showwarning = lambda message, *a, **k: print(f"warning: {message}", file=sys.stderr)
+    from .scene import run_scene
+    from .scene.summary import digest
+
+    try:
+        run = run_scene(args.scene, out=args.out, plots_dir=args.plots, archive=args.archive,
+                        progress=lambda msg: print(msg, file=sys.stderr, flush=True))
+    except ModalError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 1
+    except OSError as exc:
+        print(f"error: {exc.filename or args.scene}: {exc.strerror or exc}", file=sys.stderr)
+        return 1
+    if args.json:
+        doc = {"scene": args.scene, "stages": run.stages, "archive": run.archive_path, "plots": list(run.plot_paths),
+               "timings_s": run.timings_s, "results": {s: digest(s, r) for s, r in run.results.items()}}
+        json.dump(_clean(doc), sys.stdout, indent=1, allow_nan=False)
+        sys.stdout.write("\n")
+    else:
+        print(run.summary)
+    return 0

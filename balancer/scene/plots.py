@@ -1,0 +1,118 @@
+"""One figure per stage, saved as PNG (crash-safely) for the scene runner."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from modal.io._atomic import atomic_path
+
+__all__ = ["stage_figures", "save_stage_plot"]
+
+
+def _identify(results):
+    from modal.plots import plot_fit
+
+    if "frf" not in results:
+        return []
+    return [("fit", plot_fit(results["frf"], results["identify"]))]
+
+
+def _stability(results):
+    stage = results["adb_stability"]
+    wn = stage.intervals.natural_frequency_rad_s
+    fig = Figure(figsize=(7, 4), layout="constrained")
+    ax = fig.add_subplot()
+    ax.plot(stage.speeds_rad_s / wn, stage.max_real_part_per_s, lw=1.2)
+    ax.axhline(0, color="0.5", lw=0.8)
+    for lo, hi in stage.intervals.intervals_ratio:
+        ax.axvspan(lo, hi, color="tab:green", alpha=0.15, lw=0)
+    ax.set_xlabel("speed Ω/ωn")
+    ax.set_ylabel("max Re λ of the balanced state [1/s]")
+    ax.set_title("balanced state: stable where shaded")
+    return [("stability", fig)]
+
+
+def _response(results):
+    r = results["adb_response"]
+    fig = Figure(figsize=(10, 7), layout="constrained")
+    ax_amp, ax_orbit, ax_balls, ax_runup = fig.subplots(2, 2).ravel()
+    ax_amp.plot(r.time_s, r.amplitude_m * 1e3, lw=0.8, label="with balls")
+    ax_runup.plot(r.speed_rad_s, r.amplitude_m * 1e3, lw=0.8, label="with balls")
+    if r.amplitude_without_balls_m.size:
+        ax_amp.plot(r.time_s, r.amplitude_without_balls_m * 1e3, lw=0.8, label="without balls")
+        ax_runup.plot(r.speed_rad_s, r.amplitude_without_balls_m * 1e3, lw=0.8, label="without balls")
+    ax_amp.set_xlabel("time [s]")
+    ax_amp.set_ylabel("amplitude [mm]")
+    ax_amp.legend(fontsize="small")
+    ax_orbit.plot(r.rotor_x_m * 1e3, r.rotor_y_m * 1e3, lw=0.5)
+    ax_orbit.set_aspect("equal", adjustable="datalim")
+    ax_orbit.set_xlabel("x [mm]")
+    ax_orbit.set_ylabel("y [mm]")
+    ax_balls.plot(r.time_s, np.degrees(np.angle(np.exp(1j * r.ball_angles_rad))), ".", ms=0.8)  # wrapped
+    for angle in np.atleast_1d(r.balanced_ball_angles_rad):
+        ax_balls.axhline(np.degrees(angle), color="0.5", lw=0.6, ls="--")
+    ax_balls.set_xlabel("time [s]")
+    ax_balls.set_ylabel("ball angle from unbalance [deg]")
+    ax_runup.set_xlabel("speed [rad/s]")
+    ax_runup.set_ylabel("amplitude [mm]")
+    ax_runup.legend(fontsize="small")
+    return [("response", fig)]
+
+
+def _compressor(results):
+    from ..crank_plots import plot_force_locus, plot_objective
+
+    c = results["compressor"]
+    return [("force_locus", plot_force_locus(c.mechanism, c.speed_rpm, c.counterweight_mass_kg, c.counterweight_radius_m)),
+            ("objective", plot_objective(c.mechanism, c.speed_rpm, c.optimum))]
+
+
+def _mounts(results):
+    m = results["mounts"]
+    fig = Figure(figsize=(7, 4), layout="constrained")
+    ax = fig.add_subplot()
+    before = m.comparison.base_force_amplitude_before_n
+    after = m.comparison.base_force_amplitude_after_n
+    labels = [f"{order}x {axis}" for order in range(1, before.shape[0] + 1) for axis in "xyz"]
+    x = np.arange(len(labels))
+    ax.bar(x - 0.2, before.ravel(), 0.4, label="before balancing")
+    ax.bar(x + 0.2, after.ravel(), 0.4, label="after balancing")
+    ax.set_xticks(x, labels, rotation=90, fontsize="small")
+    ax.set_ylabel("force into the base [N]")
+    ax.legend(fontsize="small")
+    return [("base_force", fig)]
+
+
+def _drive(results):
+    d = results["drive"]
+    fig = Figure(figsize=(7, 3), layout="constrained")
+    ax = fig.add_subplot()
+    speeds = [d.drive.stages[0].driver_speed_rpm] + [s.driven_speed_rpm for s in d.drive.stages]
+    ax.plot(range(len(speeds)), speeds, "o-")
+    ax.set_xticks(range(len(speeds)), ["motor"] + [f"stage {i + 1}" for i in range(len(speeds) - 1)])
+    ax.set_ylabel("speed [rpm]")
+    return [("speeds", fig)]
+
+
+_FIGURES = {"identify": _identify, "adb_stability": _stability, "adb_response": _response,
+            "compressor": _compressor, "mounts": _mounts, "drive": _drive}
+
+
+def stage_figures(stage: str, results) -> list[tuple[str, Figure]]:
+    """(name, Figure) pairs for a stage; empty for stages without a plot."""
+    if stage not in results or stage not in _FIGURES:
+        return []
+    return _FIGURES[stage](results)
+
+
+def save_stage_plot(stage: str, results, folder: Path) -> list[Path]:
+    """Save a stage's figures as PNG files in ``folder``; returns their paths."""
+    paths = []
+    for name, fig in stage_figures(stage, results):
+        path = Path(folder) / f"{stage}_{name}.png"
+        with atomic_path(path) as tmp:
+            fig.savefig(tmp, dpi=100, format="png")
+        paths.append(path)
+    return paths

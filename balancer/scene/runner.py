@@ -1,0 +1,224 @@
+"""The scene runner: does only the stages the outputs need, reuses unchanged
+stages from an earlier archive, writes the archive, plots and a summary."""
+from __future__ import annotations
+
+import hashlib
+import json
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable
+
+import h5py
+
+import modal
+from modal.archive import read_node, write_archive
+from modal.errors import ArchiveError, SceneError
+
+from .schema import STAGES, Reference, Scene, dependencies, load_scene, parse_scene
+from .stages import STAGE_FUNCTIONS
+
+__all__ = ["SceneRun", "run_scene", "plan", "stage_hashes"]
+
+#: configuration sections that make up each stage's inputs (besides its dependencies' hashes)
+_STAGE_CONFIG = {
+    "frf": ("frf",), "identify": ("identify",), "drive": ("drive",), "rotor": ("rotor", "adb.m", "adb.n", "adb.R", "adb.D"),
+    "adb_stability": ("adb.stability",), "adb_response": ("adb.response",),
+    "compressor": ("compressor.crank_radius_m", "compressor.rod_length_m", "compressor.rotating_mass_kg",
+                   "compressor.reciprocating_mass_kg", "compressor.speed_rpm", "compressor.harmonics",
+                   "compressor.counterweight_k"),
+    "mounts": ("compressor.body", "compressor.mounts"),
+}
+
+
+@dataclass(frozen=True)
+class SceneRun:
+    """What a run did and produced.
+
+    Attributes
+    ----------
+    stages : dict
+        Every stage name → ``"ran"``, ``"reused"`` (read back from the earlier
+        archive, inputs unchanged) or ``"skipped"`` (not needed by the outputs).
+    results : dict
+        Stage name → result object, for the stages that ran or were reused.
+    inputs_hash : dict
+        Stage name → SHA-256 of its inputs (configuration and upstream hashes).
+    archive_path : str or None
+    plot_paths : tuple of str
+    summary : str
+        The readable summary printed by the command line.
+    timings_s : dict
+        Wall time of each stage that ran, s.
+    """
+
+    stages: dict[str, str]
+    results: dict[str, Any]
+    inputs_hash: dict[str, str]
+    archive_path: str | None
+    plot_paths: tuple[str, ...]
+    summary: str
+    timings_s: dict[str, float] = field(default_factory=dict)
+
+
+def _canonical(value):
+    if isinstance(value, Reference):
+        return value.text
+    if isinstance(value, dict):
+        return {k: _canonical(v) for k, v in sorted(value.items())}
+    if isinstance(value, (list, tuple)):
+        return [_canonical(v) for v in value]
+    if isinstance(value, complex):
+        return [value.real, value.imag]
+    return value
+
+
+def stage_hashes(scene: Scene, stages) -> dict[str, str]:
+    """SHA-256 of each stage's inputs: its configuration, its files' bytes and its dependencies' hashes."""
+    hashes: dict[str, str] = {}
+    for stage in STAGES:
+        if stage not in stages:
+            continue
+        config = {key: _canonical(scene.section(key)) for key in _STAGE_CONFIG[stage]}
+        if stage == "frf" and scene.section("frf.file"):
+            path = scene.folder / scene.section("frf.file")
+            try:
+                config["file_sha256"] = hashlib.sha256(path.read_bytes()).hexdigest()
+            except OSError as exc:
+                raise SceneError(f"{scene.source}: key 'frf.file' = {scene.section('frf.file')!r}: cannot read {path} "
+                                 f"({exc.strerror})") from None
+        payload = {"stage": stage, "config": config, "software": modal.__version__,
+                   "deps": {d: hashes[d] for d in dependencies(scene, stage)}}
+        hashes[stage] = hashlib.sha256(json.dumps(payload, sort_keys=True).encode()).hexdigest()
+    return hashes
+
+
+def _closure(scene: Scene, wanted) -> set[str]:
+    need, todo = set(), list(wanted)
+    while todo:
+        stage = todo.pop()
+        if stage not in need:
+            need.add(stage)
+            todo.extend(dependencies(scene, stage))
+    return need
+
+
+def _wanted(scene: Scene) -> list[str]:
+    out = scene.section("outputs")
+    wanted = set(out.get("tables", [])) | set(out.get("plots", []))
+    archive = out.get("archive", False)
+    if isinstance(archive, list):
+        wanted |= set(archive)
+    return [s for s in STAGES if s in wanted]
+
+
+def plan(scene: Scene, earlier: h5py.File | None = None) -> tuple[dict[str, str], dict[str, str]]:
+    """Decide each stage's status without computing anything: (statuses, hashes)."""
+    wanted = _wanted(scene)
+    hashes = stage_hashes(scene, _closure(scene, wanted))
+    status = {s: "skipped" for s in STAGES}
+    demand = set(wanted)
+    for stage in reversed(STAGES):
+        if stage not in demand:
+            continue
+        if earlier is not None and stage in earlier and earlier[stage].attrs.get("inputs_hash") == hashes[stage]:
+            status[stage] = "reused"
+        else:
+            status[stage] = "ran"
+            demand.update(dependencies(scene, stage))
+    return status, hashes
+
+
+def _open_earlier(path) -> h5py.File | None:
+    if path is None:
+        return None
+    path = Path(path)
+    if not path.is_file():
+        return None  # nothing to reuse yet: run everything
+    try:
+        f = h5py.File(path, "r")
+    except OSError as exc:
+        raise ArchiveError(f"{path}: not a readable HDF5 archive ({exc})") from None
+    from modal.archive import _check_schema
+
+    try:
+        _check_schema(f, str(path))
+    except ArchiveError:
+        f.close()
+        raise
+    return f
+
+
+def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, plots_dir: str | Path | None = None,
+              archive: str | Path | None = None, progress: Callable[[str], None] | None = None) -> SceneRun:
+    """Run a scene end to end.
+
+    Parameters
+    ----------
+    scene : path, dict or Scene
+        A TOML file, the same content as a dict, or a validated scene.
+    out : path, optional
+        Archive to write; default ``out/<scene name>.h5`` when the scene asks
+        for an archive.
+    plots_dir : path, optional
+        Folder for the plots; default ``<archive stem>_plots`` beside the archive.
+    archive : path, optional
+        An earlier archive of the same scene: stages whose inputs are unchanged
+        are read back from it instead of being recomputed.
+    progress : callable, optional
+        Called with a line of text before and after each stage that runs.
+    """
+    if isinstance(scene, (str, Path)):
+        scene = load_scene(scene)
+    elif isinstance(scene, dict):
+        scene = parse_scene(scene)
+    say = progress or (lambda _msg: None)
+    earlier = _open_earlier(archive)
+    try:
+        status, hashes = plan(scene, earlier)
+        results: dict[str, Any] = {}
+        timings: dict[str, float] = {}
+        for stage in STAGES:
+            if status[stage] == "reused":
+                results[stage] = read_node(earlier[stage])
+    finally:
+        if earlier is not None:
+            earlier.close()
+    for stage in STAGES:
+        if status[stage] != "ran":
+            continue
+        say(f"{stage}: running")
+        t0 = time.perf_counter()
+        kwargs = {dep: results[dep] for dep in dependencies(scene, stage) if dep in results}
+        results[stage] = STAGE_FUNCTIONS[stage](scene, **kwargs)
+        timings[stage] = time.perf_counter() - t0
+        say(f"{stage}: done in {timings[stage]:.2f} s")
+    outputs = scene.section("outputs")
+    name = scene.section("scene.name") or Path(scene.source).stem or "scene"
+    archive_path = None
+    stored = outputs.get("archive", False)
+    if stored or out is not None:
+        keep = [s for s in STAGES if s in results and (stored is True or stored is False or s in stored)]
+        archive_path = Path(out) if out is not None else Path("out") / f"{_slug(name)}.h5"
+        archive_path.parent.mkdir(parents=True, exist_ok=True)
+        write_archive(archive_path, {s: results[s] for s in keep}, scene_text=scene.text or None,
+                      inputs_hash={s: hashes[s] for s in keep})
+    plot_paths = []
+    if outputs.get("plots"):
+        from .plots import save_stage_plot
+
+        folder = Path(plots_dir) if plots_dir is not None else (
+            archive_path.with_name(archive_path.stem + "_plots") if archive_path else Path("out") / f"{_slug(name)}_plots")
+        folder.mkdir(parents=True, exist_ok=True)
+        for stage in outputs["plots"]:
+            plot_paths += save_stage_plot(stage, results, folder)
+    from .summary import format_summary
+
+    summary = format_summary(name, status, results, outputs.get("tables", []), timings,
+                             str(archive_path) if archive_path else None, plot_paths)
+    return SceneRun(status, results, hashes, str(archive_path) if archive_path else None, tuple(map(str, plot_paths)),
+                    summary, timings)
+
+
+def _slug(text: str) -> str:
+    return "".join(c if c.isalnum() or c in "-_" else "_" for c in text).strip("_") or "scene"

@@ -1,0 +1,273 @@
+"""The scene's stages: each a plain function from its configuration and the
+results of the stages it depends on to a frozen result dataclass.
+
+They only wire the library together; a script can call any of them directly.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+import modal
+from modal.errors import SceneError
+from modal.units import TWO_PI
+
+from ..adb import ADBParameters, ParameterStd, identified_std, stable_speed_intervals
+from ..adb.simulate import SimulationResult, simulate
+from ..adb.speed import LinearRunUp
+from ..adb.stability import SpeedIntervals
+from .schema import DRIVE_FIELDS, IDENTIFIED_FIELDS, Reference, Scene, parse_reference
+
+__all__ = [
+    "RotorStage", "StabilityStage", "DriveStage", "CompressorStage", "MountsStage",
+    "stage_frf", "stage_identify", "stage_drive", "stage_rotor", "stage_adb_stability", "stage_adb_response",
+    "stage_compressor", "stage_mounts", "resolve", "STAGE_FUNCTIONS",
+]
+
+
+@dataclass(frozen=True)
+class RotorStage:
+    """Ball-balancer parameters as used, with the standard errors carried from identification.
+
+    ``sources`` says where each of M, k, c came from (a number or a reference).
+    """
+
+    params: ADBParameters
+    std: ParameterStd
+    sources: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class StabilityStage:
+    """Speed intervals (rad/s) where the balanced state is stable, and the eigenvalue curve."""
+
+    intervals: SpeedIntervals
+    speeds_rad_s: np.ndarray
+    max_real_part_per_s: np.ndarray
+    can_balance: bool
+
+
+@dataclass(frozen=True)
+class DriveStage:
+    """Belt drive and, when a shaft is given, its hand-over to the rotor."""
+
+    drive: object  # balancer.drive.BeltDrive
+    handover: object | None  # balancer.shaft.RotorHandover
+
+
+@dataclass(frozen=True)
+class CompressorStage:
+    """Crank counterweight study: mechanism, exact optimum and the chosen counterweight."""
+
+    mechanism: object  # balancer.crank.SliderCrank
+    optimum: object  # balancer.crank.OptimalCounterweight
+    counterweight_mass_kg: float
+    counterweight_radius_m: float
+    speed_rpm: float
+
+
+@dataclass(frozen=True)
+class MountsStage:
+    """The compressor body on its mounts: modes and base forces before/after balancing."""
+
+    system: object  # balancer.mounts.MountedBody
+    natural_frequencies_hz: np.ndarray
+    comparison: object  # balancer.mounts.BalancingComparison
+
+
+# ---------------------------------------------------------------- references
+def _identified_mode(identified, ref: Reference, key: str, scene: Scene):
+    if ref.mode > len(identified):
+        raise SceneError(f"{scene.source}: key '{key}' = {ref.text!r}: identification found "
+                         f"{len(identified)} mode(s), expected at least {ref.mode}")
+    return identified[ref.mode - 1]
+
+
+def _channel(identified, scene: Scene) -> int:
+    channel = scene.section("identify.channel")
+    mode = identified[0]
+    driving = np.atleast_1d(mode.driving_point)
+    if channel is None:
+        hits = np.flatnonzero(driving)
+        return int(hits[0]) if hits.size else 0
+    if not 0 <= channel < driving.size:
+        raise SceneError(f"{scene.source}: key 'identify.channel' = {channel}: expected 0..{driving.size - 1}")
+    return channel
+
+
+def resolve(value, key: str, scene: Scene, identified=None, drive=None) -> float:
+    """A number, or the value a reference points at (SI units)."""
+    if isinstance(value, str):
+        value = parse_reference(value)
+    if not isinstance(value, Reference):
+        return value
+    if value.source == "identified":
+        mode = _identified_mode(identified, value, key, scene)
+        raw = np.atleast_1d(getattr(mode, IDENTIFIED_FIELDS[value.field]))
+        number = float(raw[_channel(identified, scene)] if raw.size > 1 else raw[0])
+        if not math.isfinite(number):
+            raise SceneError(f"{scene.source}: key '{key}' = {value.text!r} is not defined for that channel "
+                             f"(flags: {', '.join(mode.flags) or 'none'}); choose a driving-point channel")
+        return number
+    handover = getattr(drive, "handover", None)
+    if handover is None:
+        raise SceneError(f"{scene.source}: key '{key}' = {value.text!r} needs [drive.shaft] for the hand-over")
+    return float(getattr(handover, DRIVE_FIELDS[value.field]))
+
+
+# -------------------------------------------------------------------- stages
+def stage_frf(scene: Scene) -> modal.FRF:
+    """Read the FRF file or make the synthetic FRF."""
+    cfg = scene.section("frf")
+    if "file" in cfg:
+        from modal.io import read_frf
+
+        hints = {k: cfg[k] for k in ("kind", "frequency_axis") if k in cfg}
+        return read_frf(scene.folder / cfg["file"], **hints)
+    syn = cfg["synthetic"]
+    from modal.synthetic import add_noise, modal_frf
+
+    f = np.linspace(syn.get("f_min_hz", 0.0), syn["f_max_hz"], syn["n_lines"] + 1)[1:]
+    n_modes = len(syn["natural_frequency_hz"])
+    for key in ("damping_ratio", "modal_constant"):
+        if len(syn[key]) != n_modes:
+            raise SceneError(f"{scene.source}: key 'frf.synthetic.{key}' has {len(syn[key])} values; "
+                             f"expected one per natural frequency ({n_modes})")
+    frf = modal_frf(f, syn["natural_frequency_hz"], syn["damping_ratio"], syn["modal_constant"],
+                    kind=syn.get("kind", "receptance"), response_points=["1"], reference_points=["1"])
+    return add_noise(frf, syn.get("noise", 0.0), seed=syn.get("seed", 0)) if syn.get("noise", 0.0) > 0 else frf
+
+
+def stage_identify(scene: Scene, frf: modal.FRF) -> modal.IdentificationResult:
+    """Identify the modes of the FRF."""
+    cfg = scene.section("identify", {})
+    bands = [tuple(b) for b in cfg["bands_hz"]] if "bands_hz" in cfg else None
+    return modal.identify(frf, cfg.get("method", "nls"), bands_hz=bands,
+                          min_prominence_db=cfg.get("min_prominence_db", 6.0), max_modes=cfg.get("max_modes"))
+
+
+def stage_drive(scene: Scene) -> DriveStage:
+    """Belt stages in series and the shaft's hand-over (speed, stiffness, critical-speed margin)."""
+    from ..drive import BeltStageSpec, belt_drive
+    from ..shaft import ShaftGeometry, rotor_handover
+
+    cfg = scene.section("drive")
+    specs = [BeltStageSpec(**{k: v for k, v in s.items()}) for s in cfg["stages"]]
+    drive = belt_drive(cfg["motor_speed_rpm"], cfg["power_w"], specs, service_factor=cfg.get("service_factor", 1.0))
+    handover = None
+    shaft = cfg.get("shaft")
+    if shaft:
+        geometry = ShaftGeometry(shaft["length_m"], shaft["bearing_a_m"], shaft["bearing_b_m"])
+        last = drive.stages[-1]
+        kwargs = {"youngs_modulus_pa": shaft["youngs_modulus_pa"]} if "youngs_modulus_pa" in shaft else {}
+        handover = rotor_handover(last.driven_speed_rpm * TWO_PI / 60, geometry, shaft["diameter_m"],
+                                  shaft["rotor_position_m"], shaft["rotor_mass_kg"], **kwargs)
+    return DriveStage(drive, handover)
+
+
+def stage_rotor(scene: Scene, identify=None, drive=None) -> RotorStage:
+    """Ball-balancer parameters, with M, k, c resolved from identification or the drive."""
+    rotor, adb = scene.section("rotor"), scene.section("adb")
+    values, sources = {}, []
+    for key in ("M", "k", "c"):
+        raw = rotor[key]
+        values[key] = resolve(raw, f"rotor.{key}", scene, identify, drive)
+        sources.append(f"{key} = {raw.text if isinstance(raw, Reference) else raw!r}")
+    std = {"k": 0.0, "c": 0.0, "M": 0.0}
+    if identify is not None:
+        channel = _channel(identify, scene)
+        for key, field in (("M", "mass"), ("k", "stiffness"), ("c", "damping")):
+            raw = rotor[key]
+            if isinstance(raw, Reference) and raw.source == "identified" and raw.field == field:
+                mode = identify[raw.mode - 1]
+                value = getattr(identified_std(mode, channel if np.ndim(mode.mass_kg) else None), key)
+                std[key] = value if math.isfinite(value) else 0.0
+    M = values["M"]
+    if isinstance(rotor["M"], Reference) and rotor.get("mass_includes_balls", True):
+        M -= adb["n"] * adb["m"]
+        if M <= 0:
+            raise SceneError(f"{scene.source}: key 'rotor.M': identified mass {values['M']:.6g} kg minus the balls "
+                             f"({adb['n']} x {adb['m']} kg) is not positive")
+    params = ADBParameters(M=M, m=adb["m"], n=adb["n"], R=adb["R"], e=rotor["e"], k=values["k"], c=values["c"],
+                           D=adb["D"])
+    return RotorStage(params, ParameterStd(**std), tuple(sources))
+
+
+def stage_adb_stability(scene: Scene, rotor: RotorStage) -> StabilityStage:
+    """Stable speed intervals of the balanced state, and max Re λ against speed."""
+    from ..adb import balanced_stability
+
+    cfg = scene.section("adb.stability", {})
+    params = rotor.params
+    wn = params.natural_frequency_rad_s
+    speed_max = cfg.get("speed_max_rad_s", cfg.get("speed_max_ratio", 4.0) * wn)
+    can = params.can_balance
+    if not can:
+        raise SceneError(f"{scene.source}: [adb] cannot balance: n·m·R = {params.n * params.m * params.R:.3g} kg m "
+                         f"< M·e = {params.M * params.e:.3g} kg m; use more or heavier balls or a larger race")
+    intervals = stable_speed_intervals(params, speed_max, grid_points=cfg.get("grid_points", 2000))
+    speeds = np.linspace(0.05 * wn, speed_max, 400)
+    curve = balanced_stability(params, speeds)
+    return StabilityStage(intervals, speeds, np.asarray(curve.max_real_part_per_s), can)
+
+
+def stage_adb_response(scene: Scene, rotor: RotorStage, drive=None) -> SimulationResult:
+    """Time response: constant speed, or a run-up through the critical speed."""
+    cfg = scene.section("adb.response")
+    if "speed_rad_s" in cfg:
+        speed = resolve(cfg["speed_rad_s"], "adb.response.speed_rad_s", scene, drive=drive)
+    else:
+        if "speed_end_rad_s" not in cfg or "ramp_s" not in cfg:
+            raise SceneError(f"{scene.source}: key 'adb.response' needs speed_rad_s, or speed_end_rad_s and ramp_s")
+        end = resolve(cfg["speed_end_rad_s"], "adb.response.speed_end_rad_s", scene, drive=drive)
+        speed = LinearRunUp(cfg.get("speed_start_rad_s", 0.0), end, cfg["ramp_s"])
+    t_end = cfg.get("t_end_s", 2 * cfg.get("ramp_s", 1.0))
+    return simulate(rotor.params, speed, t_end, cfg.get("initial_ball_angles_rad"), rtol=cfg.get("rtol", 1e-8))
+
+
+def stage_compressor(scene: Scene) -> CompressorStage:
+    """Exact optimum counterweight of the slider-crank (lightest: r_c = r, or a given k)."""
+    from ..crank import SliderCrank, counterweight_on_curve, optimal_counterweight
+
+    cfg = scene.section("compressor")
+    mech = SliderCrank(cfg["crank_radius_m"], cfg["rod_length_m"], cfg["rotating_mass_kg"],
+                       cfg["reciprocating_mass_kg"], harmonics=cfg.get("harmonics", (1, 2)))
+    optimum = optimal_counterweight(mech, cfg["speed_rpm"])
+    chosen = counterweight_on_curve(mech, optimum, k=cfg["counterweight_k"]) if "counterweight_k" in cfg \
+        else counterweight_on_curve(mech, optimum)
+    return CompressorStage(mech, optimum, float(chosen.mass_kg), float(chosen.radius_m), cfg["speed_rpm"])
+
+
+def stage_mounts(scene: Scene, compressor: CompressorStage, identify=None) -> MountsStage:
+    """Body on mounts: natural frequencies and the base force before and after balancing."""
+    from ..mounts import Mount, MountedBody, RigidBody, balancing_comparison, natural_modes
+
+    body_cfg = scene.section("compressor.body")
+    mounts = []
+    for i, m in enumerate(scene.section("compressor.mounts")):
+        vectors = {}
+        for key in ("stiffness_n_per_m", "damping_n_s_per_m"):
+            raw = m.get(key, [0.0, 0.0, 0.0])
+            if isinstance(raw, str):
+                value = resolve(raw, f"compressor.mounts[{i}].{key}", scene, identify)
+                raw = [value, value, value]
+            vectors[key] = raw
+        mounts.append(Mount(m["position_m"], vectors["stiffness_n_per_m"], vectors["damping_n_s_per_m"]))
+    system = MountedBody(RigidBody(body_cfg["mass_kg"], np.array(body_cfg["inertia_kg_m2"])), tuple(mounts),
+                         damping_ratio=body_cfg.get("damping_ratio", 0.0))
+    modes = natural_modes(system)
+    comparison = balancing_comparison(system, compressor.mechanism, compressor.speed_rpm, body_cfg["crank_centre_m"],
+                                      compressor.counterweight_mass_kg, compressor.counterweight_radius_m)
+    return MountsStage(system, np.asarray(modes.natural_frequency_hz), comparison)
+
+
+STAGE_FUNCTIONS = {
+    "frf": stage_frf, "identify": stage_identify, "drive": stage_drive, "rotor": stage_rotor,
+    "adb_stability": stage_adb_stability, "adb_response": stage_adb_response, "compressor": stage_compressor,
+    "mounts": stage_mounts,
+}
+
+
