@@ -45,6 +45,7 @@ DEFAULT_VARIABLES = {
     "response_points": ("response_points",),
     "reference_points": ("reference_points",),
 }
+_MATLAB_CLASS = {"float64": "double", "float32": "single", "bool": "logical"}
 _HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 
 
@@ -168,7 +169,7 @@ def _lookup(variables: dict[str, Any], role: str, hints: dict[str, Any], src: st
 
 def _describe(value: Any) -> str:
     if isinstance(value, np.ndarray):
-        kind = "complex" if value.dtype.kind == "c" else value.dtype.name
+        kind = "complex" if value.dtype.kind == "c" else _MATLAB_CLASS.get(value.dtype.name, value.dtype.name)
         return f"({'x'.join(map(str, value.shape))} {kind})"
     if isinstance(value, str):
         return "(char)"

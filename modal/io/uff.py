@@ -200,6 +200,9 @@ def read_frf_uff(path: str | os.PathLike, **hints: Any) -> FRF:
     chosen = _choose(hints.get("dataset"), blocks, headers, src)
     frfs = []
     for b in chosen:
+        problem = _check_header(b, src)
+        if problem:
+            raise FormatError(problem)
         dset = _read_set(uff, b, src, header_only=False)
         frfs.append(_to_arrays(b, dset, src, hints))
     return _assemble(chosen, frfs, src, hints)
@@ -324,24 +327,29 @@ def _assemble(chosen: list[_Block], parts: list[dict], src: str, hints: dict[str
                      reference_points=points("ref"), units=units, hints=hints)
 
 
-def _diagnose(block: _Block, src: str) -> str:
-    """A message naming the first bad record or value of a dataset pyuff could not parse."""
-    lines = block.raw.split(b"\n")
-    binary = len(lines) > 1 and lines[1][6:7].lower() == b"b"
+_INT_FIELDS = {
+    6: [(0, 5, "func_type"), (5, 15, "func_id"), (15, 20, "ver_num"), (20, 30, "load_case_id"),
+        (41, 51, "rsp_node"), (51, 55, "rsp_dir"), (66, 76, "ref_node"), (76, 80, "ref_dir")],
+    7: [(0, 10, "ord_data_type"), (10, 20, "num_pts"), (20, 30, "abscissa_spacing")],
+    8: [(0, 10, "abscissa_spec_data_type")], 9: [(0, 10, "ordinate_spec_data_type")],
+    10: [(0, 10, "orddenom_spec_data_type")], 11: [(0, 10, "z_axis_spec_data_type")],
+}
+_REQUIRED = {"func_type", "rsp_node", "rsp_dir", "ref_node", "ref_dir", "ord_data_type", "num_pts",
+             "abscissa_spacing"}
+
+
+def _check_header(block: _Block, src: str) -> str | None:
+    """A message for the first bad field of records 6–11 (pyuff reads some as 0 silently), or None."""
+    lines = block.raw.split(b"\n", 14)
     if len(lines) < 14:
         return (f"{src}: {block.where()}: only {max(len(lines) - 1, 0)} lines before the closing '    -1'; "
                 "expected 12 header records and data (truncated dataset?)")
     text = [ln.decode("latin-1").rstrip("\r") for ln in lines[:14]]
-    int_fields = {6: [(0, 5, "func_type"), (5, 15, "func_id"), (15, 20, "ver_num"), (20, 30, "load_case_id"),
-                      (41, 51, "rsp_node"), (51, 55, "rsp_dir"), (66, 76, "ref_node"), (76, 80, "ref_dir")],
-                  7: [(0, 10, "ord_data_type"), (10, 20, "num_pts"), (20, 30, "abscissa_spacing")],
-                  8: [(0, 10, "abscissa_spec_data_type")], 9: [(0, 10, "ordinate_spec_data_type")],
-                  10: [(0, 10, "orddenom_spec_data_type")], 11: [(0, 10, "z_axis_spec_data_type")]}
-    for record, fields in int_fields.items():
+    for record, fields in _INT_FIELDS.items():
         ln = text[record + 1]
         for a, e, name in fields:
             tok = ln[a:e].strip()
-            if record in (6, 7) and name in ("func_type", "ord_data_type", "num_pts", "abscissa_spacing") or tok:
+            if name in _REQUIRED or tok:
                 try:
                     int(tok)
                 except ValueError:
@@ -353,6 +361,17 @@ def _diagnose(block: _Block, src: str) -> str:
             float(tok)
         except ValueError:
             return f"{src}: {block.where(7, name)}: {tok!r} is not a number; expected E13.5 in columns {a + 1}-{e}"
+    return None
+
+
+def _diagnose(block: _Block, src: str) -> str:
+    """A message naming the first bad record or value of a dataset pyuff could not parse."""
+    problem = _check_header(block, src)
+    if problem:
+        return problem
+    lines = block.raw.split(b"\n")
+    text = [ln.decode("latin-1").rstrip("\r") for ln in lines[:14]]
+    binary = text[1][6:7].lower() == "b"
     if binary:
         return (f"{src}: {block.where()}: the binary data cannot be decoded (byte order, precision or length "
                 "do not match record 7); expected the 58b layout (pyuff.fix_58b may repair some vendor files)")
