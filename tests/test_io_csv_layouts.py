@@ -99,3 +99,13 @@ def test_kind_aliases_and_units_hint(tmp_path):
     text = "# kind: inertance\n" + _table([F, H[0].real, H[0].imag], header=["f", "re", "im"])
     frf = read_frf(_write(tmp_path, "k.csv", text), units="g/N")
     assert frf.kind == "accelerance" and frf.units == "g/N"
+
+
+def test_trailing_delimiter_and_utf16(tmp_path):
+    text = _table([F, H[0].real, H[0].imag], delimiter=";", header=["f", "re", "im"])
+    text = "\n".join(ln + ";" for ln in text.splitlines()) + "\n"
+    frf = read_frf(_write(tmp_path, "x.csv", text), kind="mobility")
+    assert np.array_equal(frf.response, H[0])
+    path = tmp_path / "u16.csv"
+    path.write_bytes(text.encode("utf-16"))
+    assert np.array_equal(read_frf(path, kind="mobility").response, H[0])

@@ -52,6 +52,8 @@ def sniff_format(path: str | os.PathLike) -> str:
         return "mat73" if head.startswith(b"MATLAB") and hdf5_at > 0 else "hdf5"
     if head.startswith(b"MATLAB 5.0 MAT-file"):
         return "mat5"
+    if head.startswith((b"\xff\xfe", b"\xfe\xff")):  # UTF-16 text (some Windows exporters)
+        return "text"
     first = next((ln.strip() for ln in head.split(b"\n") if ln.strip()), b"")
     if first == b"-1":
         return "uff"

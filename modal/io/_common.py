@@ -31,7 +31,7 @@ HINTS = frozenset({
 
 #: Frequency units a column or hint may name, as the factor that turns them into Hz.
 _FREQUENCY_FACTORS = {
-    "hz": 1.0, "1/s": 1.0, "khz": 1e3, "mhz": 1e6,
+    "hz": 1.0, "hertz": 1.0, "cps": 1.0, "1/s": 1.0, "khz": 1e3, "mhz": 1e6,
     "rad/s": 1.0 / TWO_PI, "rad/sec": 1.0 / TWO_PI, "rads": 1.0 / TWO_PI, "rad_s": 1.0 / TWO_PI,
     "cpm": 1.0 / 60.0, "rpm": 1.0 / 60.0, "1/min": 1.0 / 60.0,
 }

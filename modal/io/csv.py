@@ -124,6 +124,12 @@ def read_frf_csv(path: str | os.PathLike, **hints: Any) -> FRF:
     src = source_name(path)
     p = check_file(path)
     raw = p.read_bytes()
+    if raw.startswith((b"\xff\xfe", b"\xfe\xff")):
+        try:
+            text = raw.decode("utf-16")
+        except UnicodeDecodeError:
+            raise FormatError(f"{src}: line 1: damaged UTF-16 text; expected a text file of numbers") from None
+        return _read_text(text, src, hints)
     if b"\x00" in raw[:4096]:
         raise FormatError(f"{src}: line 1: binary content (NUL bytes); expected a text file of numbers")
     try:
@@ -158,6 +164,9 @@ def _read_text(text: str, src: str, hints: dict[str, Any]) -> FRF:
     if not data:
         last = header_lines[-1][0] if header_lines else content[-1][0]
         raise FormatError(f"{src}: line {last}: only a header or comments, no data lines; expected rows of numbers")
+    if delim is not None and all(ln.endswith(delim) for _, ln in data):  # trailing delimiter (spreadsheets)
+        data = [(n, ln[:-1]) for n, ln in data]
+        header_lines = [(n, ln[:-1] if ln.endswith(delim) else ln) for n, ln in header_lines]
     canonical = _check_format(meta, src)
     names = _split(header_lines[-1][1], delim) if header_lines else None
     n_cols = len(_split(data[0][1], delim))
