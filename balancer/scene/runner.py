@@ -113,19 +113,18 @@ def _wanted(scene: Scene) -> list[str]:
 
 
 def plan(scene: Scene, earlier: h5py.File | None = None) -> tuple[dict[str, str], dict[str, str]]:
-    """Decide each stage's status without computing anything: (statuses, hashes)."""
-    wanted = _wanted(scene)
-    hashes = stage_hashes(scene, _closure(scene, wanted))
+    """Decide each stage's status without computing anything: (statuses, hashes).
+
+    The outputs' stages and everything upstream of them are needed; a needed
+    stage whose inputs hash matches the earlier archive is reused (read back),
+    any other needed stage runs, and the rest are skipped.
+    """
+    needed = _closure(scene, _wanted(scene))
+    hashes = stage_hashes(scene, needed)
     status = {s: "skipped" for s in STAGES}
-    demand = set(wanted)
-    for stage in reversed(STAGES):
-        if stage not in demand:
-            continue
-        if earlier is not None and stage in earlier and earlier[stage].attrs.get("inputs_hash") == hashes[stage]:
-            status[stage] = "reused"
-        else:
-            status[stage] = "ran"
-            demand.update(dependencies(scene, stage))
+    for stage in needed:
+        same = earlier is not None and stage in earlier and earlier[stage].attrs.get("inputs_hash") == hashes[stage]
+        status[stage] = "reused" if same else "ran"
     return status, hashes
 
 
