@@ -15,6 +15,18 @@ from .equilibria import (
 )
 from .linear import EigenAnalysis, eigen_analysis
 from .parameters import ADBParameters, ParameterBatch, ParameterStd, identified_std
+from .simulate import (
+    BatchSimulationResult,
+    IntegrationResult,
+    SimulationResult,
+    classify_final_state,
+    default_initial_ball_angles,
+    integrate,
+    settling_time,
+    simulate,
+    simulate_batch,
+)
+from .speed import CallableSpeed, ConstantSpeed, LinearRunUp, SpeedProfile
 from .stability import (
     BalancedStability,
     RouthHurwitzResult,
@@ -57,4 +69,17 @@ __all__ = [
     "stability_map",
     "stable_speed_intervals",
     "threshold_sensitivity",
+    "BatchSimulationResult",
+    "IntegrationResult",
+    "SimulationResult",
+    "classify_final_state",
+    "default_initial_ball_angles",
+    "integrate",
+    "settling_time",
+    "simulate",
+    "simulate_batch",
+    "CallableSpeed",
+    "ConstantSpeed",
+    "LinearRunUp",
+    "SpeedProfile",
 ]

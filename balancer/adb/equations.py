@@ -37,6 +37,7 @@ __all__ = [
     "fixed_frame_jacobian",
     "rotating_to_fixed",
     "fixed_to_rotating",
+    "scalar_rhs",
     "COMPLEX_STEP_H",
 ]
 
@@ -319,3 +320,80 @@ def fixed_to_rotating(state, speed_rad_s, n: int):
     out[..., 3 + n] = zy - omega * u
     out[..., 4 + n:4 + 2 * n] = state[..., 4 + n:4 + 2 * n]
     return out
+
+
+def scalar_rhs(M: float, m: float, n: int, R: float, e: float, k: float, c: float, D: float, *, frame: str):
+    """Right-hand side for a single parameter set in plain Python floats (fast for small n).
+
+    Same equations as :func:`rotating_frame_rhs` / :func:`fixed_frame_rhs` (tested equal to
+    rounding); numpy's per-call overhead dominates for one small system, so ``solve_ivp``
+    runs of a single set use this instead.  ``n = 0`` gives the rotor without balls.
+
+    Parameters
+    ----------
+    M, m, n, R, e, k, c, D : float, float, int, float, float, float, float, float
+        As in :class:`~balancer.adb.ADBParameters` (SI).
+    frame : {"rotating", "fixed"}
+        Formulation (state layouts as in this module).
+
+    Returns
+    -------
+    callable
+        ``f(y, speed_rad_s, acceleration_rad_s2) -> ndarray``.
+    """
+    import math
+
+    total = M + n * m
+    mR = m * R
+    unbalance = M * e
+    drag = D / (m * R * R) if m > 0 else 0.0
+    inv_R = 1.0 / R
+    rotating = frame == "rotating"
+    size = 4 + 2 * n + (0 if rotating else 1)
+    sin, cos = math.sin, math.cos
+
+    def rhs(state, omega: float, alpha: float):
+        y = state.tolist()
+        px, py, vx, vy = y[0], y[1], y[2 + n], y[3 + n]
+        if rotating:
+            nu, nu_dot, uc, us, offset = omega, alpha, 1.0, 0.0, 0.0
+        else:
+            theta = y[4 + 2 * n]
+            nu, nu_dot, uc, us, offset = 0.0, 0.0, cos(theta), sin(theta), theta
+        a0x = -2.0 * nu * vy - nu_dot * py - nu * nu * px
+        a0y = 2.0 * nu * vx + nu_dot * px - nu * nu * py
+        sum_x = sum_y = s_ss = s_cc = s_sc = 0.0
+        balls = []
+        for i in range(n):
+            b = y[2 + i] + offset
+            s, co = sin(b), cos(b)
+            rate = y[4 + n + i]
+            h = -drag * rate - (a0y * co - a0x * s) * inv_R
+            speed = omega + rate
+            force = speed * speed
+            sum_x += force * co + h * s
+            sum_y += force * s - h * co
+            s_ss += s * s
+            s_cc += co * co
+            s_sc += s * co
+            balls.append((s, co, h))
+        fx = (-c * (vx - nu * py) - k * px + unbalance * (omega * omega * uc + alpha * us)
+              + mR * sum_x - total * a0x)
+        fy = (-c * (vy + nu * px) - k * py + unbalance * (omega * omega * us - alpha * uc)
+              + mR * sum_y - total * a0y)
+        a11 = total - m * s_ss
+        a22 = total - m * s_cc
+        a12 = m * s_sc
+        det = a11 * a22 - a12 * a12
+        ax = (a22 * fx - a12 * fy) / det
+        ay = (a11 * fy - a12 * fx) / det
+        out = [0.0] * size
+        out[0], out[1], out[2 + n], out[3 + n] = vx, vy, ax, ay
+        for i, (s, co, h) in enumerate(balls):
+            out[2 + i] = y[4 + n + i]
+            out[4 + n + i] = h - (ay * co - ax * s) * inv_R - alpha
+        if not rotating:
+            out[4 + 2 * n] = omega
+        return np.array(out)
+
+    return rhs

@@ -1,0 +1,757 @@
+"""Time responses: constant speed and run-up, single runs and stacked batches.
+
+* Constant speed is integrated in the rotating frame (autonomous; the balanced state
+  is a fixed point, so steps grow as the balls settle); rotor coordinates are rotated
+  back exactly for the fixed-frame orbit.
+* A speed profile (run-up) is integrated in the fixed Cartesian frame.
+* The integrator is chosen by stiffness: DOP853 (explicit, 8th order) unless the ball
+  drag rate ``D / (m R^2)`` exceeds ``STIFFNESS_RATIO`` times the fastest dynamic rate
+  ``max(omega_n, |omega|)``; then LSODA with the exact (complex-step) Jacobian,
+  banded for stacked batches.
+* A batch of parameter sets is one stacked ``solve_ivp`` system.  Because ``solve_ivp``
+  controls an RMS norm over all components, the tolerances are divided by ``sqrt(B)``,
+  which bounds every member's local error estimate by the single-run tolerance.
+
+Settling (``adb.md`` section 5): for two balls, the last time a ball is more than
+``settle_tolerance * |phi*|`` from the nearest balanced configuration; otherwise the last
+time the unbalance residual ``|M e + m R sum e^(i phi)|`` exceeds ``settle_tolerance * M e``.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Sequence
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from modal.errors import ParameterError
+
+from .equations import (
+    fixed_frame_jacobian,
+    fixed_frame_rhs,
+    fixed_to_rotating,
+    rotating_frame_jacobian,
+    rotating_frame_rhs,
+    rotating_to_fixed,
+    scalar_rhs,
+)
+from .equilibria import balanced_ball_angles, unbalanced_states
+from .parameters import ADBParameters, ParameterBatch
+from .speed import ConstantSpeed, SpeedProfile, as_speed_profile, check_profile
+
+__all__ = [
+    "STIFFNESS_RATIO",
+    "SimulationResult",
+    "BatchSimulationResult",
+    "IntegrationResult",
+    "default_initial_ball_angles",
+    "choose_method",
+    "integrate",
+    "simulate",
+    "simulate_batch",
+    "settling_time",
+    "classify_final_state",
+]
+
+STIFFNESS_RATIO = 50.0
+"""Ball-drag rate over the fastest dynamic rate above which the drag counts as stiff."""
+
+FINAL_STATES = ("balanced", "locked", "whirl", "transient")
+LOCK_TOLERANCE_RAD = 0.05
+"""Largest distance (rad) of a ball from an unbalanced equilibrium for a "locked" state."""
+
+
+def default_initial_ball_angles(n: int) -> np.ndarray:
+    """Default start: balls resting near the heavy spot, spread over 0.3-0.5 rad (rad).
+
+    With the rotor at rest this is never an equilibrium (the balls add to the unbalance).
+    """
+    if n == 1:
+        return np.array([0.3])
+    return 0.3 + 0.2 * np.arange(n) / (n - 1)
+
+
+def choose_method(params: ADBParameters | ParameterBatch, max_speed_rad_s: float) -> str:
+    """``"LSODA"`` if the ball drag is stiff, else ``"DOP853"``.
+
+    Parameters
+    ----------
+    params : ADBParameters or ParameterBatch
+        Parameters (for a batch the stiffest member decides).
+    max_speed_rad_s : float
+        Largest shaft speed of the run (rad/s).
+    """
+    batch = params if isinstance(params, ParameterBatch) else ParameterBatch.from_parameters(params)
+    drag_rate = batch.D / (batch.m * batch.R**2)
+    dynamic = np.maximum(batch.natural_frequency_rad_s, abs(max_speed_rad_s))
+    return "LSODA" if np.max(drag_rate / dynamic) > STIFFNESS_RATIO else "DOP853"
+
+
+@dataclass(frozen=True, slots=True)
+class IntegrationResult:
+    """Sampled states of a (possibly stacked) integration.
+
+    Attributes
+    ----------
+    time_s : ndarray, shape (T,)
+        Sample times (s).
+    states : ndarray, shape (B, T, N)
+        States in the integration frame.
+    frame : str
+        ``"rotating"`` or ``"fixed"``.
+    method : str
+        ``solve_ivp`` method used.
+    n_function_evaluations, n_jacobian_evaluations : int
+        Counters from ``solve_ivp`` (one evaluation covers the whole batch).
+    rtol : float
+        Relative tolerance passed to ``solve_ivp`` (after the batch scaling).
+    """
+
+    time_s: np.ndarray
+    states: np.ndarray
+    frame: str
+    method: str
+    n_function_evaluations: int
+    n_jacobian_evaluations: int
+    rtol: float
+
+
+def _absolute_tolerances(batch: ParameterBatch, rtol: float, speed_scale: float, fixed: bool) -> np.ndarray:
+    n = batch.n
+    rate = np.maximum(batch.natural_frequency_rad_s, abs(speed_scale))[:, None]
+    position = 1e-3 * rtol * batch.R[:, None]
+    angle = np.full((batch.size, 1), 1e-3 * rtol)
+    parts = [position, position, np.repeat(angle, n, 1), position * rate, position * rate, np.repeat(angle * rate, n, 1)]
+    if fixed:
+        parts.append(np.full((batch.size, 1), rtol))
+    return np.concatenate(parts, axis=1).reshape(-1)
+
+
+def _banded(jac: np.ndarray) -> np.ndarray:
+    """Pack a block-diagonal Jacobian (B blocks of N x N) in LSODA's banded format."""
+    batch, size, _ = jac.shape
+    band = np.zeros((2 * size - 1, batch * size))
+    for i in range(size):
+        for j in range(size):
+            band[i - j + size - 1, j::size] = jac[:, i, j]
+    return band
+
+
+def integrate(
+    params: ADBParameters | Sequence[ADBParameters],
+    speed: Any,
+    initial_states,
+    t_eval_s,
+    *,
+    frame: str = "rotating",
+    method: str = "auto",
+    rtol: float = 1e-9,
+    atol=None,
+) -> IntegrationResult:
+    """Integrate one or a stacked batch of systems from given states.
+
+    Parameters
+    ----------
+    params : ADBParameters or sequence of ADBParameters
+        One parameter set or a batch (common ``n``).
+    speed : float, callable or SpeedProfile
+        Shaft speed (rad/s); the rotating frame needs a constant speed.
+    initial_states : ndarray, shape (N,) or (B, N)
+        States at ``t_eval_s[0]`` in the chosen frame (see :mod:`.equations`).
+    t_eval_s : array_like, shape (T,)
+        Increasing sample times (s); the run spans ``[t_eval_s[0], t_eval_s[-1]]``.
+    frame : {"rotating", "fixed"}
+        Formulation.
+    method : str
+        ``"auto"`` (by stiffness) or any ``solve_ivp`` method.
+    rtol : float
+        Relative tolerance per member (divided by ``sqrt(B)`` for the stacked system).
+    atol : float or ndarray, optional
+        Absolute tolerance per component; default scaled from ``rtol`` (positions
+        ``1e-3 rtol R``, angles ``1e-3 rtol`` rad, rates times ``max(omega_n, |omega|)``).
+
+    Returns
+    -------
+    IntegrationResult
+    """
+    members = [params] if isinstance(params, ADBParameters) else list(params)
+    batch = ParameterBatch.from_parameters(members)
+    profile = as_speed_profile(speed)
+    times = np.asarray(t_eval_s, dtype=float).reshape(-1)
+    if times.size < 2 or not np.all(np.isfinite(times)) or np.any(np.diff(times) <= 0):
+        raise ParameterError(f"t_eval_s: expected at least 2 finite, increasing times; got {times.size} values")
+    speeds = check_profile(profile, float(times[-1]))
+    if frame not in ("rotating", "fixed"):
+        raise ParameterError(f"frame = {frame!r}: expected 'rotating' or 'fixed'")
+    if frame == "rotating" and not isinstance(profile, ConstantSpeed):
+        raise ParameterError("frame = 'rotating' needs a constant speed; use frame='fixed' for a speed profile")
+    if not (math.isfinite(rtol) and 0.0 < rtol < 1.0):
+        raise ParameterError(f"rtol = {rtol!r}: expected 0 < rtol < 1")
+    y0 = np.atleast_2d(np.asarray(initial_states, dtype=float))
+    size = y0.shape[-1]
+    expected = 4 + 2 * batch.n + (frame == "fixed")
+    if size != expected or y0.shape[0] not in (1, batch.size):
+        raise ParameterError(f"initial_states has shape {y0.shape}: expected ({batch.size}, {expected})")
+    if not np.all(np.isfinite(y0)):
+        raise ParameterError("initial_states: expected finite values")
+    y0 = np.broadcast_to(y0, (batch.size, size))
+    max_speed = float(np.max(np.abs(speeds)))
+    chosen = choose_method(batch, max_speed) if method == "auto" else method
+    scale = math.sqrt(batch.size)
+    rtol_eff = rtol / scale
+    atol_eff = (_absolute_tolerances(batch, rtol, max_speed, frame == "fixed") if atol is None
+                else np.broadcast_to(np.asarray(atol, dtype=float), (batch.size * size,))) / scale
+    rhs = rotating_frame_rhs if frame == "rotating" else fixed_frame_rhs
+    jacobian = rotating_frame_jacobian if frame == "rotating" else fixed_frame_jacobian
+    constant = isinstance(profile, ConstantSpeed)
+
+    def speed_at(t: float) -> tuple[float, float]:
+        if constant:
+            return profile.speed, 0.0
+        return float(profile.speed_rad_s(t)), float(profile.acceleration_rad_s2(t))
+
+    if batch.size == 1:
+        single = scalar_rhs(*(float(getattr(batch, name)[0]) for name in ("M", "m")), batch.n,
+                            *(float(getattr(batch, name)[0]) for name in ("R", "e", "k", "c", "D")), frame=frame)
+
+        def fun(t, y):
+            omega, alpha = speed_at(t)
+            if not (math.isfinite(omega) and math.isfinite(alpha)):
+                raise ParameterError(f"speed profile is not finite at t = {t!r} s: expected finite values")
+            return single(y, omega, alpha)
+    else:
+        def fun(t, y):
+            omega, alpha = speed_at(t)
+            if not (math.isfinite(omega) and math.isfinite(alpha)):
+                raise ParameterError(f"speed profile is not finite at t = {t!r} s: expected finite values")
+            return rhs(y.reshape(batch.size, size), batch, omega, alpha).reshape(-1)
+
+    options: dict[str, Any] = {}
+    if chosen in ("LSODA", "Radau", "BDF"):
+        def jac(t, y):
+            omega, alpha = speed_at(t)
+            blocks = jacobian(y.reshape(batch.size, size), batch, omega, alpha)
+            if chosen == "LSODA" and batch.size > 1:
+                return _banded(blocks)
+            if batch.size == 1:
+                return blocks[0]
+            from scipy.sparse import block_diag
+
+            return block_diag(list(blocks), format="csc")
+
+        options["jac"] = jac
+        if chosen == "LSODA" and batch.size > 1:
+            options["lband"] = options["uband"] = size - 1
+    solution = solve_ivp(fun, (times[0], times[-1]), y0.reshape(-1), method=chosen, t_eval=times,
+                         rtol=rtol_eff, atol=atol_eff, **options)
+    if solution.status != 0:
+        raise ParameterError(f"integration failed ({chosen}): {solution.message}")
+    states = solution.y.reshape(batch.size, size, -1).transpose(0, 2, 1)
+    return IntegrationResult(
+        time_s=solution.t, states=states, frame=frame, method=chosen,
+        n_function_evaluations=int(solution.nfev), n_jacobian_evaluations=int(solution.njev), rtol=rtol_eff,
+    )
+
+
+# --------------------------------------------------------------------------- analysis
+
+
+def _wrap(angle):
+    return np.angle(np.exp(1j * angle))
+
+
+def _outside_tolerance(params: ADBParameters, angles: np.ndarray, tolerance: float) -> np.ndarray:
+    """Per sample: whether the balls are outside the settling tolerance. angles: (T, n)."""
+    if params.n == 2 and params.can_balance:
+        target = balanced_ball_angles(params)
+        limit = tolerance * abs(target[0])
+        straight = np.max(np.abs(_wrap(angles - target)), axis=-1)
+        swapped = np.max(np.abs(_wrap(angles - target[::-1])), axis=-1)
+        return np.minimum(straight, swapped) > limit
+    a = params.unbalance_ratio
+    residual = np.abs(a + np.sum(np.exp(1j * angles), axis=-1))
+    return residual > tolerance * (a if a > 0 else 1.0)
+
+
+def settling_time(params: ADBParameters, time_s, ball_angles_rad, tolerance: float = 0.01) -> float:
+    """Time after which the balls stay within ``tolerance`` of a balanced configuration (s).
+
+    Parameters
+    ----------
+    params : ADBParameters
+        Parameters.
+    time_s : ndarray, shape (T,)
+        Sample times (s).
+    ball_angles_rad : ndarray, shape (T, n)
+        Ball angles relative to the unbalance (rad).
+    tolerance : float
+        Relative tolerance (see the module notes).
+
+    Returns
+    -------
+    float
+        The last exit time, interpolated linearly between samples; 0 if never outside;
+        ``inf`` if still outside at the last sample or if balancing is impossible.
+    """
+    if not params.can_balance:
+        return math.inf
+    outside = _outside_tolerance(params, np.asarray(ball_angles_rad), tolerance)
+    if outside[-1]:
+        return math.inf
+    if not np.any(outside):
+        return 0.0
+    last = int(np.nonzero(outside)[0][-1])
+    return float(0.5 * (time_s[last] + time_s[last + 1]))
+
+
+def classify_final_state(params: ADBParameters, time_s, ball_angles_rad, ball_rates_rad_s,
+                         *, window_start_s: float, final_speed_rad_s: float, tolerance: float = 0.01
+                         ) -> tuple[str, np.ndarray]:
+    """Classify the end of a run and return the balls' mean slip rates over the window.
+
+    Classes: ``"balanced"`` (within ``tolerance`` of a balanced configuration throughout
+    the window); ``"whirl"`` (non-synchronous: some ball slips by more than 0.5 rad over
+    the window at a steady rate: its mean rates over the two halves of the window of one
+    sign and within a factor 2); ``"locked"`` (throughout the window every
+    ball is within ``LOCK_TOLERANCE_RAD`` of an unbalanced equilibrium at the final speed,
+    balls together on the deflection line, and ``|phi'| < 0.05 omega_n``); else
+    ``"transient"`` (still settling: lengthen the run).
+
+    Parameters
+    ----------
+    params : ADBParameters
+        Parameters.
+    time_s : ndarray, shape (T,)
+        Sample times (s).
+    ball_angles_rad, ball_rates_rad_s : ndarray, shape (T, n)
+        Relative ball angles (rad) and rates (rad/s).
+    window_start_s : float
+        Start of the final window (s).
+    final_speed_rad_s : float
+        Shaft speed at the end of the run (rad/s), for the unbalanced equilibria.
+    tolerance : float
+        Settling tolerance.
+
+    Returns
+    -------
+    (str, ndarray)
+        Class name and mean relative rate of each ball over the window (rad/s).
+    """
+    window = time_s >= window_start_s
+    if np.count_nonzero(window) < 2:
+        window = np.zeros_like(window)
+        window[-2:] = True
+    angles, rates, t = ball_angles_rad[window], ball_rates_rad_s[window], time_s[window]
+    drift = angles[-1] - angles[0]
+    slip = drift / (t[-1] - t[0])
+    if params.can_balance and not np.any(_outside_tolerance(params, angles, tolerance)):
+        return "balanced", slip
+    middle = len(t) // 2
+    first = (angles[middle] - angles[0]) / (t[middle] - t[0])
+    second = (angles[-1] - angles[middle]) / (t[-1] - t[middle])
+    steady = (first * second > 0) & (np.abs(second) >= 0.5 * np.abs(first)) & (np.abs(second) <= 2 * np.abs(first))
+    if np.any((np.abs(drift) > 0.5) & steady):
+        return "whirl", slip
+    if final_speed_rad_s and np.max(np.abs(rates)) < 0.05 * params.natural_frequency_rad_s:
+        for state, p in unbalanced_states(params, abs(final_speed_rad_s)):
+            gamma = state[2]
+            near_gamma = np.abs(_wrap(angles - gamma)) < LOCK_TOLERANCE_RAD
+            near_opposite = np.abs(_wrap(angles - gamma - math.pi)) < LOCK_TOLERANCE_RAD
+            if np.all(near_gamma | near_opposite) and np.all(np.sum(near_gamma, axis=-1) == p):
+                return "locked", slip
+    return "transient", slip
+
+
+@dataclass(frozen=True, slots=True)
+class SimulationResult:
+    """One simulated run of the rotor with balls (and without, for comparison).
+
+    Attributes
+    ----------
+    time_s : ndarray, shape (T,)
+        Sample times (s).
+    speed_rad_s, rotor_angle_rad : ndarray, shape (T,)
+        Shaft speed (rad/s) and rotor angle (rad).
+    rotor_x_m, rotor_y_m : ndarray, shape (T,)
+        Rotor centre in the fixed frame (m).
+    rotor_u_m, rotor_v_m : ndarray, shape (T,)
+        Rotor centre in the frame turning with the shaft (m); ``u`` along the unbalance.
+    amplitude_m : ndarray, shape (T,)
+        Vibration amplitude ``sqrt(x^2 + y^2)`` (m).
+    ball_angles_rad, ball_rates_rad_s : ndarray, shape (T, n)
+        Ball angles relative to the unbalance direction (rad) and their rates (rad/s).
+    balanced_ball_angles_rad : ndarray, shape (n,) or (0,)
+        The balanced configuration (symmetric member for n >= 3); empty if impossible.
+    settled : bool
+        Whether the balls ended within the settling tolerance.
+    settling_time_s : float
+        Last time outside the tolerance (s); inf if not settled.
+    residual_amplitude_m : float
+        Largest amplitude over the final window (m).
+    final_state : str
+        ``"balanced"``, ``"locked"``, ``"whirl"`` or ``"transient"``.
+    final_slip_rate_rad_s : ndarray, shape (n,)
+        Mean ball rate relative to the race over the final window (rad/s).
+    amplitude_without_balls_m : ndarray, shape (T,) or (0,)
+        Amplitude of the same rotor with the balls removed (m).
+    rotor_x_without_balls_m, rotor_y_without_balls_m : ndarray, shape (T,) or (0,)
+        Its orbit (m).
+    residual_amplitude_without_balls_m : float
+        Its largest amplitude over the final window (m); nan only if not computed.
+    window_start_s : float
+        Start of the final window (s).
+    settle_tolerance : float
+        Relative settling tolerance used.
+    frame, method : str
+        Formulation and integrator.
+    rtol : float
+        Relative tolerance.
+    n_function_evaluations, n_jacobian_evaluations : int
+        Integrator counters.
+    """
+
+    time_s: np.ndarray
+    speed_rad_s: np.ndarray
+    rotor_angle_rad: np.ndarray
+    rotor_x_m: np.ndarray
+    rotor_y_m: np.ndarray
+    rotor_u_m: np.ndarray
+    rotor_v_m: np.ndarray
+    amplitude_m: np.ndarray
+    ball_angles_rad: np.ndarray
+    ball_rates_rad_s: np.ndarray
+    balanced_ball_angles_rad: np.ndarray
+    settled: bool
+    settling_time_s: float
+    residual_amplitude_m: float
+    final_state: str
+    final_slip_rate_rad_s: np.ndarray
+    amplitude_without_balls_m: np.ndarray
+    rotor_x_without_balls_m: np.ndarray
+    rotor_y_without_balls_m: np.ndarray
+    residual_amplitude_without_balls_m: float
+    window_start_s: float
+    settle_tolerance: float
+    frame: str
+    method: str
+    rtol: float
+    n_function_evaluations: int
+    n_jacobian_evaluations: int
+
+
+def _check_time(t_end_s: float) -> float:
+    try:
+        value = float(t_end_s)
+    except (TypeError, ValueError) as exc:
+        raise ParameterError(f"t_end_s = {t_end_s!r}: expected a finite time > 0 s") from exc
+    if not (math.isfinite(value) and value > 0.0):
+        raise ParameterError(f"t_end_s = {value!r}: expected a finite time > 0 s")
+    return value
+
+
+def _initial_ball_angles(params: ADBParameters, angles) -> np.ndarray:
+    if angles is None:
+        return default_initial_ball_angles(params.n)
+    array = np.asarray(angles, dtype=float).reshape(-1)
+    if array.shape[0] != params.n or not np.all(np.isfinite(array)):
+        raise ParameterError(
+            f"initial_ball_angles_rad = {angles!r}: expected {params.n} finite angles (rad, relative to the unbalance)"
+        )
+    return array
+
+
+def _initial_state(n: int, angles, position, velocity, rates, frame: str, speed0: float) -> np.ndarray:
+    fixed = np.zeros(5 + 2 * n)
+    fixed[0:2] = position
+    fixed[2:2 + n] = angles
+    fixed[2 + n:4 + n] = velocity
+    fixed[4 + n:4 + 2 * n] = rates
+    if frame == "fixed":
+        return fixed
+    return fixed_to_rotating(fixed, speed0, n)
+
+
+def _pair(value, name: str) -> np.ndarray:
+    array = np.asarray(value, dtype=float).reshape(-1)
+    if array.shape != (2,) or not np.all(np.isfinite(array)):
+        raise ParameterError(f"{name} = {value!r}: expected two finite numbers (x, y)")
+    return array
+
+
+def _sample_times(t_end: float, n_samples: int | None, max_speed: float) -> np.ndarray:
+    if n_samples is None:
+        per_revolution = 40.0 * max_speed / (2 * math.pi) * t_end
+        n_samples = int(min(max(2001, per_revolution), 200_001))
+    if int(n_samples) < 3:
+        raise ParameterError(f"n_samples = {n_samples!r}: expected >= 3")
+    return np.linspace(0.0, t_end, int(n_samples))
+
+
+def _fixed_outputs(result: IntegrationResult, profile: SpeedProfile, n: int, member: int = 0):
+    """Fixed-frame (x, y), rotating (u, v), angles, rates, rotor angle and speed of one member."""
+    t = result.time_s
+    states = result.states[member]
+    if result.frame == "rotating":
+        omega = profile.speed
+        theta = omega * t
+        speed = np.full_like(t, omega)
+        fixed = rotating_to_fixed(states, theta, omega, n)
+        rot = states
+    else:
+        speed = np.asarray(profile.speed_rad_s(t), dtype=float)
+        theta = states[:, 4 + 2 * n]
+        fixed = states
+        rot = fixed_to_rotating(states, speed, n)
+    return fixed[:, 0], fixed[:, 1], rot[:, 0], rot[:, 1], states[:, 2:2 + n], states[:, 4 + n:4 + 2 * n], theta, speed
+
+
+def simulate(
+    params: ADBParameters,
+    speed: Any,
+    t_end_s: float,
+    initial_ball_angles_rad=None,
+    *,
+    initial_rotor_position_m=(0.0, 0.0),
+    initial_rotor_velocity_m_s=(0.0, 0.0),
+    initial_ball_rates_rad_s=None,
+    frame: str = "auto",
+    method: str = "auto",
+    rtol: float = 1e-9,
+    n_samples: int | None = None,
+    settle_tolerance: float = 0.01,
+    final_window_fraction: float = 0.1,
+    compare_without_balls: bool = True,
+) -> SimulationResult:
+    """Simulate the rotor with balls at constant speed or along a speed profile.
+
+    Parameters
+    ----------
+    params : ADBParameters
+        Parameters.
+    speed : float, callable or SpeedProfile
+        Constant shaft speed (rad/s), a function of time returning rad/s, or a profile
+        such as :class:`~balancer.adb.speed.LinearRunUp`.
+    t_end_s : float
+        Duration (s).
+    initial_ball_angles_rad : array_like of length n, optional
+        Ball angles relative to the unbalance at t = 0 (rad).  Default: balls resting
+        near the heavy spot, spread over 0.3-0.5 rad (never an equilibrium).
+    initial_rotor_position_m, initial_rotor_velocity_m_s : (float, float)
+        Rotor centre position (m) and velocity (m/s) in the fixed frame at t = 0.
+    initial_ball_rates_rad_s : array_like of length n, optional
+        Ball rates relative to the race at t = 0 (rad/s); default 0 (moving with the race).
+    frame : {"auto", "rotating", "fixed"}
+        Formulation; "auto" is rotating for a constant speed, fixed for a profile.
+    method : str
+        "auto" (DOP853, or LSODA with the exact Jacobian for stiff drag) or any
+        ``solve_ivp`` method.
+    rtol : float
+        Relative tolerance.
+    n_samples : int, optional
+        Number of output samples; default at least 2001 and 40 per revolution.
+    settle_tolerance : float
+        Relative tolerance for settling (see the module notes).
+    final_window_fraction : float
+        Fraction of the run, at its end, used for the residual amplitude and the
+        final-state classification.
+    compare_without_balls : bool
+        Also simulate the same rotor with the balls removed.
+
+    Returns
+    -------
+    SimulationResult
+    """
+    if not isinstance(params, ADBParameters):
+        raise ParameterError(f"params: got {type(params).__name__}; expected ADBParameters")
+    t_end = _check_time(t_end_s)
+    if not 0.0 < final_window_fraction <= 1.0:
+        raise ParameterError(f"final_window_fraction = {final_window_fraction!r}: expected 0 < fraction <= 1")
+    if not 0.0 < settle_tolerance < 1.0:
+        raise ParameterError(f"settle_tolerance = {settle_tolerance!r}: expected 0 < tolerance < 1")
+    profile = as_speed_profile(speed)
+    speeds = check_profile(profile, t_end)
+    max_speed = float(np.max(np.abs(speeds)))
+    if frame == "auto":
+        frame = "rotating" if isinstance(profile, ConstantSpeed) else "fixed"
+    n = params.n
+    angles = _initial_ball_angles(params, initial_ball_angles_rad)
+    rates = np.zeros(n) if initial_ball_rates_rad_s is None else np.asarray(initial_ball_rates_rad_s, dtype=float).reshape(-1)
+    if rates.shape != (n,) or not np.all(np.isfinite(rates)):
+        raise ParameterError(f"initial_ball_rates_rad_s = {initial_ball_rates_rad_s!r}: expected {n} finite rates (rad/s)")
+    position = _pair(initial_rotor_position_m, "initial_rotor_position_m")
+    velocity = _pair(initial_rotor_velocity_m_s, "initial_rotor_velocity_m_s")
+    speed0 = float(speeds[0])
+    times = _sample_times(t_end, n_samples, max_speed)
+    y0 = _initial_state(n, angles, position, velocity, rates, frame, speed0)
+    run = integrate(params, profile, y0, times, frame=frame, method=method, rtol=rtol)
+    x, y, u, v, phi, dphi, theta, omega = _fixed_outputs(run, profile, n)
+    amplitude = np.hypot(x, y)
+    window_start = t_end * (1.0 - final_window_fraction)
+    window = run.time_s >= window_start
+    settle = settling_time(params, run.time_s, phi, settle_tolerance)
+    final_state, slip = classify_final_state(params, run.time_s, phi, dphi, window_start_s=window_start,
+                                             final_speed_rad_s=float(omega[-1]), tolerance=settle_tolerance)
+    target = balanced_ball_angles(params) if params.can_balance and (n >= 2 or math.isclose(params.unbalance_ratio, 1.0)) else np.zeros(0)
+    empty = np.zeros(0)
+    x0 = y0n = a0 = empty
+    residual0 = math.nan
+    if compare_without_balls:
+        x0, y0n, a0, residual0 = _without_balls(params, profile, frame, position, velocity, speed0, times, rtol, window)
+    return SimulationResult(
+        time_s=run.time_s, speed_rad_s=omega, rotor_angle_rad=theta,
+        rotor_x_m=x, rotor_y_m=y, rotor_u_m=u, rotor_v_m=v, amplitude_m=amplitude,
+        ball_angles_rad=phi, ball_rates_rad_s=dphi, balanced_ball_angles_rad=target,
+        settled=bool(math.isfinite(settle)), settling_time_s=settle,
+        residual_amplitude_m=float(np.max(amplitude[window])),
+        final_state=final_state, final_slip_rate_rad_s=slip,
+        amplitude_without_balls_m=a0, rotor_x_without_balls_m=x0, rotor_y_without_balls_m=y0n,
+        residual_amplitude_without_balls_m=residual0,
+        window_start_s=window_start, settle_tolerance=float(settle_tolerance),
+        frame=frame, method=run.method, rtol=float(rtol),
+        n_function_evaluations=run.n_function_evaluations, n_jacobian_evaluations=run.n_jacobian_evaluations,
+    )
+
+
+def _without_balls(params, profile, frame, position, velocity, speed0, times, rtol, window):
+    """The same rotor (mass M) with the balls removed: the n = 0 case of the equations."""
+    bare = scalar_rhs(params.M, params.m, 0, params.R, params.e, params.k, params.c, 0.0, frame=frame)
+    wn = math.sqrt(params.k / params.M)
+    max_speed = float(np.max(np.abs(profile.speed_rad_s(times)))) if frame == "fixed" else abs(profile.speed)
+    rate = max(wn, max_speed)
+    position_tol = 1e-3 * rtol * params.R
+    if frame == "rotating":
+        y0 = _initial_state(0, np.zeros(0), position, velocity, np.zeros(0), "rotating", speed0)
+        atol = np.array([position_tol, position_tol, position_tol * rate, position_tol * rate])
+
+        def fun(t, y):
+            return bare(y, profile.speed, 0.0)
+    else:
+        y0 = _initial_state(0, np.zeros(0), position, velocity, np.zeros(0), "fixed", speed0)
+        atol = np.array([position_tol, position_tol, position_tol * rate, position_tol * rate, rtol])
+
+        def fun(t, y):
+            return bare(y, float(profile.speed_rad_s(t)), float(profile.acceleration_rad_s2(t)))
+    solution = solve_ivp(fun, (times[0], times[-1]), y0, method="DOP853", t_eval=times, rtol=rtol, atol=atol)
+    if solution.status != 0:
+        raise ParameterError(f"integration without balls failed: {solution.message}")
+    states = solution.y.T
+    if frame == "rotating":
+        theta = profile.speed * times
+        c, s = np.cos(theta), np.sin(theta)
+        x = states[:, 0] * c - states[:, 1] * s
+        y = states[:, 0] * s + states[:, 1] * c
+    else:
+        x, y = states[:, 0], states[:, 1]
+    amplitude = np.hypot(x, y)
+    return x, y, amplitude, float(np.max(amplitude[window]))
+
+
+@dataclass(frozen=True, slots=True)
+class BatchSimulationResult:
+    """A batch of runs integrated as one stacked system.
+
+    Attributes
+    ----------
+    time_s : ndarray, shape (T,)
+        Sample times (s).
+    rotor_x_m, rotor_y_m : ndarray, shape (B, T)
+        Rotor centres in the fixed frame (m).
+    ball_angles_rad : ndarray, shape (B, T, n)
+        Ball angles relative to the unbalance (rad).
+    settling_time_s : ndarray, shape (B,)
+        Settling times (s); inf where not settled.
+    residual_amplitude_m : ndarray, shape (B,)
+        Largest amplitude over the final window (m).
+    final_state : tuple of str
+        Final-state class of each member.
+    method : str
+        Integrator.
+    rtol : float
+        Per-member relative tolerance requested.
+    n_function_evaluations : int
+        Evaluations of the stacked right-hand side.
+    """
+
+    time_s: np.ndarray
+    rotor_x_m: np.ndarray
+    rotor_y_m: np.ndarray
+    ball_angles_rad: np.ndarray
+    settling_time_s: np.ndarray
+    residual_amplitude_m: np.ndarray
+    final_state: tuple[str, ...]
+    method: str
+    rtol: float
+    n_function_evaluations: int
+
+
+def simulate_batch(
+    params: Sequence[ADBParameters],
+    speed: Any,
+    t_end_s: float,
+    initial_ball_angles_rad=None,
+    *,
+    method: str = "auto",
+    rtol: float = 1e-9,
+    n_samples: int = 201,
+    settle_tolerance: float = 0.01,
+    final_window_fraction: float = 0.1,
+) -> BatchSimulationResult:
+    """Simulate many parameter sets (common ``n``) as one stacked system, rotor starting at rest.
+
+    Parameters
+    ----------
+    params : sequence of ADBParameters
+        The batch (common ball count).
+    speed : float, callable or SpeedProfile
+        Shaft speed (rad/s) or profile, common to the batch.
+    t_end_s : float
+        Duration (s).
+    initial_ball_angles_rad : array_like, shape (n,) or (B, n), optional
+        Initial ball angles relative to the unbalance (rad); default as :func:`simulate`.
+    method : str
+        "auto" or a ``solve_ivp`` method.
+    rtol : float
+        Relative tolerance per member (the stacked system uses ``rtol / sqrt(B)``).
+    n_samples : int
+        Output samples.
+    settle_tolerance, final_window_fraction : float
+        As in :func:`simulate`.
+
+    Returns
+    -------
+    BatchSimulationResult
+    """
+    members = list(params)
+    batch = ParameterBatch.from_parameters(members)
+    n = batch.n
+    t_end = _check_time(t_end_s)
+    profile = as_speed_profile(speed)
+    speeds = check_profile(profile, t_end)
+    frame = "rotating" if isinstance(profile, ConstantSpeed) else "fixed"
+    if initial_ball_angles_rad is None:
+        angles = np.broadcast_to(default_initial_ball_angles(n), (batch.size, n))
+    else:
+        angles = np.broadcast_to(np.asarray(initial_ball_angles_rad, dtype=float), (batch.size, n))
+        if not np.all(np.isfinite(angles)):
+            raise ParameterError("initial_ball_angles_rad: expected finite angles (rad)")
+    y0 = np.array([_initial_state(n, a, (0.0, 0.0), (0.0, 0.0), np.zeros(n), frame, float(speeds[0])) for a in angles])
+    times = _sample_times(t_end, n_samples, float(np.max(np.abs(speeds))))
+    run = integrate(members, profile, y0, times, frame=frame, method=method, rtol=rtol)
+    window_start = t_end * (1.0 - final_window_fraction)
+    window = run.time_s >= window_start
+    xs, ys, phis, settles, residuals, finals = [], [], [], [], [], []
+    for index, member in enumerate(members):
+        x, y, _, _, phi, dphi, _, omega = _fixed_outputs(run, profile, n, index)
+        xs.append(x)
+        ys.append(y)
+        phis.append(phi)
+        settles.append(settling_time(member, run.time_s, phi, settle_tolerance))
+        residuals.append(float(np.max(np.hypot(x, y)[window])))
+        finals.append(classify_final_state(member, run.time_s, phi, dphi, window_start_s=window_start,
+                                           final_speed_rad_s=float(omega[-1]), tolerance=settle_tolerance)[0])
+    return BatchSimulationResult(
+        time_s=run.time_s, rotor_x_m=np.array(xs), rotor_y_m=np.array(ys), ball_angles_rad=np.array(phis),
+        settling_time_s=np.array(settles), residual_amplitude_m=np.array(residuals), final_state=tuple(finals),
+        method=run.method, rtol=float(rtol), n_function_evaluations=run.n_function_evaluations,
+    )
