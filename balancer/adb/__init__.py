@@ -5,6 +5,7 @@ SI units and radians throughout; nondimensional groups use ``omega_n = sqrt(k / 
 """
 from __future__ import annotations
 
+from .drag import AIR, LIGHT_OIL, WATER, BallDrag, Fluid, ball_drag, drag_coefficient, flow_regime
 from .equilibria import (
     Equilibrium,
     balanced_ball_angles,
@@ -82,4 +83,12 @@ __all__ = [
     "ConstantSpeed",
     "LinearRunUp",
     "SpeedProfile",
+    "AIR",
+    "LIGHT_OIL",
+    "WATER",
+    "BallDrag",
+    "Fluid",
+    "ball_drag",
+    "drag_coefficient",
+    "flow_regime",
 ]
