@@ -1,6 +1,8 @@
 """Automatic ball balancer (ADB) on a planar Jeffcott rotor (Chung & Ro model).
 
 Entry points: :class:`ADBParameters`, :func:`stable_speed_intervals`, :func:`simulate`.
+Plots live in :mod:`balancer.adb.plots` (imported on demand, so matplotlib is not loaded
+by the numerical modules).
 SI units and radians throughout; nondimensional groups use ``omega_n = sqrt(k / (M + n m))``.
 """
 from __future__ import annotations
@@ -28,6 +30,7 @@ from .simulate import (
     simulate_batch,
 )
 from .speed import CallableSpeed, ConstantSpeed, LinearRunUp, SpeedProfile
+from .studies import SettlingStudy, settling_study
 from .stability import (
     BalancedStability,
     RouthHurwitzResult,
@@ -91,4 +94,6 @@ __all__ = [
     "ball_drag",
     "drag_coefficient",
     "flow_regime",
+    "SettlingStudy",
+    "settling_study",
 ]
