@@ -29,7 +29,9 @@ from __future__ import annotations
 
 import os
 import re
+import tempfile
 import warnings
+from pathlib import Path
 from datetime import datetime, timezone
 from typing import Any
 
@@ -177,8 +179,11 @@ def read_frf_uff(path: str | os.PathLike, **hints: Any) -> FRF:
         last = data.count(b"\n", 0, tags[-1]) + 1
         raise FormatError(f"{src}: line {last}: dataset {len(tags) // 2 + 1} has no closing '    -1' line; "
                           "expected every dataset to end with one (truncated file?)")
-    blocks = [_Block(k + 1, data.count(b"\n", 0, tags[2 * k]) + 1, data[tags[2 * k]:tags[2 * k + 1]])
-              for k in range(len(tags) // 2)]
+    blocks, line, pos = [], 1, 0
+    for k in range(len(tags) // 2):  # line numbers counted incrementally (large files)
+        line += data.count(b"\n", pos, tags[2 * k])
+        pos = tags[2 * k]
+        blocks.append(_Block(k + 1, line, data[tags[2 * k]:tags[2 * k + 1]]))
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
@@ -457,13 +462,19 @@ def write_frf_uff(frf: FRF, path: str | os.PathLike, binary: bool = False) -> No
             "z_axis_spec_data_type": 0,
             "x": freq.copy(), "data": np.asarray(frf.channels[ch], dtype=complex).copy(),
         })
-    with atomic_path(path) as tmp:
+    with atomic_path(path) as tmp, tempfile.TemporaryDirectory(prefix="modalbal-uff-") as scratch_dir:
+        scratch = Path(scratch_dir) / "set.uff"
+        # pyuff rescans the whole file after every dataset it writes (quadratic in the number of
+        # channels), so each dataset is written alone to a scratch file and appended here.
+        # Mode "add" on an empty file: pyuff's "overwrite" truncates the file again when it
+        # switches to binary for 58b data, losing the header it has just written.
         try:
-            with warnings.catch_warnings():
+            with open(tmp, "wb") as out, warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                # mode "add" on the empty temporary file: pyuff's "overwrite" truncates the file
-                # again when it switches to binary for 58b data, losing the header it just wrote
-                pyuff.UFF(os.fspath(tmp)).write_sets(dsets, mode="add", force_double=True)
+                for dset in dsets:
+                    scratch.write_bytes(b"")
+                    pyuff.UFF(os.fspath(scratch)).write_sets(dset, mode="add", force_double=True)
+                    out.write(scratch.read_bytes())
         except Exception as exc:  # pyuff raises bare Exception
             raise FormatError(f"{src}: pyuff could not write dataset 58 ({exc})") from None
 
