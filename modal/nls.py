@@ -66,6 +66,27 @@ def _design(x, params, power, region, n_regions):
     return Phi, dphi
 
 
+def _compress(Y: np.ndarray, rank: int) -> np.ndarray:
+    """Many channels: replace Y (n_freq, n_ch) by Y V with V (n_ch, rank) orthonormal.
+
+    The cost ||P⊥ Y V||² and its gradient depend on the channels only through
+    the row space kept by V; a randomised range finder (one power iteration,
+    fixed seed) keeps the signal subspace, whose rank is at most the number of
+    basis columns, plus a margin. With exact data this is lossless; with noise
+    it drops only noise directions that carry no information on the poles.
+    Modal constants and noise levels are computed afterwards on the full data.
+    """
+    n_ch = Y.shape[1]
+    if n_ch <= 2 * rank:
+        return Y
+    rng = np.random.default_rng(12345)
+    omega = rng.standard_normal((n_ch, rank)) + 1j * rng.standard_normal((n_ch, rank))
+    U, _ = np.linalg.qr(Y @ omega)
+    U, _ = np.linalg.qr(Y @ (Y.conj().T @ U))  # one power iteration sharpens the subspace
+    V, _ = np.linalg.qr(Y.conj().T @ U)  # (n_ch, rank) orthonormal basis of the row space
+    return np.ascontiguousarray(Y @ V)
+
+
 def _project(Phi, Y):
     Q, R = np.linalg.qr(Phi)
     Q = np.ascontiguousarray(Q)
@@ -110,6 +131,10 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
     params[1::2] = np.asarray(damping_ratio0, float)
     n_modes = params.size // 2
     n_theta = params.size
+
+    Y_full = Y
+    n_b_guess = n_modes + n_regions
+    Y = _compress(Y, 2 * n_b_guess + 8)
 
     def evaluate(p):
         Phi, dphi = _design(x, p, power, region, n_regions)
@@ -157,6 +182,10 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
             break
 
     Phi, dphi, Q, R, QhY, res, cost = state
+    if Y is not Y_full:  # back to the channels: one projection of the full data
+        Y = Y_full
+        QhY = Q.conj().T @ Y
+        res = Y - Q @ QhY
     n_freq = x.size
     n_b = Phi.shape[1]
     C = np.linalg.solve(R, QhY)
