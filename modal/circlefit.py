@@ -197,8 +197,15 @@ def circle_fit_curve(omega: np.ndarray, mobility: np.ndarray, noise_std: float) 
     p0 = np.array([x_r, zeta0, theta_r])
     params, residual, jac, ok = _levenberg_marquardt(p0, xs, theta)
     x_n, zeta, psi = params
+    # a pole outside the fitted lines or a damping ratio above 1 is no estimate (too few
+    # points on the arc): keep the classical values, flagged
+    if ok and not (xs[0] <= x_n <= xs[-1] and zeta < 1.0):
+        ok = False
     if not ok:
         x_n, zeta, psi = p0
+        if not (xs[0] <= x_n <= xs[-1]):
+            x_n = xs[i - sel[0]] if sel[0] <= i <= sel[-1] else x_r
+        zeta = min(zeta, 1.0)
         flags.append("did_not_converge")
     std_x = std_z = np.nan
     dof = xs.size - 3
@@ -209,6 +216,11 @@ def circle_fit_curve(omega: np.ndarray, mobility: np.ndarray, noise_std: float) 
             std_x, std_z = np.sqrt(max(cov[0, 0], 0)), np.sqrt(max(cov[1, 1], 0))
         except np.linalg.LinAlgError:
             pass
+    if "resolution_limited" in flags or not ok:
+        # unresolved peak: the line spacing bounds what the data can say (quantisation)
+        spacing = float(np.min(np.diff(xs)))
+        std_x = float(np.hypot(std_x if np.isfinite(std_x) else 0.0, spacing / np.sqrt(12)))
+        std_z = float(np.hypot(std_z if np.isfinite(std_z) else 0.0, spacing / (2 * x_n)))
     omega_n = x_n * w_ref
     modal_constant = 2 * zeta * omega_n * 2 * rho * np.exp(1j * psi)
     residual = centre - rho * np.exp(1j * psi)

@@ -47,7 +47,7 @@ def invert_half_power(w1: float, w2: float, power: int) -> tuple[float, float]:
     return wn, zeta
 
 
-def _one_sided(u_peak: float, u_cross: float, power: int, upper: bool) -> tuple[float, float]:
+def _one_sided(u_peak: float, u_cross: float, power: int) -> tuple[float, float]:
     """(ωn, ζ) from the refined peak and one crossing (the other is missing)."""
     if power == 1:  # r = sqrt(1+ζ²) ± ζ about the peak ωn
         wn = np.sqrt(u_peak)
@@ -129,7 +129,7 @@ def half_power_curve(omega: np.ndarray, h: np.ndarray, power: int, noise_std: fl
     elif np.isfinite(w1) or np.isfinite(w2):
         flags.append("missing_crossing")
         wc = w1 if np.isfinite(w1) else w2
-        wn, zeta = _one_sided(u_peak, wc**2, power, upper=np.isfinite(w2))
+        wn, zeta = _one_sided(u_peak, wc**2, power)
     else:
         flags.append("missing_crossing")
         # no crossing at all: the band holds less than the half-power width
@@ -149,4 +149,9 @@ def half_power_curve(omega: np.ndarray, h: np.ndarray, power: int, noise_std: fl
         d2 = np.subtract(invert_half_power(w1, w2 + eps2, power), invert_half_power(w1, w2 - eps2, power)) / (2 * eps2)
         std_wn = float(np.sqrt(d1[0] ** 2 * var_w[0] + d2[0] ** 2 * var_w[1]))
         std_zeta = float(np.sqrt(d1[1] ** 2 * var_w[0] + d2[1] ** 2 * var_w[1]))
+    if "resolution_limited" in flags or "missing_crossing" in flags:
+        # the crossings are decided by the grid: add the quantisation of the line spacing
+        spacing = float(np.min(np.diff(omega)))
+        std_wn = float(np.hypot(std_wn if np.isfinite(std_wn) else 0.0, spacing / np.sqrt(12)))
+        std_zeta = float(np.hypot(std_zeta if np.isfinite(std_zeta) else 0.0, spacing / (2 * wn)))
     return HalfPowerEstimate(float(wn), float(zeta), std_wn, std_zeta, n_above, tuple(flags))

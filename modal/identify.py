@@ -115,6 +115,11 @@ def _sdof_estimates(frf, band, power, noise, method, channels=None):
         wn_c = float(omega[np.argmax(np.abs(h).max(axis=0))])
         z_c = float(np.min(np.diff(omega)) / (2 * wn_c)) if omega.size > 1 else np.nan
         flags.add("too_few_points")
+    if flags & _RESOLUTION_FLAGS and omega.size > 1:
+        # grid quantisation is the same on every channel: it does not average down
+        spacing = float(np.min(np.diff(omega)))
+        s_wn_c = max(s_wn_c, spacing / np.sqrt(12)) if np.isfinite(s_wn_c) else spacing / np.sqrt(12)
+        s_z_c = max(s_z_c, spacing / (2 * wn_c)) if np.isfinite(s_z_c) else spacing / (2 * wn_c)
     q = float(np.nanmedian(quality)) if len(quality) and np.isfinite(quality).any() else np.nan
     return wn_c, z_c, s_wn_c, s_z_c, const, flags, q
 

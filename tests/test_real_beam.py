@@ -1,0 +1,50 @@
+"""Fitting the measured free-free beam (../shared/data/real, from ladisk/pyuff, MIT)."""
+import warnings
+
+import numpy as np
+import pytest
+
+import modal
+from modal import ModalWarning
+
+#: an independent LSCF + LSFD fit (sdypy-EMA, 10–1000 Hz, order 50), see ../shared/data/real/README.md
+LSCF_HZ = [51.5, 142.2, 278.7, 460.4, 687.2]
+
+
+@pytest.fixture(scope="module")
+def beam():
+    from conftest import SHARED
+
+    paths = sorted((SHARED / "data" / "real").glob("pyuff_meas_point_*.txt"))
+    if len(paths) != 3:
+        pytest.skip("../shared/data/real is not beside the checkout")
+    # the files hold 1001 complex lines without a frequency axis: 0..1000 Hz, 1 Hz steps
+    channels = [modal.read_frf(p, frequency_step=1.0, kind="accelerance") for p in paths]
+    frf = modal.FRF(channels[0].frequency_hz, np.array([c.response for c in channels]), kind="accelerance",
+                    response_points=["1"] * 3, reference_points=["1", "2", "3"])
+    return frf.cropped(10.0, 1000.0)
+
+
+def test_nls_finds_the_five_modes(beam):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ModalWarning)  # real data: flags are expected, checked below
+        result = modal.identify(beam, "nls")
+    found = np.array([m.natural_frequency_hz for m in result])
+    for f_ref in LSCF_HZ:
+        nearest = found[np.argmin(np.abs(found - f_ref))]
+        # the LSCF values are printed to 0.1 Hz; the issue asks for 0.1 %
+        assert abs(nearest / f_ref - 1) < 1e-3, (f_ref, found)
+    for mode in result:
+        assert np.isfinite(mode.natural_frequency_hz) and np.isfinite(mode.damping_ratio)
+        assert mode.lines_per_bandwidth < 1  # ζ ≈ 0.02–0.06 % on 1 Hz lines
+
+
+@pytest.mark.parametrize("method", ["halfpower", "circle"])
+def test_sdof_methods_are_flagged_resolution_limited(beam, method):
+    with pytest.warns(modal.ResolutionWarning, match="resolution_limited"):
+        result = modal.identify(beam, method)
+    for mode in result:
+        if any(abs(mode.natural_frequency_hz / f - 1) < 0.01 for f in LSCF_HZ):
+            assert "resolution_limited" in mode.flags
+            # the reported uncertainty covers at least the line-spacing quantisation
+            assert mode.std.natural_frequency_hz >= 1.0 / np.sqrt(12) * 0.999
