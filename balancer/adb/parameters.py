@@ -375,7 +375,13 @@ class ParameterBatch:
     """A batch of parameter sets with a common ball count, as arrays of shape ``(B,)``.
 
     Used internally to evaluate the equations of motion for many sets at once.
-    Attributes have the same names and units as :class:`ADBParameters`.
+
+    Attributes
+    ----------
+    M, m, R, e, k, c, D : ndarray, shape (B,)
+        As in :class:`ADBParameters` (kg, kg, m, m, N/m, N s/m, N m s).
+    n : int
+        Common ball count.
     """
 
     M: np.ndarray

@@ -165,6 +165,15 @@ def as_speed_profile(speed: Any) -> SpeedProfile:
 def check_profile(profile: SpeedProfile, t_end_s: float, samples: int = 1001) -> np.ndarray:
     """Sample a profile on ``[0, t_end_s]`` and raise if any speed or acceleration is not finite.
 
+    Parameters
+    ----------
+    profile : SpeedProfile
+        The profile.
+    t_end_s : float
+        End of the run (s).
+    samples : int
+        Number of sample times.
+
     Returns
     -------
     ndarray
