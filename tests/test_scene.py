@@ -219,3 +219,23 @@ def test_sigkill_during_write_never_damages_the_previous_archive(tmp_path):
             old = target.read_bytes()
     # the kills must have hit writes in progress, or the test proves nothing
     assert outcomes["old"] >= 5, outcomes
+
+
+DRIVE = {"motor_speed_rpm": 930.0, "power_w": 750.0, "service_factor": 1.3,
+         "stages": [{"driver_diameter_m": 0.100, "driven_diameter_m": 0.120, "center_distance_m": 0.300,
+                     "per_belt_rating_w": 1275.0}],
+         "shaft": {"length_m": 1.30, "bearing_a_m": 0.0, "bearing_b_m": 1.15, "diameter_m": 0.025,
+                   "rotor_position_m": 1.30, "rotor_mass_kg": 2.0, "youngs_modulus_pa": 205e9}}
+
+
+def test_drive_hands_speed_and_stiffness_to_the_rotor():
+    config = scene(drive=DRIVE, rotor={"M": 2.0, "k": "drive:stiffness", "c": 20.0, "e": 1e-4},
+                   adb={**ADB, "response": {"speed_rad_s": "drive:speed", "t_end_s": 0.2}},
+                   outputs={"tables": ["rotor", "drive"]})
+    run = run_scene(config)
+    assert {s for s, v in run.stages.items() if v == "ran"} == {"drive", "rotor"}
+    handover = run.results["drive"].handover
+    # docs/drive.md worked example: 775 rpm = 81.158 rad/s, overhung 25 mm shaft: k = 403.2 kN/m
+    assert abs(handover.speed_rad_s - 81.158) < 1e-3
+    assert abs(handover.stiffness_n_per_m / 403.2e3 - 1) < 5e-4
+    assert run.results["rotor"].params.k == handover.stiffness_n_per_m
