@@ -464,3 +464,32 @@ def test_hdf5_missing_dataset(tmp_path):
     with h5py.File(path, "r+") as fh:
         del fh["frf/0/frequency_hz"]
     _fails(path, "group /frf/0", "no dataset 'frequency_hz'")
+
+
+# ================================================================ writers
+def test_uff_writer_refuses_point_ids_it_cannot_store(tmp_path):
+    frf = FRF(FREQ, _frf().response, kind="mobility", response_points=["left wing"], reference_points=["1+Z"])
+    with pytest.raises(FormatError, match=r"h\.uff: field 'response_points' channel 0: point id 'left wing'"):
+        write_frf(frf, tmp_path / "h.uff")
+    assert list(tmp_path.iterdir()) == []
+    write_frf(frf, tmp_path / "h.csv")  # other formats store any id
+    assert read_frf(tmp_path / "h.csv").response_points == ("left wing",)
+
+
+def test_writers_leave_an_existing_target_alone_on_failure(tmp_path, monkeypatch):
+    import h5py
+
+    target = tmp_path / "keep.h5"
+    write_frf(_frf(), target)
+    before = target.read_bytes()
+
+    def broken(group, frf):
+        group.create_dataset("frequency_hz", data=frf.frequency_hz)
+        raise OSError("device full")
+
+    monkeypatch.setattr("modal.io.hdf5.write_frf_group", broken)
+    with pytest.raises(OSError, match="device full"):
+        write_frf(_frf(2), target)
+    assert target.read_bytes() == before and [p.name for p in tmp_path.iterdir()] == ["keep.h5"]
+    with h5py.File(target, "r") as fh:
+        assert fh["frf/0/response"].shape == (FREQ.size,)

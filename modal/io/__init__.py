@@ -111,7 +111,8 @@ def read_frf(path: str | os.PathLike | Sequence[str | os.PathLike], **hints: Any
             Text layout (``"re_im"``, ``"mag_deg"``, ``"db_deg"``, ``"complex"``...), column
             delimiter and decimal mark (``","`` for a decimal comma).
         ``dataset``
-            UFF: which dataset (0-based index among the file's datasets) to read.
+            UFF: the dataset number(s) to read, 1-based over all datasets of the file as
+            in the error messages (an int or a list); HDF5: the group name under ``/frf``.
         ``response_points``, ``reference_points``, ``units``
             Override or supply point ids and the response unit.
 
