@@ -71,12 +71,32 @@ def _fit_growth_rate(params, ratio, amplitude, t_end):
     return slope, lam.real
 
 
-@pytest.mark.parametrize("ratio, amplitude, t_end", [(2.0, 1e-6, 0.6), (1.2, 1e-9, 2.0), (5.0, 1e-6, 0.6)])
-def test_growth_rates_agree_with_simulation(ratio, amplitude, t_end):
+GROWTH_CASES = [
+    # (name, parameter changes, speed ratio, start amplitude, duration in s): decaying cases start
+    # at 1e-6, growing ones at 1e-9 so that they stay below ~1e-6 (linear regime); runs cover
+    # at least five half-periods of the critical pair so that the envelope has peaks to fit.
+    ("S1", {}, 0.5, 1e-9, 1.5),
+    ("S1", {}, 1.05, 1e-9, 3.0),
+    ("S1", {}, 1.2, 1e-9, 2.0),
+    ("S1", {}, 1.5, 1e-6, 1.0),
+    ("S1", {}, 2.0, 1e-6, 0.6),
+    ("S1", {}, 5.0, 1e-6, 0.6),
+    ("S3", {"c": 2.0}, 2.0, 1e-6, 1.0),
+    ("S5", {"D": 1e-4}, 2.0, 1e-6, 1.0),
+    ("S5", {"D": 1e-4}, 1.2, 1e-9, 1.0),
+    ("S6", {"n": 3}, 2.0, 1e-6, 1.0),
+    ("S6", {"n": 3}, 1.2, 1e-9, 1.0),
+]
+
+
+@pytest.mark.parametrize("name, changes, ratio, amplitude, t_end", GROWTH_CASES,
+                         ids=[f"{c[0]}-{c[2]}" for c in GROWTH_CASES])
+def test_growth_rates_agree_with_simulation(name, changes, ratio, amplitude, t_end):
     # In the linear regime (deviation <= 1e-6) nonlinear corrections are O(1e-6) relative
     # and the integrator error (rtol 1e-12) is smaller still; the envelope of
-    # |Re(v e^{lambda t})| has peaks exactly e^{Re lambda T/2} apart.  The issue asks for 5 %.
-    fitted, predicted = _fit_growth_rate(S1, ratio, amplitude, t_end)
+    # |Re(v e^{lambda t})| has peaks exactly e^{Re lambda T/2} apart.  The issue asks for 5 %
+    # (observed: below 0.2 %).
+    fitted, predicted = _fit_growth_rate(S1.replace(**changes), ratio, amplitude, t_end)
     assert fitted == pytest.approx(predicted, rel=0.05)
     assert math.copysign(1, fitted) == math.copysign(1, predicted)
 
@@ -236,3 +256,11 @@ def test_bad_simulation_arguments_raise():
         integrate(S1, LinearRunUp(0, 100, 1), np.zeros(8), [0, 0.1], frame="rotating")
     with pytest.raises(ParameterError, match="duration_s"):
         LinearRunUp(0.0, 100.0, 0.0)
+
+
+def test_simulation_without_balancing_capacity_reports_not_settled():
+    # n m R = 2e-3 kg m < M e = 5e-3 kg m: simulating is allowed (physics), balancing is not
+    heavy = S1.replace(e=5e-3)
+    result = simulate(heavy, 3 * WN, 0.3, n_samples=301)
+    assert not result.settled and result.settling_time_s == math.inf
+    assert result.final_state != "balanced" and result.balanced_ball_angles_rad.size == 0
