@@ -47,7 +47,8 @@ def test_three_beam_points_combine_into_three_channels(real):
 def test_beam_needs_kind_and_frequency_lines(real):
     with pytest.raises(FormatError, match=r"pyuff_meas_point_1\.txt.*kind= \(--kind\)"):
         read_frf(real / BEAM[0], frequency_step=1.0)
-    with pytest.raises(FormatError, match=r"pyuff_meas_point_1\.txt: the file has no frequency column.*frequency_step="):
+    with pytest.raises(FormatError,
+                       match=r"pyuff_meas_point_1\.txt: the file has no frequency column.*frequency_step="):
         read_frf(real / BEAM[0], kind="accelerance")
 
 

@@ -190,7 +190,8 @@ def read_frf_uff(path: str | os.PathLike, **hints: Any) -> FRF:
             uff = pyuff.UFF(os.fspath(p))
             types = [int(t) for t in uff.get_set_types()]
     except Exception as exc:  # pyuff raises bare Exception
-        raise FormatError(f"{src}: cannot be scanned as UFF ({exc}); expected datasets between '    -1' lines") from None
+        raise FormatError(f"{src}: cannot be scanned as UFF ({exc}); "
+                          "expected datasets between '    -1' lines") from None
     if len(types) != len(blocks):
         raise FormatError(f"{src}: {len(blocks)} datasets found but pyuff sees {len(types)}; "
                           "expected a well-formed UFF file")
@@ -400,7 +401,8 @@ def _diagnose(block: _Block, src: str) -> str:
                         f"is not a number; expected fields of {w} characters")
     per_point = (2 if odt in (5, 6) else 1) + (0 if spacing == 1 else 1)
     return (f"{src}: {block.where(7, 'num_pts')}: {count} values in the data records do not make "
-            f"{n_pts} points of {per_point} value(s) each; expected {n_pts * per_point} (truncated or damaged dataset?)")
+            f"{n_pts} points of {per_point} value(s) each; expected {n_pts * per_point} "
+            "(truncated or damaged dataset?)")
 
 
 # ------------------------------------------------------------ writing
@@ -485,4 +487,5 @@ def _node_dir(points, ch: int, name: str, src: str) -> tuple[int, int]:
     try:
         return parse_point(points[ch])
     except ValueError as exc:
-        raise FormatError(f"{src}: field '{name}' channel {ch}: {exc}; UFF stores a node number and a direction") from None
+        raise FormatError(f"{src}: field '{name}' channel {ch}: {exc}; "
+                          "UFF stores a node number and a direction") from None
