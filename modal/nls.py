@@ -142,7 +142,7 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
         return Phi, dphi, Q, R, QhY, res, float(np.sum(res.real**2) + np.sum(res.imag**2))
 
     state = evaluate(params)
-    lam = 1e-3
+    lam = 1e-4
     converged = False
     n_iter = 0
     for n_iter in range(1, max_iter + 1):
@@ -165,6 +165,8 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
                 lam *= 10
                 continue
             trial = params + step
+            if lam <= 1e-2 and np.max(np.abs(step) / np.maximum(np.abs(params), 1e-300)) < step_tol:
+                break  # the Gauss–Newton step is below rounding: converged, nothing to evaluate
             if np.all(trial[0::2] > 0) and np.all(trial[1::2] > 0) and np.all(np.isfinite(trial)):
                 new_state = evaluate(trial)
                 if new_state[-1] <= cost:
@@ -172,12 +174,14 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
                     break
             lam *= 4
         if not accepted:
-            converged = cost <= 1e-28 * np.vdot(Y, Y).real or lam > 1e10
+            small = np.max(np.abs(step) / np.maximum(np.abs(params), 1e-300)) < step_tol
+            converged = bool(small or cost <= 1e-28 * np.vdot(Y, Y).real)
             break
         rel_step = np.max(np.abs(step) / np.maximum(np.abs(params), 1e-300))
         params, state = trial, new_state
         lam = max(lam / 3, 1e-12)
-        if rel_step < step_tol or new_state[-1] <= 1e-30 * np.vdot(Y, Y).real:
+        flat = cost - new_state[-1] <= 1e-13 * cost  # no decrease left above rounding
+        if rel_step < step_tol or flat or new_state[-1] <= 1e-30 * np.vdot(Y, Y).real:
             converged = True
             break
 
