@@ -35,29 +35,16 @@ def _stability(results):
 
 
 def _response(results):
+    from ..adb.plots import plot_amplitude, plot_ball_angles, plot_orbit, plot_run_up
+
     r = results["adb_response"]
     fig = Figure(figsize=(10, 7), layout="constrained")
     ax_amp, ax_orbit, ax_balls, ax_runup = fig.subplots(2, 2).ravel()
-    ax_amp.plot(r.time_s, r.amplitude_m * 1e3, lw=0.8, label="with balls")
-    ax_runup.plot(r.speed_rad_s, r.amplitude_m * 1e3, lw=0.8, label="with balls")
-    if r.amplitude_without_balls_m.size:
-        ax_amp.plot(r.time_s, r.amplitude_without_balls_m * 1e3, lw=0.8, label="without balls")
-        ax_runup.plot(r.speed_rad_s, r.amplitude_without_balls_m * 1e3, lw=0.8, label="without balls")
-    ax_amp.set_xlabel("time [s]")
-    ax_amp.set_ylabel("amplitude [mm]")
-    ax_amp.legend(fontsize="small")
-    ax_orbit.plot(r.rotor_x_m * 1e3, r.rotor_y_m * 1e3, lw=0.5)
-    ax_orbit.set_aspect("equal", adjustable="datalim")
-    ax_orbit.set_xlabel("x [mm]")
-    ax_orbit.set_ylabel("y [mm]")
-    ax_balls.plot(r.time_s, np.degrees(np.angle(np.exp(1j * r.ball_angles_rad))), ".", ms=0.8)  # wrapped
-    for angle in np.atleast_1d(r.balanced_ball_angles_rad):
-        ax_balls.axhline(np.degrees(angle), color="0.5", lw=0.6, ls="--")
-    ax_balls.set_xlabel("time [s]")
-    ax_balls.set_ylabel("ball angle from unbalance [deg]")
-    ax_runup.set_xlabel("speed [rad/s]")
-    ax_runup.set_ylabel("amplitude [mm]")
-    ax_runup.legend(fontsize="small")
+    plot_amplitude(r, ax=ax_amp)
+    plot_orbit(r, ax=ax_orbit)
+    plot_ball_angles(r, ax=ax_balls)
+    wn = results["rotor"].params.natural_frequency_rad_s if "rotor" in results else None
+    plot_run_up(r, wn, ax=ax_runup)
     return [("response", fig)]
 
 
