@@ -59,6 +59,43 @@ def _half_power_width(freq, ind, i):
     return freq[hi] - freq[lo]
 
 
+def _nearest_higher(y: np.ndarray, order) -> np.ndarray:
+    """Index of the nearest strictly higher sample in the order given (−1 if none), by a monotonic stack."""
+    out = np.full(y.size, -1)
+    stack: list[int] = []
+    for i in order:
+        while stack and y[stack[-1]] <= y[i]:
+            stack.pop()
+        out[i] = stack[-1] if stack else -1
+        stack.append(i)
+    return out
+
+
+def _peaks_with_prominence(y: np.ndarray, min_prominence: float) -> np.ndarray:
+    """Local maxima of ``y`` whose topographic prominence is at least ``min_prominence``.
+
+    Prominence as in ``scipy.signal.peak_prominences``: the peak height minus the
+    higher of the two lowest points between the peak and the nearest higher
+    sample (or the end of the data) on each side.
+    """
+    n = y.size
+    if n < 3:
+        return np.zeros(0, dtype=int)
+    inner = np.flatnonzero((y[1:-1] > y[:-2]) & (y[1:-1] >= y[2:])) + 1
+    if inner.size == 0:
+        return inner
+    left = _nearest_higher(y, range(n))
+    right = _nearest_higher(y, range(n - 1, -1, -1))
+    right[right < 0] = n
+    keep = []
+    for p in inner:
+        left_base = y[left[p] + 1:p + 1].min()
+        right_base = y[p:right[p]].min()
+        if y[p] - max(left_base, right_base) >= min_prominence:
+            keep.append(p)
+    return np.array(keep, dtype=int)
+
+
 def find_modes(frf: FRF, min_prominence_db: float = 6.0, noise_factor: float = 10.0,
                bandwidths: float = 3.0, max_modes: int | None = None,
                noise_std: np.ndarray | None = None) -> list[ModeBand]:
@@ -69,8 +106,6 @@ def find_modes(frf: FRF, min_prominence_db: float = 6.0, noise_factor: float = 1
     Its band is ±``bandwidths`` half-power widths (at least ±5 lines), clipped
     halfway to the neighbouring peaks and to the data.
     """
-    from scipy.signal import find_peaks  # imported here: scipy.signal takes a second to import
-
     freq = frf.frequency_hz
     ind = mode_indicator(frf)
     noise = estimate_noise_std(frf) if noise_std is None else noise_std
@@ -79,7 +114,7 @@ def find_modes(frf: FRF, min_prominence_db: float = 6.0, noise_factor: float = 1
         noise_rel = float(np.sqrt(np.nanmean((noise / peak_mag) ** 2)))
     floor = noise_factor * noise_rel if np.isfinite(noise_rel) else 0.0
     db = 20 * np.log10(np.maximum(ind, np.finfo(float).tiny))
-    idx, props = find_peaks(db, prominence=min_prominence_db)
+    idx = _peaks_with_prominence(db, min_prominence_db)
     keep = ind[idx] > floor
     idx = idx[keep]
     if max_modes is not None and idx.size > max_modes:
