@@ -42,14 +42,23 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True)
     fit = sub.add_parser("fit", help="identify the modes of an FRF file",
                          description="Identify natural frequency, damping, modal constant and k, c, m of every mode.")
-    fit.add_argument("path", help="FRF file (UFF 58/58b, CSV, MAT, HDF5)")
+    fit.add_argument("path", nargs="+", help="FRF file(s) (UFF 58/58b, CSV, MAT, HDF5); several files on one "
+                     "frequency axis become one multi-channel FRF")
     fit.add_argument("--method", choices=["nls", "circle", "halfpower", "all"], default="nls",
                      help="identification method (default: nls, the least-squares refinement)")
     fit.add_argument("--band", nargs=2, type=float, action="append", metavar=("FMIN", "FMAX"),
                      help="fitting band of one mode in Hz (repeat for several modes); default: automatic")
     fit.add_argument("--kind", choices=FRF_KINDS, help="FRF kind when the file does not say")
-    fit.add_argument("--frequency-axis", dest="frequency_axis", choices=["hz", "rad/s", "cpm"],
+    fit.add_argument("--frequency-axis", dest="frequency_axis", choices=["hz", "khz", "rad/s", "cpm", "rpm"],
                      help="unit of the file's frequency column when it does not say")
+    fit.add_argument("--frequency-step", dest="frequency_step", type=float, metavar="HZ",
+                     help="line spacing (Hz) for files without a frequency column")
+    fit.add_argument("--frequency-start", dest="frequency_start", type=float, metavar="HZ",
+                     help="first line (Hz) for files without a frequency column (default 0)")
+    fit.add_argument("--layout", help="CSV layout when the header does not say (re_im, mag_phase_deg, db_phase_deg, ...)")
+    fit.add_argument("--delimiter", help="CSV delimiter")
+    fit.add_argument("--decimal", help="CSV decimal mark, e.g. ','")
+    fit.add_argument("--dataset", type=int, help="UFF dataset number (1-based) when the file holds several axes")
     fit.add_argument("--json", action="store_true", help="print one JSON document on stdout")
     fit.add_argument("--plot", metavar="OUT.png", help="write a figure of the fit")
     fit.add_argument("--archive", metavar="OUT.h5", help="write the FRF and results to an HDF5 archive")
@@ -64,8 +73,10 @@ def _fit(args) -> int:
     from .identify import identify
     from .io import read_frf
 
-    hints = {k: v for k, v in (("kind", args.kind), ("frequency_axis", args.frequency_axis)) if v is not None}
-    frf = read_frf(args.path, **hints)
+    names = ("kind", "frequency_axis", "frequency_step", "frequency_start", "layout", "delimiter", "decimal", "dataset")
+    hints = {k: getattr(args, k) for k in names if getattr(args, k) is not None}
+    frf = read_frf(args.path[0] if len(args.path) == 1 else args.path, **hints)
+    label = args.path[0] if len(args.path) == 1 else f"{args.path[0]} (+{len(args.path) - 1} files)"
     methods = ["nls", "circle", "halfpower"] if args.method == "all" else [args.method]
     results = [identify(frf, method, bands_hz=args.band) for method in methods]
     points = None
@@ -74,14 +85,14 @@ def _fit(args) -> int:
         points = [f"{r} / {q}" for r, q in zip(frf.response_points, refs)]
     if args.json:
         rows = [row for result in results for row in result.rows()]
-        doc = {"file": str(args.path), "kind": frf.kind, "n_channels": frf.n_channels,
+        doc = {"file": args.path[0] if len(args.path) == 1 else list(args.path), "kind": frf.kind, "n_channels": frf.n_channels,
                "methods": methods, "modes": rows}
         json.dump(_jsonable(doc), sys.stdout, indent=1, allow_nan=False)
         sys.stdout.write("\n")
     else:
         from .report import format_table
 
-        print(f"{args.path}: {frf.n_channels} channel(s), {frf.n_freq} lines, "
+        print(f"{label}: {frf.n_channels} channel(s), {frf.n_freq} lines, "
               f"{frf.frequency_hz[0]:g}–{frf.frequency_hz[-1]:g} Hz, {frf.kind}")
         for result in results:
             print()
@@ -114,7 +125,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"error: {exc}", file=sys.stderr)
         return 1
     except OSError as exc:
-        print(f"error: {exc.filename or args.path}: {exc.strerror or exc}", file=sys.stderr)
+        print(f"error: {exc.filename or args.path[0]}: {exc.strerror or exc}", file=sys.stderr)
         return 1
     return 2
 

@@ -93,3 +93,20 @@ def test_no_half_written_plot_on_failure(tmp_path):
     out = run("fit", path, "--plot", png)
     assert out.returncode == 1 and "no resonance" in out.stderr
     assert not png.exists() and list(tmp_path.glob("*.tmp")) == []
+
+
+def test_real_beam_files_and_time_data_refused():
+    from conftest import SHARED
+
+    real = SHARED / "data" / "real"
+    beams = sorted(real.glob("pyuff_meas_point_*.txt"))
+    if len(beams) != 3:
+        pytest.skip("../shared/data/real is not beside the checkout")
+    out = run("fit", *beams, "--frequency-step", "1", "--kind", "accelerance", "--band", "40", "60", "--json")
+    assert out.returncode == 0, out.stderr
+    rows = json.loads(out.stdout)["modes"]
+    assert {row["channel"] for row in rows} == {0, 1, 2}
+    assert abs(rows[0]["natural_frequency_hz"] / 51.5 - 1) < 1e-3  # LSCF value, 0.1 %
+    time_file = real / "pyuff_MPSTD_Set001_2024_10_08_10_27_07.uff"
+    refused = run("fit", time_file)
+    assert refused.returncode == 1 and "time response" in refused.stderr and "func_type" in refused.stderr
