@@ -264,3 +264,13 @@ def test_simulation_without_balancing_capacity_reports_not_settled():
     result = simulate(heavy, 3 * WN, 0.3, n_samples=301)
     assert not result.settled and result.settling_time_s == math.inf
     assert result.final_state != "balanced" and result.balanced_ball_angles_rad.size == 0
+
+
+def test_callable_profile_is_never_called_before_zero():
+    def speed(t):
+        if t < 0:
+            raise AssertionError("called at negative time")
+        return 2 * WN * math.sqrt(t / 0.2) if t < 0.2 else 2 * WN
+
+    result = simulate(S1, speed, 0.05, n_samples=51, compare_without_balls=False)
+    assert result.speed_rad_s[-1] == pytest.approx(2 * WN * math.sqrt(0.25))

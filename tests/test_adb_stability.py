@@ -224,3 +224,15 @@ def test_balancing_required_for_stability_questions():
         stable_speed_intervals(S1, math.nan)
     # equilibria still exist without balancing: only unbalanced ones
     assert all(eq.kind == "unbalanced" for eq in find_equilibria(heavy, 2 * WN))
+
+
+def test_another_family_member_can_be_passed():
+    # n = 3 (S6): the balanced states form a one-parameter family and stability depends on the
+    # member; the symmetric one is the default, another member is accepted and analysed.
+    p = S1.replace(n=3)
+    default = stable_speed_intervals(p, 20 * p.natural_frequency_rad_s)
+    assert default.intervals_ratio[0, 0] == pytest.approx(1.461, abs=XTOL)
+    member = balanced_ball_angles(p, free_angles_rad=[2.0])
+    other = stable_speed_intervals(p, 20 * p.natural_frequency_rad_s, ball_angles_rad=member)
+    assert np.allclose(other.ball_angles_rad, member)
+    assert abs(other.lowest_stable_speed_rad_s - default.lowest_stable_speed_rad_s) > 1e-3 * p.natural_frequency_rad_s

@@ -380,7 +380,8 @@ class SimulationResult:
     amplitude_m : ndarray, shape (T,)
         Vibration amplitude ``sqrt(x^2 + y^2)`` (m).
     ball_angles_rad, ball_rates_rad_s : ndarray, shape (T, n)
-        Ball angles relative to the unbalance direction (rad) and their rates (rad/s).
+        Ball angles relative to the unbalance direction (rad, continuous: not wrapped, so a
+        slipping ball's angle keeps growing) and their rates relative to the race (rad/s).
     balanced_ball_angles_rad : ndarray, shape (n,) or (0,)
         The balanced configuration (symmetric member for n >= 3); empty if impossible.
     settled : bool
@@ -398,7 +399,9 @@ class SimulationResult:
     rotor_x_without_balls_m, rotor_y_without_balls_m : ndarray, shape (T,) or (0,)
         Its orbit (m).
     residual_amplitude_without_balls_m : float
-        Its largest amplitude over the final window (m); nan only if not computed.
+        Its largest amplitude over the final window (m); nan if not computed.
+    compared_without_balls : bool
+        Whether the run without balls was made (else its arrays are empty).
     window_start_s : float
         Start of the final window (s).
     settle_tolerance : float
@@ -431,6 +434,7 @@ class SimulationResult:
     rotor_x_without_balls_m: np.ndarray
     rotor_y_without_balls_m: np.ndarray
     residual_amplitude_without_balls_m: float
+    compared_without_balls: bool
     window_start_s: float
     settle_tolerance: float
     frame: str
@@ -607,6 +611,7 @@ def simulate(
         final_state=final_state, final_slip_rate_rad_s=slip,
         amplitude_without_balls_m=a0, rotor_x_without_balls_m=x0, rotor_y_without_balls_m=y0n,
         residual_amplitude_without_balls_m=residual0,
+        compared_without_balls=bool(compare_without_balls),
         window_start_s=window_start, settle_tolerance=float(settle_tolerance),
         frame=frame, method=run.method, rtol=float(rtol),
         n_function_evaluations=run.n_function_evaluations, n_jacobian_evaluations=run.n_jacobian_evaluations,

@@ -2,7 +2,8 @@
 
 A profile gives the speed ``omega(t)`` (rad/s) and the angular acceleration
 ``omega'(t)`` (rad/s^2).  Plain callables are wrapped; their acceleration is taken by a
-central difference (step 1e-6 s: truncation ~1e-12 omega''', rounding ~2e-10 omega).
+central difference (step 1e-6 s: truncation ~1e-12 omega''', rounding ~2e-10 omega;
+forward difference for t < 1e-6 s, so the function is never called at negative times).
 """
 from __future__ import annotations
 
@@ -132,12 +133,18 @@ class CallableSpeed:
         return self._call(time_s)
 
     def acceleration_rad_s2(self, time_s):
-        """Angular acceleration (rad/s^2) by a central difference."""
-        h = self.step_s
+        """Angular acceleration (rad/s^2) by a central difference (forward one before t = h,
+        so that the function is never called at negative times)."""
         if np.ndim(time_s):
             t = np.asarray(time_s, dtype=float)
-            return (self.speed_rad_s(t + h) - self.speed_rad_s(t - h)) / (2.0 * h)
-        return (self._call(time_s + h) - self._call(time_s - h)) / (2.0 * h)
+            return np.array([self._derivative(float(x)) for x in t.ravel()]).reshape(t.shape)
+        return self._derivative(float(time_s))
+
+    def _derivative(self, t: float) -> float:
+        h = self.step_s
+        if t < h:
+            return (self._call(t + h) - self._call(t)) / h
+        return (self._call(t + h) - self._call(t - h)) / (2.0 * h)
 
 
 def as_speed_profile(speed: Any) -> SpeedProfile:
