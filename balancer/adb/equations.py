@@ -322,7 +322,8 @@ def fixed_to_rotating(state, speed_rad_s, n: int):
     return out
 
 
-def scalar_rhs(M: float, m: float, n: int, R: float, e: float, k: float, c: float, D: float, *, frame: str):
+def scalar_rhs(M: float, m: float, n: int, R: float, e: float, k: float, c: float, D: float, *, frame: str,
+               clamped: bool = False):
     """Right-hand side for a single parameter set in plain Python floats (fast for small n).
 
     Same equations as :func:`rotating_frame_rhs` / :func:`fixed_frame_rhs` (tested equal to
@@ -335,6 +336,9 @@ def scalar_rhs(M: float, m: float, n: int, R: float, e: float, k: float, c: floa
         As in :class:`~balancer.adb.ADBParameters` (SI).
     frame : {"rotating", "fixed"}
         Formulation (state layouts as in this module).
+    clamped : bool
+        Balls held at their places on the race (``phi' = phi'' = 0``): the rotor then carries
+        them as rigid point masses, ``(M + n m) z'' = ... + m R sum (omega^2 - i omega') e^{i b}``.
 
     Returns
     -------
@@ -364,6 +368,21 @@ def scalar_rhs(M: float, m: float, n: int, R: float, e: float, k: float, c: floa
         a0y = 2.0 * nu * vx + nu_dot * px - nu * nu * py
         sum_x = sum_y = s_ss = s_cc = s_sc = 0.0
         balls = []
+        if clamped:
+            for i in range(n):
+                b = y[2 + i] + offset
+                s, co = sin(b), cos(b)
+                sum_x += omega * omega * co + alpha * s
+                sum_y += omega * omega * s - alpha * co
+            fx = (-c * (vx - nu * py) - k * px + unbalance * (omega * omega * uc + alpha * us)
+                  + mR * sum_x - total * a0x)
+            fy = (-c * (vy + nu * px) - k * py + unbalance * (omega * omega * us - alpha * uc)
+                  + mR * sum_y - total * a0y)
+            out = [0.0] * size
+            out[0], out[1], out[2 + n], out[3 + n] = vx, vy, fx / total, fy / total
+            if not rotating:
+                out[4 + 2 * n] = omega
+            return np.array(out)
         for i in range(n):
             b = y[2 + i] + offset
             s, co = sin(b), cos(b)

@@ -526,6 +526,7 @@ def simulate(
     settle_tolerance: float = 0.01,
     final_window_fraction: float = 0.1,
     compare_without_balls: bool = True,
+    release_time_s: float | None = None,
 ) -> SimulationResult:
     """Simulate the rotor with balls at constant speed or along a speed profile.
 
@@ -561,6 +562,10 @@ def simulate(
         final-state classification.
     compare_without_balls : bool
         Also simulate the same rotor with the balls removed.
+    release_time_s : float, optional
+        Hold the balls at their initial places on the race until this time (s), then let
+        them go (Rodrigues et al.'s remedy for run-up: clamp the balls until the speed is
+        supercritical).  Default: free from the start.
 
     Returns
     -------
@@ -588,7 +593,15 @@ def simulate(
     speed0 = float(speeds[0])
     times = _sample_times(t_end, n_samples, max_speed)
     y0 = _initial_state(n, angles, position, velocity, rates, frame, speed0)
-    run = integrate(params, profile, y0, times, frame=frame, method=method, rtol=rtol)
+    if release_time_s is None:
+        run = integrate(params, profile, y0, times, frame=frame, method=method, rtol=rtol)
+    else:
+        release = float(release_time_s)
+        if not (math.isfinite(release) and 0.0 < release < t_end):
+            raise ParameterError(f"release_time_s = {release_time_s!r}: expected 0 < release_time_s < t_end_s = {t_end}")
+        if np.any(rates != 0.0):
+            raise ParameterError("initial_ball_rates_rad_s: expected zeros when the balls start clamped (release_time_s)")
+        run = _integrate_clamped_then_free(params, profile, y0, times, release, frame, method, rtol)
     x, y, u, v, phi, dphi, theta, omega = _fixed_outputs(run, profile, n)
     amplitude = np.hypot(x, y)
     window_start = t_end * (1.0 - final_window_fraction)
@@ -615,6 +628,40 @@ def simulate(
         window_start_s=window_start, settle_tolerance=float(settle_tolerance),
         frame=frame, method=run.method, rtol=float(rtol),
         n_function_evaluations=run.n_function_evaluations, n_jacobian_evaluations=run.n_jacobian_evaluations,
+    )
+
+
+def _integrate_clamped_then_free(params, profile, y0, times, release, frame, method, rtol) -> IntegrationResult:
+    """Balls held on the race until ``release`` (rigid point masses), then free."""
+    n = params.n
+    clamped = scalar_rhs(params.M, params.m, n, params.R, params.e, params.k, params.c, params.D,
+                         frame=frame, clamped=True)
+    constant = isinstance(profile, ConstantSpeed)
+
+    def fun(t, y):
+        if constant:
+            return clamped(y, profile.speed, 0.0)
+        omega, alpha = float(profile.speed_rad_s(t)), float(profile.acceleration_rad_s2(t))
+        if not (math.isfinite(omega) and math.isfinite(alpha)):
+            raise ParameterError(f"speed profile is not finite at t = {t!r} s: expected finite values")
+        return clamped(y, omega, alpha)
+
+    batch = ParameterBatch.from_parameters(params)
+    max_speed = float(np.max(np.abs(profile.speed_rad_s(times)))) if not constant else abs(profile.speed)
+    atol = _absolute_tolerances(batch, rtol, max_speed, frame == "fixed")
+    before = times[times <= release]
+    first = solve_ivp(fun, (times[0], release), y0, method="DOP853", t_eval=np.append(before, release)
+                      if before[-1] < release else before, rtol=rtol, atol=atol, dense_output=False)
+    if first.status != 0:
+        raise ParameterError(f"integration with clamped balls failed: {first.message}")
+    after = times[times > release]
+    second = integrate(params, profile, first.y[:, -1], np.concatenate([[release], after]), frame=frame,
+                       method=method, rtol=rtol)
+    states = np.concatenate([first.y.T[: before.size], second.states[0, 1:]], axis=0)[None]
+    return IntegrationResult(
+        time_s=times, states=states, frame=frame, method=second.method,
+        n_function_evaluations=int(first.nfev) + second.n_function_evaluations,
+        n_jacobian_evaluations=second.n_jacobian_evaluations, rtol=second.rtol,
     )
 
 
