@@ -236,3 +236,14 @@ def test_another_family_member_can_be_passed():
     other = stable_speed_intervals(p, 20 * p.natural_frequency_rad_s, ball_angles_rad=member)
     assert np.allclose(other.ball_angles_rad, member)
     assert abs(other.lowest_stable_speed_rad_s - default.lowest_stable_speed_rad_s) > 1e-3 * p.natural_frequency_rad_s
+
+
+def test_no_stable_speed_without_drag_or_without_support_damping():
+    # Finding 3's limit cases: beta = 0 (no ball drag) fails beta > kappa zeta; zeta = 0 leaves
+    # the rotor's whirl undamped.  With both zero the balanced state is at best marginal, and the
+    # interval search must not mistake marginal points for stable ones.
+    for changes in ({"D": 0.0}, {"c": 0.0}, {"c": 0.0, "D": 0.0}):
+        p = S1.replace(**changes)
+        assert len(stable_speed_intervals(p, 10 * WN)) == 0
+    classes = balanced_stability(S1.replace(c=0.0, D=0.0), np.linspace(0.1, 10, 200) * WN).stability_class
+    assert set(np.unique(classes)) == {UNSTABLE, MARGINAL}

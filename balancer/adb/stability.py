@@ -257,8 +257,12 @@ def stable_speed_intervals(
         return float(_analyse_balanced([params], np.array([speed]), [angles]).max_real_part_per_s[0])
 
     def boundary(index: int) -> float:
-        # sign change of the growth rate between grid points index and index + 1
-        return brentq(growth, speeds[index], speeds[index + 1], xtol=xtol_ratio * wn, rtol=4 * np.finfo(float).eps)
+        # sign change of the growth rate between grid points index and index + 1; if one of
+        # them is marginal the signs may agree, and the grid point on the stable side is kept
+        low, high = speeds[index], speeds[index + 1]
+        if growth(low) * growth(high) > 0.0:
+            return high if stable[index + 1] else low
+        return brentq(growth, low, high, xtol=xtol_ratio * wn, rtol=4 * np.finfo(float).eps)
 
     intervals = []
     start = speeds[0] if stable[0] else None
