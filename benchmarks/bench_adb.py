@@ -22,7 +22,8 @@ from scipy.integrate import solve_ivp
 
 from balancer.adb import ADBParameters, stability_map
 from balancer.adb.equations import fixed_to_rotating
-from balancer.adb.simulate import default_initial_ball_angles, integrate
+from balancer.adb.integrate import integrate
+from balancer.adb.simulate import default_initial_ball_angles
 
 S1 = ADBParameters(M=1.0, m=0.02, n=2, R=0.05, e=0.5e-3, k=1e4, c=20.0, D=1e-3)
 SEED = ADBParameters(M=8.0, m=0.005, n=5, R=0.028, e=8e-5, k=15000.0, c=70.1, D=0.2)

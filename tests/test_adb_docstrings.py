@@ -9,7 +9,7 @@ import inspect
 import numpy as np
 import pytest
 
-MODULES = ["parameters", "equations", "linear", "equilibria", "stability", "speed", "simulate", "drag", "studies", "plots"]
+MODULES = ["parameters", "equations", "linear", "equilibria", "stability", "speed", "integrate", "analysis", "simulate", "drag", "studies", "plots"]
 
 
 def _public(module_name):

@@ -9,7 +9,8 @@ import pytest
 from balancer.adb import ADBParameters, ParameterBatch, balanced_ball_angles, balanced_stability, balanced_state
 from balancer.adb.equations import fixed_frame_rhs, rotating_frame_rhs, scalar_rhs
 from balancer.adb.linear import state_scales
-from balancer.adb.simulate import default_initial_ball_angles, integrate, simulate, simulate_batch
+from balancer.adb.integrate import integrate
+from balancer.adb.simulate import default_initial_ball_angles, simulate, simulate_batch
 from balancer.adb.speed import LinearRunUp
 from modal.errors import ParameterError
 

@@ -18,17 +18,9 @@ from .equilibria import (
 )
 from .linear import EigenAnalysis, eigen_analysis
 from .parameters import ADBParameters, ParameterBatch, ParameterStd, identified_std
-from .simulate import (
-    BatchSimulationResult,
-    IntegrationResult,
-    SimulationResult,
-    classify_final_state,
-    default_initial_ball_angles,
-    integrate,
-    settling_time,
-    simulate,
-    simulate_batch,
-)
+from .analysis import classify_final_state, settling_time
+from .integrate import IntegrationResult, choose_method, integrate
+from .simulate import BatchSimulationResult, SimulationResult, default_initial_ball_angles, simulate, simulate_batch
 from .speed import CallableSpeed, ConstantSpeed, LinearRunUp, SpeedProfile
 from .studies import SettlingStudy, settling_study
 from .stability import (
@@ -79,6 +71,7 @@ __all__ = [
     "classify_final_state",
     "default_initial_ball_angles",
     "integrate",
+    "choose_method",
     "settling_time",
     "simulate",
     "simulate_batch",

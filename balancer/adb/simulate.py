@@ -4,17 +4,8 @@
   is a fixed point, so steps grow as the balls settle); rotor coordinates are rotated
   back exactly for the fixed-frame orbit.
 * A speed profile (run-up) is integrated in the fixed Cartesian frame.
-* The integrator is chosen by stiffness: DOP853 (explicit, 8th order) unless the ball
-  drag rate ``D / (m R^2)`` exceeds ``STIFFNESS_RATIO`` times the fastest dynamic rate
-  ``max(omega_n, |omega|)``; then LSODA with the exact (complex-step) Jacobian,
-  banded for stacked batches.
-* A batch of parameter sets is one stacked ``solve_ivp`` system.  Because ``solve_ivp``
-  controls an RMS norm over all components, the tolerances are divided by ``sqrt(B)``,
-  which bounds every member's local error estimate by the single-run tolerance.
-
-Settling (``adb.md`` section 5): for two balls, the last time a ball is more than
-``settle_tolerance * |phi*|`` from the nearest balanced configuration; otherwise the last
-time the unbalance residual ``|M e + m R sum e^(i phi)|`` exceeds ``settle_tolerance * M e``.
+* Integrator choice and batching: :mod:`.integrate`; settling and final-state classes:
+  :mod:`.analysis`.
 """
 from __future__ import annotations
 
@@ -27,40 +18,20 @@ from scipy.integrate import solve_ivp
 
 from modal.errors import ParameterError
 
-from .equations import (
-    fixed_frame_jacobian,
-    fixed_frame_rhs,
-    fixed_to_rotating,
-    rotating_frame_jacobian,
-    rotating_frame_rhs,
-    rotating_to_fixed,
-    scalar_rhs,
-)
-from .equilibria import balanced_ball_angles, unbalanced_states
+from .analysis import classify_final_state, settling_time
+from .equations import fixed_to_rotating, rotating_to_fixed, scalar_rhs
+from .equilibria import balanced_ball_angles
+from .integrate import IntegrationResult, _absolute_tolerances, integrate
 from .parameters import ADBParameters, ParameterBatch
 from .speed import ConstantSpeed, SpeedProfile, as_speed_profile, check_profile
 
 __all__ = [
-    "STIFFNESS_RATIO",
     "SimulationResult",
     "BatchSimulationResult",
-    "IntegrationResult",
     "default_initial_ball_angles",
-    "choose_method",
-    "integrate",
     "simulate",
     "simulate_batch",
-    "settling_time",
-    "classify_final_state",
 ]
-
-STIFFNESS_RATIO = 50.0
-"""Ball-drag rate over the fastest dynamic rate above which the drag counts as stiff."""
-
-FINAL_STATES = ("balanced", "locked", "whirl", "transient")
-LOCK_TOLERANCE_RAD = 0.05
-"""Largest distance (rad) of a ball from an unbalanced equilibrium for a "locked" state."""
-
 
 def default_initial_ball_angles(n: int) -> np.ndarray:
     """Default start: balls resting near the heavy spot, spread over 0.3-0.5 rad (rad).
@@ -70,297 +41,6 @@ def default_initial_ball_angles(n: int) -> np.ndarray:
     if n == 1:
         return np.array([0.3])
     return 0.3 + 0.2 * np.arange(n) / (n - 1)
-
-
-def choose_method(params: ADBParameters | ParameterBatch, max_speed_rad_s: float) -> str:
-    """``"LSODA"`` if the ball drag is stiff, else ``"DOP853"``.
-
-    Parameters
-    ----------
-    params : ADBParameters or ParameterBatch
-        Parameters (for a batch the stiffest member decides).
-    max_speed_rad_s : float
-        Largest shaft speed of the run (rad/s).
-    """
-    batch = params if isinstance(params, ParameterBatch) else ParameterBatch.from_parameters(params)
-    drag_rate = batch.D / (batch.m * batch.R**2)
-    dynamic = np.maximum(batch.natural_frequency_rad_s, abs(max_speed_rad_s))
-    return "LSODA" if np.max(drag_rate / dynamic) > STIFFNESS_RATIO else "DOP853"
-
-
-@dataclass(frozen=True, slots=True)
-class IntegrationResult:
-    """Sampled states of a (possibly stacked) integration.
-
-    Attributes
-    ----------
-    time_s : ndarray, shape (T,)
-        Sample times (s).
-    states : ndarray, shape (B, T, N)
-        States in the integration frame.
-    frame : str
-        ``"rotating"`` or ``"fixed"``.
-    method : str
-        ``solve_ivp`` method used.
-    n_function_evaluations, n_jacobian_evaluations : int
-        Counters from ``solve_ivp`` (one evaluation covers the whole batch).
-    rtol : float
-        Relative tolerance passed to ``solve_ivp`` (after the batch scaling).
-    """
-
-    time_s: np.ndarray
-    states: np.ndarray
-    frame: str
-    method: str
-    n_function_evaluations: int
-    n_jacobian_evaluations: int
-    rtol: float
-
-
-def _absolute_tolerances(batch: ParameterBatch, rtol: float, speed_scale: float, fixed: bool) -> np.ndarray:
-    n = batch.n
-    rate = np.maximum(batch.natural_frequency_rad_s, abs(speed_scale))[:, None]
-    position = 1e-3 * rtol * batch.R[:, None]
-    angle = np.full((batch.size, 1), 1e-3 * rtol)
-    parts = [position, position, np.repeat(angle, n, 1), position * rate, position * rate, np.repeat(angle * rate, n, 1)]
-    if fixed:
-        parts.append(np.full((batch.size, 1), rtol))
-    return np.concatenate(parts, axis=1).reshape(-1)
-
-
-def _banded(jac: np.ndarray) -> np.ndarray:
-    """Pack a block-diagonal Jacobian (B blocks of N x N) in LSODA's banded format."""
-    batch, size, _ = jac.shape
-    band = np.zeros((2 * size - 1, batch * size))
-    for i in range(size):
-        for j in range(size):
-            band[i - j + size - 1, j::size] = jac[:, i, j]
-    return band
-
-
-def integrate(
-    params: ADBParameters | Sequence[ADBParameters],
-    speed: Any,
-    initial_states,
-    t_eval_s,
-    *,
-    frame: str = "rotating",
-    method: str = "auto",
-    rtol: float = 1e-9,
-    atol=None,
-) -> IntegrationResult:
-    """Integrate one or a stacked batch of systems from given states.
-
-    Parameters
-    ----------
-    params : ADBParameters or sequence of ADBParameters
-        One parameter set or a batch (common ``n``).
-    speed : float, callable or SpeedProfile
-        Shaft speed (rad/s); the rotating frame needs a constant speed.
-    initial_states : ndarray, shape (N,) or (B, N)
-        States at ``t_eval_s[0]`` in the chosen frame (see :mod:`.equations`).
-    t_eval_s : array_like, shape (T,)
-        Increasing sample times (s); the run spans ``[t_eval_s[0], t_eval_s[-1]]``.
-    frame : {"rotating", "fixed"}
-        Formulation.
-    method : str
-        ``"auto"`` (by stiffness) or any ``solve_ivp`` method.
-    rtol : float
-        Relative tolerance per member (divided by ``sqrt(B)`` for the stacked system).
-    atol : float or ndarray, optional
-        Absolute tolerance per component; default scaled from ``rtol`` (positions
-        ``1e-3 rtol R``, angles ``1e-3 rtol`` rad, rates times ``max(omega_n, |omega|)``).
-
-    Returns
-    -------
-    IntegrationResult
-    """
-    members = [params] if isinstance(params, ADBParameters) else list(params)
-    batch = ParameterBatch.from_parameters(members)
-    profile = as_speed_profile(speed)
-    times = np.asarray(t_eval_s, dtype=float).reshape(-1)
-    if times.size < 2 or not np.all(np.isfinite(times)) or np.any(np.diff(times) <= 0):
-        raise ParameterError(f"t_eval_s: expected at least 2 finite, increasing times; got {times.size} values")
-    speeds = check_profile(profile, float(times[-1]))
-    if frame not in ("rotating", "fixed"):
-        raise ParameterError(f"frame = {frame!r}: expected 'rotating' or 'fixed'")
-    if frame == "rotating" and not isinstance(profile, ConstantSpeed):
-        raise ParameterError("frame = 'rotating' needs a constant speed; use frame='fixed' for a speed profile")
-    if not (math.isfinite(rtol) and 0.0 < rtol < 1.0):
-        raise ParameterError(f"rtol = {rtol!r}: expected 0 < rtol < 1")
-    y0 = np.atleast_2d(np.asarray(initial_states, dtype=float))
-    size = y0.shape[-1]
-    expected = 4 + 2 * batch.n + (frame == "fixed")
-    if size != expected or y0.shape[0] not in (1, batch.size):
-        raise ParameterError(f"initial_states has shape {y0.shape}: expected ({batch.size}, {expected})")
-    if not np.all(np.isfinite(y0)):
-        raise ParameterError("initial_states: expected finite values")
-    y0 = np.broadcast_to(y0, (batch.size, size))
-    max_speed = float(np.max(np.abs(speeds)))
-    chosen = choose_method(batch, max_speed) if method == "auto" else method
-    scale = math.sqrt(batch.size)
-    rtol_eff = rtol / scale
-    atol_eff = (_absolute_tolerances(batch, rtol, max_speed, frame == "fixed") if atol is None
-                else np.broadcast_to(np.asarray(atol, dtype=float), (batch.size * size,))) / scale
-    rhs = rotating_frame_rhs if frame == "rotating" else fixed_frame_rhs
-    jacobian = rotating_frame_jacobian if frame == "rotating" else fixed_frame_jacobian
-    constant = isinstance(profile, ConstantSpeed)
-
-    def speed_at(t: float) -> tuple[float, float]:
-        if constant:
-            return profile.speed, 0.0
-        return float(profile.speed_rad_s(t)), float(profile.acceleration_rad_s2(t))
-
-    if batch.size == 1:
-        single = scalar_rhs(*(float(getattr(batch, name)[0]) for name in ("M", "m")), batch.n,
-                            *(float(getattr(batch, name)[0]) for name in ("R", "e", "k", "c", "D")), frame=frame)
-
-        def fun(t, y):
-            omega, alpha = speed_at(t)
-            if not (math.isfinite(omega) and math.isfinite(alpha)):
-                raise ParameterError(f"speed profile is not finite at t = {t!r} s: expected finite values")
-            return single(y, omega, alpha)
-    else:
-        def fun(t, y):
-            omega, alpha = speed_at(t)
-            if not (math.isfinite(omega) and math.isfinite(alpha)):
-                raise ParameterError(f"speed profile is not finite at t = {t!r} s: expected finite values")
-            return rhs(y.reshape(batch.size, size), batch, omega, alpha).reshape(-1)
-
-    options: dict[str, Any] = {}
-    if chosen in ("LSODA", "Radau", "BDF"):
-        def jac(t, y):
-            omega, alpha = speed_at(t)
-            blocks = jacobian(y.reshape(batch.size, size), batch, omega, alpha)
-            if chosen == "LSODA" and batch.size > 1:
-                return _banded(blocks)
-            if batch.size == 1:
-                return blocks[0]
-            from scipy.sparse import block_diag
-
-            return block_diag(list(blocks), format="csc")
-
-        options["jac"] = jac
-        if chosen == "LSODA" and batch.size > 1:
-            options["lband"] = options["uband"] = size - 1
-    solution = solve_ivp(fun, (times[0], times[-1]), y0.reshape(-1), method=chosen, t_eval=times,
-                         rtol=rtol_eff, atol=atol_eff, **options)
-    if solution.status != 0:
-        raise ParameterError(f"integration failed ({chosen}): {solution.message}")
-    states = solution.y.reshape(batch.size, size, -1).transpose(0, 2, 1)
-    return IntegrationResult(
-        time_s=solution.t, states=states, frame=frame, method=chosen,
-        n_function_evaluations=int(solution.nfev), n_jacobian_evaluations=int(solution.njev), rtol=rtol_eff,
-    )
-
-
-# --------------------------------------------------------------------------- analysis
-
-
-def _wrap(angle):
-    return np.angle(np.exp(1j * angle))
-
-
-def _outside_tolerance(params: ADBParameters, angles: np.ndarray, tolerance: float) -> np.ndarray:
-    """Per sample: whether the balls are outside the settling tolerance. angles: (T, n)."""
-    if params.n == 2 and params.can_balance:
-        target = balanced_ball_angles(params)
-        limit = tolerance * abs(target[0])
-        straight = np.max(np.abs(_wrap(angles - target)), axis=-1)
-        swapped = np.max(np.abs(_wrap(angles - target[::-1])), axis=-1)
-        return np.minimum(straight, swapped) > limit
-    a = params.unbalance_ratio
-    residual = np.abs(a + np.sum(np.exp(1j * angles), axis=-1))
-    return residual > tolerance * (a if a > 0 else 1.0)
-
-
-def settling_time(params: ADBParameters, time_s, ball_angles_rad, tolerance: float = 0.01) -> float:
-    """Time after which the balls stay within ``tolerance`` of a balanced configuration (s).
-
-    Parameters
-    ----------
-    params : ADBParameters
-        Parameters.
-    time_s : ndarray, shape (T,)
-        Sample times (s).
-    ball_angles_rad : ndarray, shape (T, n)
-        Ball angles relative to the unbalance (rad).
-    tolerance : float
-        Relative tolerance (see the module notes).
-
-    Returns
-    -------
-    float
-        The last exit time, interpolated linearly between samples; 0 if never outside;
-        ``inf`` if still outside at the last sample or if balancing is impossible.
-    """
-    if not params.can_balance:
-        return math.inf
-    outside = _outside_tolerance(params, np.asarray(ball_angles_rad), tolerance)
-    if outside[-1]:
-        return math.inf
-    if not np.any(outside):
-        return 0.0
-    last = int(np.nonzero(outside)[0][-1])
-    return float(0.5 * (time_s[last] + time_s[last + 1]))
-
-
-def classify_final_state(params: ADBParameters, time_s, ball_angles_rad, ball_rates_rad_s,
-                         *, window_start_s: float, final_speed_rad_s: float, tolerance: float = 0.01
-                         ) -> tuple[str, np.ndarray]:
-    """Classify the end of a run and return the balls' mean slip rates over the window.
-
-    Classes: ``"balanced"`` (within ``tolerance`` of a balanced configuration throughout
-    the window); ``"whirl"`` (non-synchronous: some ball slips by more than 0.5 rad over
-    the window at a steady rate: its mean rates over the two halves of the window of one
-    sign and within a factor 2); ``"locked"`` (throughout the window every
-    ball is within ``LOCK_TOLERANCE_RAD`` of an unbalanced equilibrium at the final speed,
-    balls together on the deflection line, and ``|phi'| < 0.05 omega_n``); else
-    ``"transient"`` (still settling: lengthen the run).
-
-    Parameters
-    ----------
-    params : ADBParameters
-        Parameters.
-    time_s : ndarray, shape (T,)
-        Sample times (s).
-    ball_angles_rad, ball_rates_rad_s : ndarray, shape (T, n)
-        Relative ball angles (rad) and rates (rad/s).
-    window_start_s : float
-        Start of the final window (s).
-    final_speed_rad_s : float
-        Shaft speed at the end of the run (rad/s), for the unbalanced equilibria.
-    tolerance : float
-        Settling tolerance.
-
-    Returns
-    -------
-    (str, ndarray)
-        Class name and mean relative rate of each ball over the window (rad/s).
-    """
-    window = time_s >= window_start_s
-    if np.count_nonzero(window) < 2:
-        window = np.zeros_like(window)
-        window[-2:] = True
-    angles, rates, t = ball_angles_rad[window], ball_rates_rad_s[window], time_s[window]
-    drift = angles[-1] - angles[0]
-    slip = drift / (t[-1] - t[0])
-    if params.can_balance and not np.any(_outside_tolerance(params, angles, tolerance)):
-        return "balanced", slip
-    middle = len(t) // 2
-    first = (angles[middle] - angles[0]) / (t[middle] - t[0])
-    second = (angles[-1] - angles[middle]) / (t[-1] - t[middle])
-    steady = (first * second > 0) & (np.abs(second) >= 0.5 * np.abs(first)) & (np.abs(second) <= 2 * np.abs(first))
-    if np.any((np.abs(drift) > 0.5) & steady):
-        return "whirl", slip
-    if final_speed_rad_s and np.max(np.abs(rates)) < 0.05 * params.natural_frequency_rad_s:
-        for state, p in unbalanced_states(params, abs(final_speed_rad_s)):
-            gamma = state[2]
-            near_gamma = np.abs(_wrap(angles - gamma)) < LOCK_TOLERANCE_RAD
-            near_opposite = np.abs(_wrap(angles - gamma - math.pi)) < LOCK_TOLERANCE_RAD
-            if np.all(near_gamma | near_opposite) and np.all(np.sum(near_gamma, axis=-1) == p):
-                return "locked", slip
-    return "transient", slip
 
 
 @dataclass(frozen=True, slots=True)
