@@ -322,3 +322,20 @@ def test_clamped_balls_during_run_up():
     # held: ~0.045 R), and after release (supercritical) the balls balance
     assert np.max(held.amplitude_m) < np.max(free.amplitude_m) / 3
     assert held.final_state == "balanced" and held.settled
+
+
+def test_batch_run_up_and_implicit_methods_match_single_runs():
+    # Fixed-frame batch (speed profile) and the sparse block-diagonal Jacobian path (BDF):
+    # each member must match its single run to well within 1e-6 of the amplitude (rtol 1e-9).
+    members = [S1, S1.replace(D=3e-3)]
+    profile = LinearRunUp(0.0, 2 * WN, 0.3)
+    batch = simulate_batch(members, profile, 0.3, n_samples=61)
+    implicit = simulate_batch(members, 2 * WN, 0.05, n_samples=26, method="BDF")
+    explicit = simulate_batch(members, 2 * WN, 0.05, n_samples=26)
+    assert implicit.method == "BDF" and explicit.method == "DOP853"
+    for index, member in enumerate(members):
+        single = simulate(member, profile, 0.3, n_samples=61, compare_without_balls=False)
+        scale = np.max(single.amplitude_m)
+        assert np.max(np.abs(batch.rotor_x_m[index] - single.rotor_x_m)) < 1e-6 * scale
+        assert np.max(np.abs(implicit.rotor_y_m[index] - explicit.rotor_y_m[index])) < 1e-6 * np.max(
+            np.abs(explicit.rotor_y_m[index]))
