@@ -7,6 +7,7 @@ SI units and radians throughout; nondimensional groups use ``omega_n = sqrt(k / 
 """
 from __future__ import annotations
 
+from .analysis import classify_final_state, settling_time
 from .drag import AIR, LIGHT_OIL, WATER, BallDrag, Fluid, ball_drag, drag_coefficient, flow_regime
 from .equilibria import (
     Equilibrium,
@@ -16,13 +17,11 @@ from .equilibria import (
     symmetric_spacing_rad,
     unbalanced_states,
 )
+from .integrate import IntegrationResult, choose_method, integrate
 from .linear import EigenAnalysis, eigen_analysis
 from .parameters import ADBParameters, ParameterBatch, ParameterStd, identified_std
-from .analysis import classify_final_state, settling_time
-from .integrate import IntegrationResult, choose_method, integrate
 from .simulate import BatchSimulationResult, SimulationResult, default_initial_ball_angles, simulate, simulate_batch
 from .speed import CallableSpeed, ConstantSpeed, LinearRunUp, SpeedProfile
-from .studies import SettlingStudy, settling_study
 from .stability import (
     BalancedStability,
     RouthHurwitzResult,
@@ -38,6 +37,7 @@ from .stability import (
     stable_speed_intervals,
     threshold_sensitivity,
 )
+from .studies import SettlingStudy, settling_study
 
 __all__ = [
     "ADBParameters",
