@@ -133,7 +133,7 @@ def bench_batch(count: int, loop_subset: int, repeats: int) -> None:
         error = float(np.max(np.abs(states[..., :2] - reference[subset][..., :2])))
         scaled = elapsed * count / len(subset)
         rows[("loop", rtol)] = (scaled, error)
-        print(f"{'loop of plain solve_ivp (' + str(len(subset)) + ' timed, scaled to ' + str(count) + ')':<52}"
+        print(f"{'loop of plain solve_ivp (' + str(len(subset)) + ' timed once, x' + str(count // len(subset)) + ')':<52}"
               f"{rtol:>8.0e}{scaled:>11.2f}{error:>17.2e}{evals // len(subset):>9}")
     loop_errors = np.log([rows[("loop", r)][1] for r in (1e-6, 1e-8, 1e-10)])
     loop_times = np.log([rows[("loop", r)][0] for r in (1e-6, 1e-8, 1e-10)])
