@@ -145,3 +145,17 @@ def test_analytic_elimination_matches_full_mass_matrix(n):
         # same equations, different algebra (LU vs Cramer on the Schur complement):
         # agreement to ~1e-12 relative to the largest acceleration
         assert np.allclose(fast, slow, rtol=1e-11, atol=1e-11 * np.max(np.abs(slow)))
+
+
+def test_equilibria_of_random_parameter_sets_are_fixed_points():
+    # 30 random sets (n = 1-6, a up to n, speeds 0.2-8 omega_n): every equilibrium found, balanced
+    # or not, makes the scaled right-hand side vanish to rounding.
+    rng = np.random.default_rng(2024)
+    for _ in range(30):
+        n = int(rng.integers(1, 7))
+        p = ADBParameters.from_nondimensional(
+            n=n, mass_ratio=float(rng.uniform(0.002, 0.8 / (n + 1))), unbalance_ratio=float(rng.uniform(0.0, n)),
+            damping_ratio=float(10 ** rng.uniform(-3, 0)), drag_ratio=float(10 ** rng.uniform(-3, 2)),
+        )
+        for eq in find_equilibria(p, float(rng.uniform(0.2, 8.0)) * p.natural_frequency_rad_s):
+            assert eq.rhs_norm < 1e-12, (n, eq.kind)
