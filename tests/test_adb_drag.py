@@ -78,3 +78,19 @@ def test_drag_grows_with_slip_beyond_stokes():
     result = ball_drag(WATER, 0.008, 0.028, np.geomspace(1, 100, 20))
     assert np.all(np.diff(result.drag_n_m_s) > 0)
     assert np.all(result.drag_n_m_s > result.stokes_drag_n_m_s)
+
+
+def test_parameters_with_fluid_drag():
+    from balancer.adb import ADBParameters, stable_speed_intervals, with_fluid_drag
+
+    p = ADBParameters(M=1.0, m=0.02, n=2, R=0.05, e=0.5e-3, k=1e4, c=20.0, D=1e-3)
+    oil, drag = with_fluid_drag(p, LIGHT_OIL, 0.017)  # Stokes limit: 3 pi mu d R^2
+    assert oil.D == pytest.approx(3 * math.pi * 0.03 * 0.017 * 0.05**2, rel=1e-14)
+    assert drag.regime == ("stokes",) and oil.replace(D=p.D) == p
+    # 20 g steel balls (d = 17 mm) in light oil: beta = 0.0025, far below the reference's 0.20, so
+    # (finding 2) the balanced state becomes stable only at a higher speed
+    wn = p.natural_frequency_rad_s
+    assert oil.drag_ratio == pytest.approx(0.00245, abs=1e-5)
+    assert stable_speed_intervals(oil, 10 * wn)[0][0] > stable_speed_intervals(p, 10 * wn)[0][0]
+    air, air_drag = with_fluid_drag(p, AIR, 0.017, slip_rate_rad_s=50.0)  # Re = 2.8e3
+    assert air_drag.regime == ("newton",) and air.D < 1e-6

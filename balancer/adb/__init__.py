@@ -8,7 +8,7 @@ SI units and radians throughout; nondimensional groups use ``omega_n = sqrt(k / 
 from __future__ import annotations
 
 from .analysis import classify_final_state, settling_time
-from .drag import AIR, LIGHT_OIL, WATER, BallDrag, Fluid, ball_drag, drag_coefficient, flow_regime
+from .drag import AIR, LIGHT_OIL, WATER, BallDrag, Fluid, ball_drag, drag_coefficient, flow_regime, with_fluid_drag
 from .equilibria import (
     Equilibrium,
     balanced_ball_angles,
@@ -87,6 +87,7 @@ __all__ = [
     "ball_drag",
     "drag_coefficient",
     "flow_regime",
+    "with_fluid_drag",
     "SettlingStudy",
     "settling_study",
 ]

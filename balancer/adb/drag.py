@@ -37,6 +37,7 @@ __all__ = [
     "drag_coefficient",
     "flow_regime",
     "ball_drag",
+    "with_fluid_drag",
 ]
 
 CORRELATIONS = ("turton_levenspiel", "abraham", "stokes")
@@ -204,3 +205,29 @@ def ball_drag(fluid: Fluid, ball_diameter_m: float, race_radius_m: float, slip_r
         regime=tuple(flow_regime(float(re)) for re in reynolds), slip_rate_rad_s=slip,
         correlation=correlation, fluid_name=fluid.name,
     )
+
+
+def with_fluid_drag(params, fluid: Fluid, ball_diameter_m: float, slip_rate_rad_s: float = 0.0,
+                    correlation: str = "turton_levenspiel"):
+    """Parameters whose ball drag ``D`` comes from a fluid at a representative slip rate.
+
+    Parameters
+    ----------
+    params : ADBParameters
+        Parameters whose ``D`` is replaced (``R`` is used as the race radius).
+    fluid : Fluid
+        Fluid in the race.
+    ball_diameter_m : float
+        Ball diameter (m).
+    slip_rate_rad_s : float
+        Representative ball rate relative to the race (rad/s); 0 gives the Stokes limit.
+    correlation : {"turton_levenspiel", "abraham", "stokes"}
+        Drag-coefficient correlation.
+
+    Returns
+    -------
+    (ADBParameters, BallDrag)
+        The new parameters and the drag computation (Reynolds number, regime).
+    """
+    drag = ball_drag(fluid, ball_diameter_m, params.R, [slip_rate_rad_s], correlation)
+    return params.replace(D=float(drag.drag_n_m_s[0])), drag
