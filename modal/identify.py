@@ -22,6 +22,9 @@ CHI2_LIMIT = 3.0
 REL_STD_LIMIT = 0.1
 #: channels (strongest first) used for the NLS start values
 START_CHANNELS = 8
+#: half-power and circle fits: the pole comes from at most this many strongest channels;
+#: the other channels' modal constants are solved linearly with that pole
+POLE_CHANNELS = 32
 _RESOLUTION_FLAGS = {"resolution_limited", "missing_crossing", "too_few_points"}
 
 
@@ -61,6 +64,20 @@ def _linear_constants(omega, h, power, wn, zeta):
     noise_var = np.sum(np.abs(res) ** 2, axis=0) / dof
     gram_inv = np.linalg.inv(Phi.conj().T @ Phi)
     return coef[0], noise_var * np.real(gram_inv[0, 0]), float(np.linalg.norm(res) ** 2)
+
+
+def _constants_near_pole(frf, band, power, wn, zeta):
+    """Modal constant of every channel for a known pole: least squares over the lines within
+    ±2 half-power widths of it (at least the 5 nearest), with a complex offset."""
+    omega, h = _mode_arrays(frf, band)
+    near = np.abs(omega - wn) <= 2 * zeta * wn * 2
+    if near.sum() < 5:
+        near = np.zeros(omega.size, bool)
+        near[np.argsort(np.abs(omega - wn))[:min(5, omega.size)]] = True
+    phi = mode_basis(omega[near], wn, zeta, power)[0]
+    basis = np.column_stack([phi, np.ones_like(phi)])
+    coef, *_ = np.linalg.lstsq(basis, h[:, near].T, rcond=None)
+    return coef[0]
 
 
 def _mode_arrays(frf, band: ModeBand):
@@ -250,7 +267,14 @@ def identify(frf: FRF, method: str = "nls", bands_hz=None, *, noise_std=None, dr
     per_mode = []  # (wn, zeta, const (n_ch,), cov (n_ch,4,4) or None, std_wn, std_z, flags, quality, chi2)
     if method in ("halfpower", "circle"):
         for band in bands:
-            wn, zeta, s_wn, s_z, const, flags, q = _sdof_estimates(frf, band, power, noise, method)
+            strongest = None
+            if n_ch > POLE_CHANNELS:
+                strongest = np.argsort(_channel_weights(frf, band, noise))[::-1][:POLE_CHANNELS]
+            wn, zeta, s_wn, s_z, const, flags, q = _sdof_estimates(frf, band, power, noise, method, strongest)
+            missing = ~np.isfinite(const)
+            if missing.any() and np.isfinite(wn) and np.isfinite(zeta):
+                const = const.copy()
+                const[missing] = _constants_near_pole(frf, band, power, wn, zeta)[missing]
             cov = np.zeros((n_ch, 4, 4))
             cov[:, 0, 0], cov[:, 1, 1] = s_wn**2, s_z**2
             omega, h = _mode_arrays(frf, band)

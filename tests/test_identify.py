@@ -191,3 +191,16 @@ def test_bad_arguments():
         identify(frf, bands_hz=[100.0])
     with pytest.raises(modal.IdentificationError, match="no resonance"):
         identify(modal.FRF(np.linspace(1, 10, 50), np.ones(50)))
+
+
+@pytest.mark.parametrize("method", ["circle", "halfpower"])
+def test_many_channels_every_modal_constant(method):
+    # 40 channels (> POLE_CHANNELS): the pole from the strongest, the others solved linearly
+    rng = np.random.default_rng(7)
+    A = rng.uniform(0.2, 2.0, (40, 3))
+    frf = modal_frf(np.linspace(10, 400, 4001), THREE_FN, THREE_ZETA, A, kind="mobility")
+    result = identify(frf, method)
+    for r, mode in enumerate(result):
+        assert mode.modal_constant.shape == (40,)
+        # exact data; neighbours bend each mode's circle by ~1e-2 (see test_three_separated_modes)
+        np.testing.assert_allclose(np.abs(mode.modal_constant), A[:, r], rtol=5e-2)
