@@ -1,0 +1,441 @@
+"""Stress: identification over random modal parameters (hypothesis property tests).
+
+The cases span damping 1e-5 … 0.5, natural frequencies 0.1 Hz … 100 kHz,
+k 1 … 1e10 N/m and m 1e-4 … 1e4 kg (driving point, A = 1/m), noise 0 … 20 % of
+max |H|, 0.05 … 1000 lines per half-power band of the narrowest mode, 1 … 8
+modes whose neighbours overlap (2ζωn / Δω) by up to 3, on uniform and jittered
+(non-uniform) frequency axes, in all three FRF kinds.
+
+Invariants checked:
+
+* ``natural_frequency_hz`` and ``damping_ratio`` of every reported mode are
+  finite; k, c and m are finite unless the mode says why (``not_driving_point``
+  or ``non_positive_constant``).
+* Every estimate (fn, ζ, m, k) lies within ``K_SIGMA`` of its own standard
+  errors of the truth, or the mode carries a flag other than
+  ``driving_point_assumed``.  The rounding floor ``RTOL_EXACT`` is added for
+  noise-free data, where the reported standard errors shrink to ~1e-16 relative
+  (they scale with the noise estimate) while the fit still stops at the LM rule.
+* Results do not depend on units: H × 1e±6 and f × 1e±3 give the same damping,
+  f scaled by the factor, and m, k scaled as the modal constant dictates.
+* The three FRF kinds give the same modes (within their combined standard errors).
+
+The stress variants (``-m stress``) draw hundreds of cases; the default run keeps a
+few derandomised examples of each so the invariants are exercised on every run.
+
+Known violations are *not* asserted here (see docs/stress.md, "Findings"):
+when automatic peak detection reports fewer modes than the FRF holds
+(unresolved or hidden neighbours) the remaining estimates can be far outside
+their standard errors without a flag, and half-power damping under noise is
+biased low beyond its standard error, and neighbouring modes bias the single-mode
+methods (circle, half-power) beyond their standard errors.  Those cases are counted with
+``hypothesis.event`` but not asserted.
+"""
+from __future__ import annotations
+
+import math
+import os
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, event, given, note, seed, settings
+from hypothesis import strategies as st
+
+import modal
+from modal import FRF, add_noise, identify, modal_frf
+from modal.frf import KIND_POWER
+
+#: accept an estimate within this many of its own standard errors of the truth
+#: (a 5-sigma Gaussian excursion has probability 6e-7 per estimate)
+K_SIGMA = 5.0
+#: relative floor for noise-free data: the LM refinement stops at a relative step of
+#: 1e-13 and exact-data tests in test_identify reproduce the truth to 1e-9
+RTOL_EXACT = 1e-9
+#: accuracy is asserted for modes this well separated (overlap 2ζωn/Δω); above it the
+#: NLS standard errors were found optimistic (finding in docs/stress.md)
+OVERLAP_ASSERTED = 0.3
+#: cap on the number of lines so that one case takes well under a second or two
+N_MAX = 3000
+N_MIN = 16
+INFO_FLAGS = {"driving_point_assumed"}
+KINDS = ("receptance", "mobility", "accelerance")
+STRESS_SEED = int(os.environ.get("STRESS_SEED", "8"))
+
+STRESS = settings(max_examples=int(os.environ.get("STRESS_EXAMPLES", "200")), deadline=None, database=None,
+                  suppress_health_check=list(HealthCheck), print_blob=True)
+FAST = settings(max_examples=5, deadline=None, database=None, derandomize=True,
+                suppress_health_check=list(HealthCheck))
+
+
+@dataclass(frozen=True)
+class Case:
+    """One synthetic test case and its truth."""
+
+    frequency_hz: np.ndarray
+    fn: np.ndarray
+    zeta: np.ndarray
+    modal_constant: np.ndarray
+    kind: str
+    noise: float
+    noise_seed: int
+    lines_per_band: float
+    uniform: bool
+    explicit_bands: bool
+
+    @property
+    def overlap(self) -> float:
+        """Largest modal overlap 2·ζ·fn / Δf between neighbours (0 for one mode)."""
+        if self.fn.size < 2:
+            return 0.0
+        width = 2 * np.maximum(self.zeta[1:] * self.fn[1:], self.zeta[:-1] * self.fn[:-1])
+        return float(np.max(width / np.diff(self.fn)))
+
+    @property
+    def mass(self) -> np.ndarray:
+        return 1.0 / self.modal_constant.real
+
+    @property
+    def stiffness(self) -> np.ndarray:
+        return self.mass * (2 * np.pi * self.fn) ** 2
+
+    def frf(self, kind: str | None = None) -> FRF:
+        clean = modal_frf(self.frequency_hz, self.fn, self.zeta, self.modal_constant, kind=kind or self.kind)
+        return add_noise(clean, self.noise, seed=self.noise_seed) if self.noise > 0 else clean
+
+    def bands(self) -> list[tuple[float, float]]:
+        """±3 half-power widths per mode, clipped halfway to the neighbours."""
+        out = []
+        for r, (f, z) in enumerate(zip(self.fn, self.zeta)):
+            lo, hi = f - 6 * z * f, f + 6 * z * f
+            if r > 0:
+                lo = max(lo, 0.5 * (self.fn[r - 1] + f))
+            if r < self.fn.size - 1:
+                hi = min(hi, 0.5 * (self.fn[r + 1] + f))
+            out.append((max(lo, self.frequency_hz[0]), min(hi, self.frequency_hz[-1])))
+        return out
+
+
+@st.composite
+def cases(draw, max_modes: int = 8, noise_max: float = 0.2, explicit: bool | None = None) -> Case:
+    """Random modal parameters, axis and noise (see the module docstring for the ranges)."""
+    n = draw(st.integers(1, max_modes))
+    f1 = 10 ** draw(st.floats(-1.0, 5.0))
+    zeta0 = 10 ** draw(st.floats(-5.0, math.log10(0.5)))
+    spread = np.array(draw(st.lists(st.floats(-0.3, 0.3), min_size=n, max_size=n)))
+    zeta = np.clip(zeta0 * 10**spread, 1e-5, 0.5)
+    overlap = 10 ** np.array(draw(st.lists(st.floats(-2.0, math.log10(3.0)), min_size=n - 1, max_size=n - 1)))
+    fn = [f1]
+    for r in range(n - 1):
+        fn.append(fn[-1] * (1 + 2 * max(zeta[r], zeta[r + 1]) / overlap[r]))
+    fn = np.array(fn)
+    if fn[-1] > 1e5:
+        fn *= 1e5 / fn[-1]
+    fn = np.maximum(fn, 0.1)
+    fn = np.maximum.accumulate(fn * (1 + 1e-9 * np.arange(n)))  # distinct when the clip merged some
+    # mass of the first mode: m in [1e-4, 1e4] kg with k = m ωn² in [1, 1e10] N/m
+    wn = 2 * np.pi * fn[0]
+    lo, hi = max(1e-4, 1 / wn**2), min(1e4, 1e10 / wn**2)
+    m = 10 ** (math.log10(lo) + draw(st.floats(0.0, 1.0)) * math.log10(hi / lo))
+    ratios = 10 ** np.array(draw(st.lists(st.floats(-1.0, 1.0), min_size=n - 1, max_size=n - 1)))
+    const = np.r_[1.0, ratios] / m
+    noise = draw(st.one_of(st.just(0.0), st.floats(0.0, noise_max)))
+    lines = 10 ** draw(st.floats(math.log10(0.05), 3.0))
+    uniform = draw(st.booleans())
+    bw = 2 * zeta * fn
+    f_lo, f_hi = max(fn[0] - 5 * bw[0], 0.05 * fn[0]), fn[-1] + 5 * bw[-1]
+    df = bw.min() / lines
+    df = min(max(df, (f_hi - f_lo) / N_MAX), (f_hi - f_lo) / N_MIN)
+    offset = draw(st.floats(0.0, 0.999))
+    if uniform:
+        f = f_lo + (np.arange(int((f_hi - f_lo) / df)) + offset) * df
+    else:
+        jitter = np.random.default_rng(draw(st.integers(0, 2**32 - 1))).uniform(0.5, 1.5, int((f_hi - f_lo) / df))
+        f = f_lo + offset * df + np.concatenate([[0.0], np.cumsum(jitter[:-1] * df)])
+    kind = draw(st.sampled_from(KINDS))
+    use_bands = draw(st.booleans()) if explicit is None else explicit
+    return Case(f, fn, zeta, const, kind, noise, draw(st.integers(0, 2**31)), float(bw.min() / df), uniform, use_bands)
+
+
+def run(case: Case, method: str = "nls", frf: FRF | None = None):
+    """identify() with the toolkit's warnings caught; None if it refused with its own error."""
+    frf = case.frf() if frf is None else frf
+    bands = case.bands() if case.explicit_bands else None
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", modal.ModalWarning)
+        try:
+            return identify(frf, method, bands_hz=bands)
+        except modal.IdentificationError as exc:  # a clear refusal is an allowed outcome
+            event(f"{method}: IdentificationError ({_reason(exc)})")
+            return None
+        except IndexError as exc:
+            if not _known_circle_fit_index_error(exc):
+                raise
+            # known bug, reported (docs/stress.md, finding 1) and pinned by
+            # test_stress_known_circle_fit_index_error below
+            event(f"{method}: known circle-fit IndexError")
+            return None
+
+
+def _reason(exc: Exception) -> str:
+    text = str(exc)
+    for key in ("no resonance", "holds", "pairs"):
+        if key in text:
+            return key
+    return text[:40]
+
+
+def _known_circle_fit_index_error(exc: IndexError) -> bool:
+    import traceback
+
+    last = traceback.extract_tb(exc.__traceback__)[-1]
+    return last.name == "circle_fit_curve" and last.filename.endswith("circlefit.py") and "out of bounds" in str(exc)
+
+
+def serious(mode) -> set[str]:
+    return set(mode.flags) - INFO_FLAGS
+
+
+def check_finite(result) -> None:
+    """No NaN/Inf in fn and ζ; k, c, m finite unless a flag says why not."""
+    for mode in result:
+        assert np.isfinite(mode.natural_frequency_hz) and mode.natural_frequency_hz > 0, mode
+        assert np.isfinite(mode.damping_ratio), mode
+        allowed_nan = {"not_driving_point", "non_positive_constant"} & set(mode.flags)
+        for name in ("stiffness_n_per_m", "damping_n_s_per_m", "mass_kg"):
+            value = np.asarray(getattr(mode, name))
+            assert np.all(np.isfinite(value)) or allowed_nan, (name, value, mode.flags)
+
+
+def within(estimate: float, truth: float, std: float) -> bool:
+    """|estimate − truth| ≤ K_SIGMA·std + RTOL_EXACT·|truth| (NaN std never passes)."""
+    return bool(abs(estimate - truth) <= K_SIGMA * std + RTOL_EXACT * abs(truth))
+
+
+def check_accuracy(case: Case, result) -> None:
+    """Each estimate within K_SIGMA standard errors of the truth, or flagged."""
+    if case.overlap > OVERLAP_ASSERTED:
+        event("overlapping modes: accuracy not asserted")
+        return
+    if len(result) != case.fn.size:
+        # finding (docs/stress.md): with modes missing the others may be biased unflagged
+        event("modes missing: accuracy not asserted")
+        return
+    event("all modes reported")
+    for r, mode in enumerate(result):
+        if serious(mode):
+            event("flagged")
+            continue
+        s = mode.std
+        checks = {
+            "natural_frequency_hz": within(mode.natural_frequency_hz, case.fn[r], s.natural_frequency_hz),
+            "damping_ratio": within(mode.damping_ratio, case.zeta[r], s.damping_ratio),
+            "mass_kg": within(float(mode.mass_kg), case.mass[r], float(s.mass_kg)),
+            "stiffness_n_per_m": within(float(mode.stiffness_n_per_m), case.stiffness[r], float(s.stiffness_n_per_m)),
+        }
+        bad = [name for name, ok in checks.items() if not ok]
+        assert not bad, (f"mode {r} unflagged and outside {K_SIGMA} sigma in {bad}: "
+                         f"fn {mode.natural_frequency_hz!r} vs {case.fn[r]!r} (std {s.natural_frequency_hz:.3g}); "
+                         f"zeta {mode.damping_ratio!r} vs {case.zeta[r]!r} (std {s.damping_ratio:.3g}); "
+                         f"m {mode.mass_kg!r} vs {case.mass[r]!r} (std {s.mass_kg:.3g})")
+
+
+def describe(case: Case) -> None:
+    note(f"kind={case.kind} modes={case.fn.size} fn={case.fn.tolist()} zeta={case.zeta.tolist()} "
+         f"A={case.modal_constant.real.tolist()} noise={case.noise:.4g} L={case.lines_per_band:.4g} "
+         f"lines={case.frequency_hz.size} uniform={case.uniform} bands={case.explicit_bands}")
+
+
+# --------------------------------------------------------------------------- finite + accurate
+def _nls_property(case: Case) -> None:
+    describe(case)
+    result = run(case, "nls")
+    if result is not None:
+        check_finite(result)
+        check_accuracy(case, result)
+
+
+def _circle_property(case: Case) -> None:
+    describe(case)
+    result = run(case, "circle")
+    if result is None:
+        return
+    check_finite(result)
+    if case.fn.size == 1:
+        check_accuracy(case, result)
+    else:
+        # finding (docs/stress.md): a neighbour bends the circle; the bias exceeds the
+        # standard errors without a flag
+        event("circle with several modes: accuracy not asserted")
+
+
+def _halfpower_property(case: Case) -> None:
+    describe(case)
+    result = run(case, "halfpower")
+    if result is None:
+        return
+    check_finite(result)
+    if case.noise == 0 and case.fn.size == 1:
+        check_accuracy(case, result)
+    else:
+        # finding (docs/stress.md): the noisy maximum raises the -3 dB level, biasing ζ low
+        event("halfpower with noise: accuracy not asserted")
+
+
+@pytest.mark.stress
+@seed(STRESS_SEED)
+@STRESS
+@given(cases())
+def test_stress_nls_finite_and_within_sigma_or_flagged(case):
+    _nls_property(case)
+
+
+@FAST
+@given(cases(max_modes=3))
+def test_nls_finite_and_within_sigma_or_flagged(case):
+    _nls_property(case)
+
+
+@pytest.mark.stress
+@seed(STRESS_SEED + 1)
+@STRESS
+@given(cases())
+def test_stress_circle_finite_and_within_sigma_or_flagged(case):
+    _circle_property(case)
+
+
+@FAST
+@given(cases(max_modes=2))
+def test_circle_finite_and_within_sigma_or_flagged(case):
+    _circle_property(case)
+
+
+@pytest.mark.stress
+@seed(STRESS_SEED + 2)
+@STRESS
+@given(cases())
+def test_stress_halfpower_finite_and_within_sigma_or_flagged(case):
+    _halfpower_property(case)
+
+
+@FAST
+@given(cases(max_modes=1))
+def test_halfpower_finite_and_within_sigma_or_flagged(case):
+    _halfpower_property(case)
+
+
+# --------------------------------------------------------------------------- units
+#: scale-equivariance is exact in real arithmetic; decimal factors are not powers of
+#: two, so each line is rounded (1e-16) and the LM iterations take a different path to
+#: the same minimum, stopping at a relative step of 1e-13 — 1e-7 leaves a wide margin
+#: yet is far below any physical difference
+RTOL_UNITS = 1e-7
+
+
+def _units_property(case: Case, s_h: float, s_f: float) -> None:
+    describe(case)
+    note(f"H x {s_h:g}, f x {s_f:g}")
+    frf = case.frf()
+    scaled = FRF(frf.frequency_hz * s_f, frf.response * s_h, kind=frf.kind)
+    base = run(case, "nls", frf)
+    scaled_case = Case(case.frequency_hz * s_f, case.fn * s_f, case.zeta, case.modal_constant, case.kind,
+                       case.noise, case.noise_seed, case.lines_per_band, case.uniform, case.explicit_bands)
+    other = run(scaled_case, "nls", scaled)
+    assert (base is None) == (other is None), "one scale was refused and the other not"
+    if base is None:
+        return
+    assert len(base) == len(other)
+    p = KIND_POWER[case.kind]
+    # H = (iω)^p A / (ωn² − ω² + 2iζωnω): A' = s_h s_f^(2−p) A, m = 1/|A|, k = m ωn²
+    m_factor = 1.0 / (s_h * s_f ** (2 - p))
+    k_factor = s_f**p / s_h
+    for a, b in zip(base, other):
+        if {"did_not_converge"} & (set(a.flags) | set(b.flags)):
+            event("units: did_not_converge (different stopping point allowed)")
+            continue
+        tol_z = RTOL_UNITS * a.damping_ratio + 1e-3 * a.std.damping_ratio
+        assert abs(b.damping_ratio - a.damping_ratio) <= tol_z, (a.damping_ratio, b.damping_ratio)
+        tol_f = RTOL_UNITS * a.natural_frequency_hz + 1e-3 * a.std.natural_frequency_hz
+        assert abs(b.natural_frequency_hz / s_f - a.natural_frequency_hz) <= tol_f
+        for name, factor in (("mass_kg", m_factor), ("stiffness_n_per_m", k_factor)):
+            va, vb = float(getattr(a, name)), float(getattr(b, name))
+            if np.isfinite(va):
+                sa = float(getattr(a.std, name))
+                assert abs(vb / factor - va) <= RTOL_UNITS * abs(va) + 1e-3 * sa, (name, va, vb / factor)
+            else:
+                assert not np.isfinite(vb)
+        assert serious(a) == serious(b) or (serious(a) ^ serious(b)) <= {"high_uncertainty", "model_inadequate"}, (
+            a.flags, b.flags)
+
+
+SCALES = st.tuples(st.sampled_from([1e-6, 1e6]), st.sampled_from([1e-3, 1e3]))
+
+
+@pytest.mark.stress
+@seed(STRESS_SEED + 3)
+@STRESS
+@given(cases(), SCALES)
+def test_stress_results_do_not_depend_on_units(case, scales):
+    _units_property(case, *scales)
+
+
+@FAST
+@given(cases(max_modes=2), SCALES)
+def test_results_do_not_depend_on_units(case, scales):
+    _units_property(case, *scales)
+
+
+# --------------------------------------------------------------------------- kinds
+def _kinds_property(case: Case) -> None:
+    describe(case)
+    found = {}
+    for kind in KINDS:
+        found[kind] = run(case, "nls", case.frf(kind))
+    if any(r is None for r in found.values()) or len({len(r) for r in found.values()}) != 1:
+        event("kinds: a kind refused or found a different number of modes (not asserted)")
+        return
+    if len(found["receptance"]) != case.fn.size:
+        event("kinds: modes missing (not asserted)")
+        return
+    for modes in zip(*found.values()):
+        if any(serious(m) for m in modes):
+            continue
+        for a in modes:
+            for b in modes:
+                s_f = math.hypot(a.std.natural_frequency_hz, b.std.natural_frequency_hz)
+                s_z = math.hypot(a.std.damping_ratio, b.std.damping_ratio)
+                # two estimates of the same truth: their difference has the combined std
+                assert abs(a.natural_frequency_hz - b.natural_frequency_hz) <= (
+                    K_SIGMA * s_f + RTOL_EXACT * a.natural_frequency_hz), (a, b)
+                assert abs(a.damping_ratio - b.damping_ratio) <= K_SIGMA * s_z + RTOL_EXACT * a.damping_ratio, (a, b)
+
+
+@pytest.mark.stress
+@seed(STRESS_SEED + 4)
+@STRESS
+@given(cases())
+def test_stress_three_kinds_give_the_same_modes(case):
+    _kinds_property(case)
+
+
+@FAST
+@given(cases(max_modes=2))
+def test_three_kinds_give_the_same_modes(case):
+    _kinds_property(case)
+
+
+# --------------------------------------------------------------------------- known failures
+@pytest.mark.stress
+@pytest.mark.xfail(raises=IndexError, strict=True,
+                   reason="circle_fit_curve indexes the selected lines with a full-band index when the "
+                          "angle fit fails and the pole leaves the lines (docs/stress.md, finding 1); "
+                          "remove this marker once fixed")
+def test_stress_known_circle_fit_index_error():
+    f = 0.47670089 + 0.10465982 * np.arange(77)
+    frf = add_noise(modal_frf(f, [1.0, 1.2, 1.44, 4.32], [0.05232991, 0.1, 0.1, 0.1], [39.4784176] * 4), 0.03125,
+                    seed=0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", modal.ModalWarning)
+        result = identify(frf, "circle", bands_hz=[(2.88, 6.912)])
+    assert np.isfinite(result[0].natural_frequency_hz)
