@@ -66,18 +66,19 @@ def _linear_constants(omega, h, power, wn, zeta):
     return coef[0], noise_var * np.real(gram_inv[0, 0]), float(np.linalg.norm(res) ** 2)
 
 
-def _constants_near_pole(frf, band, power, wn, zeta):
-    """Modal constant of every channel for a known pole: least squares over the lines within
-    ±2 half-power widths of it (at least the 5 nearest), with a complex offset."""
-    omega, h = _mode_arrays(frf, band)
-    near = np.abs(omega - wn) <= 2 * zeta * wn * 2
-    if near.sum() < 5:
-        near = np.zeros(omega.size, bool)
-        near[np.argsort(np.abs(omega - wn))[:min(5, omega.size)]] = True
-    phi = mode_basis(omega[near], wn, zeta, power)[0]
-    basis = np.column_stack([phi, np.ones_like(phi)])
-    coef, *_ = np.linalg.lstsq(basis, h[:, near].T, rcond=None)
-    return coef[0]
+def _constants_all_poles(frf, bands, power, omega_n, damping_ratio):
+    """Modal constants of every channel for known poles: one linear least-squares solve
+    (all modes together, one complex offset per band region) over the lines of the bands."""
+    keep, region = _regions(bands, frf.frequency_hz)
+    omega = frf.omega_rad_s[keep]
+    ok = np.isfinite(omega_n) & np.isfinite(damping_ratio)
+    phi = mode_basis(omega, np.asarray(omega_n)[ok], np.asarray(damping_ratio)[ok], power).T
+    offsets = np.zeros((omega.size, region.max() + 1), dtype=complex)
+    offsets[np.arange(omega.size), region] = 1.0
+    coef, *_ = np.linalg.lstsq(np.hstack([phi, offsets]), frf.channels[:, keep].T, rcond=None)
+    out = np.full((len(bands), frf.n_channels), np.nan, dtype=complex)
+    out[ok] = coef[:ok.sum()]
+    return out
 
 
 def _mode_arrays(frf, band: ModeBand):
@@ -105,10 +106,7 @@ def _sdof_estimates(frf, band, power, noise, method, channels=None):
         if method == "halfpower":
             est = half_power_curve(omega, h[ch], power, noise[ch])
             wn[ch], zeta[ch], s_wn[ch], s_z[ch] = est.omega_n, est.damping_ratio, est.std_omega_n, est.std_damping_ratio
-            quality.append(est.n_above)
-            above = np.abs(h[ch]) >= np.abs(h[ch]).max() / np.sqrt(2)
-            phi = mode_basis(omega[above], est.omega_n, est.damping_ratio, power)[0]
-            const[ch] = np.vdot(phi, h[ch][above]) / np.vdot(phi, phi)
+            quality.append(est.n_above)  # constants: solved afterwards with all the poles
         else:
             if np.any(omega == 0) and power == 2:
                 omega_c, h_c = omega[omega > 0], h[ch][omega > 0]
@@ -271,16 +269,23 @@ def identify(frf: FRF, method: str = "nls", bands_hz=None, *, noise_std=None, dr
             if n_ch > POLE_CHANNELS:
                 strongest = np.argsort(_channel_weights(frf, band, noise))[::-1][:POLE_CHANNELS]
             wn, zeta, s_wn, s_z, const, flags, q = _sdof_estimates(frf, band, power, noise, method, strongest)
-            missing = ~np.isfinite(const)
-            if missing.any() and np.isfinite(wn) and np.isfinite(zeta):
-                const = const.copy()
-                const[missing] = _constants_near_pole(frf, band, power, wn, zeta)[missing]
             cov = np.zeros((n_ch, 4, 4))
             cov[:, 0, 0], cov[:, 1, 1] = s_wn**2, s_z**2
             omega, h = _mode_arrays(frf, band)
             _, var_a, _ = _linear_constants(omega, h, power, wn, zeta) if np.isfinite(wn) and np.isfinite(zeta) else (None, np.full(n_ch, np.nan), None)
             cov[:, 2, 2] = cov[:, 3, 3] = var_a / 2
             per_mode.append((wn, zeta, const, cov, s_wn, s_z, flags, q, np.nan))
+        missing = np.array([~np.isfinite(m[2]) for m in per_mode])  # (n_modes, n_ch)
+        if method == "halfpower":
+            # half-power gives poles only: every constant from one solve with all the poles
+            # (a peak-height constant ignores the neighbours' contribution)
+            missing[:] = True
+        if missing.any():
+            filled = _constants_all_poles(frf, bands, power, [m[0] for m in per_mode], [m[1] for m in per_mode])
+            for r, m in enumerate(per_mode):
+                const = m[2].copy()
+                const[missing[r]] = filled[r][missing[r]]
+                per_mode[r] = (m[0], m[1], const) + m[3:]
     else:
         starts = [_start_pole(frf, band, power, noise) for band in bands]
         keep, region = _regions(bands, frf.frequency_hz)
