@@ -230,8 +230,12 @@ def _peer_section(runs: int) -> str:
         except Exception:
             return ("### sdypy-EMA\n\nsdypy-EMA is not installed in this environment: the side-by-side run was "
                     "skipped (it is optional and not a dependency; `pip install sdypy-EMA` to include it).")
-    out = ["### sdypy-EMA side by side (LSCF poles + LSFD constants, same FRFs)\n",
-           f"Median of {runs} runs [min–max]; worst relative error over the modes it returns nearest the truth.\n",
+    version = getattr(ema, "__version__", "?")
+    out = [f"### sdypy-EMA {version} side by side (same FRFs)\n",
+           "sdypy-EMA: LSCF poles (model order 30) and the stable poles nearest the true frequencies "
+           "(`get_poles`, `select_closest_poles`; no modal constants). modalbal: `identify(frf, 'nls')`, "
+           "which also returns modal constants, k, c, m and standard errors. "
+           f"Median of {runs} runs [min–max]; worst relative error over the three modes.\n",
            "| case | tool | time | max fn err | max ζ err |", "|---|---|---|---|---|"]
     from modal import identify
 
@@ -242,7 +246,7 @@ def _peer_section(runs: int) -> str:
 
         def run_peer():
             model = ema.Model(h, freq, lower=10, upper=390, pol_order_high=30, frf_type="accelerance")
-            with contextlib.redirect_stdout(io.StringIO()):
+            with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
                 model.get_poles(show_progress=False)
                 model.select_closest_poles(list(fn))
             return model

@@ -25,7 +25,7 @@ from modal.errors import ParameterError
 from modal.units import rpm_to_rad_s
 
 STRESS_SEED = int(os.environ.get("STRESS_SEED", "8"))
-STRESS = settings(max_examples=int(os.environ.get("STRESS_EXAMPLES", "200")), deadline=None, database=None,
+STRESS = settings(max_examples=int(os.environ.get("STRESS_EXAMPLES", "1000")), deadline=None, database=None,
                   suppress_health_check=list(HealthCheck), print_blob=True)
 FAST = settings(max_examples=8, deadline=None, database=None, derandomize=True,
                 suppress_health_check=list(HealthCheck))

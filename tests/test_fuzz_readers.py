@@ -1,0 +1,540 @@
+"""Fuzzing every reader: mutated valid files give an FRF/Scene or the toolkit's own error.
+
+Seeds are small valid files written by the toolkit's own writers (UFF 58 ASCII
+and 58b binary, CSV in several layouts, MAT v5 and v7.3, HDF5) and the demo
+scene TOML.  Each input is one seed mutated by a seeded RNG (``Random(f"{fmt}:{i}")``,
+so every input is reproducible from its format and index): bit flips,
+truncation, byte insertion and deletion, line duplication and deletion, number
+mangling (NaN, Inf, huge, tiny, negative, malformed), and for the HDF5-based
+formats structural edits made with h5py (deleted or retyped datasets and
+attributes).
+
+Allowed outcomes: a valid :class:`modal.FRF` (or :class:`balancer.scene.Scene`),
+or a :class:`modal.errors.ModalError` subclass (FormatError,
+FRFValidationError, SceneError, ...).  ModalWarning warnings are allowed.
+Anything else — another exception, a hang beyond ``TIME_LIMIT_S`` — is a
+finding; the test lists each distinct one with the format and index that
+reproduce it (``python tests/test_fuzz_readers.py FORMAT INDEX OUT`` writes
+that input to OUT).
+
+The default run tries ``FAST_COUNT`` inputs per format; ``-m stress`` tries
+``STRESS_COUNT`` (10,000) per format.
+"""
+from __future__ import annotations
+
+import os
+import random
+import re
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import traceback
+import warnings
+from collections import Counter
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+os.environ.setdefault("MPLBACKEND", "Agg")
+
+import modal  # noqa: E402
+from modal.errors import ModalError, ModalWarning  # noqa: E402
+from modal.io import write_frf  # noqa: E402
+
+from conftest import SYNTHETIC  # noqa: E402
+
+FAST_COUNT = int(os.environ.get("FUZZ_FAST_COUNT", "60"))
+STRESS_COUNT = int(os.environ.get("FUZZ_STRESS_COUNT", "10000"))
+#: a reader that takes longer than this on a file of a few kB is hanging
+TIME_LIMIT_S = 20
+FORMATS = ("uff58", "uff58b", "csv", "mat", "mat73", "hdf5", "scene")
+
+
+# --------------------------------------------------------------------------- seeds
+def _seed_frf(n_channels: int, kind: str, n_lines: int = 48):
+    f = 4.0 * np.arange(n_lines)  # an even axis that UFF 58 ASCII keeps exactly
+    rng = np.random.default_rng(n_channels)
+    const = rng.standard_normal((n_channels, 2)) + 0.1j * rng.standard_normal((n_channels, 2))
+    return modal.modal_frf(f, [40.0, 130.0], [0.02, 0.03], const if n_channels > 1 else const[0], kind=kind,
+                           response_points=[f"{i + 1}+Z" for i in range(n_channels)],
+                           reference_points=["1+Z"] * n_channels)
+
+
+@dataclass
+class Seed:
+    """A valid seed file's bytes, its name and the reader hints it needs."""
+
+    name: str
+    data: bytes
+    hints: dict = field(default_factory=dict)
+
+
+#: writers stamp the time (UFF 58 date field, MAT header, HDF5 @created): the same-length
+#: stamp with every digit set to 1 keeps the seeds, hence every mutated input, reproducible
+TIMESTAMPS = re.compile(rb"\d{2}-[A-Z][a-z]{2}-\d{2} \d{2}:\d{2}:\d{2}"
+                        rb"|[A-Z][a-z]{2} [A-Z][a-z]{2} [ \d]\d \d{2}:\d{2}:\d{2} \d{4}"
+                        rb"|\d{4}-\d{2}-\d{2}T\d{2}:\d{2}:\d{2}")
+
+
+def _write(frf, suffix: str, fmt: str) -> bytes:
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / f"seed{suffix}"
+        write_frf(frf, path, format=fmt)
+        data = path.read_bytes()
+    return TIMESTAMPS.sub(lambda m: re.sub(rb"\d", b"1", m.group()), data)
+
+
+def make_seeds() -> dict[str, list[Seed]]:
+    """Valid seed files per format (every one reads back as an FRF/Scene)."""
+    one, three = _seed_frf(1, "accelerance"), _seed_frf(3, "mobility")
+    seeds: dict[str, list[Seed]] = {}
+    seeds["uff58"] = [Seed("uff58-1ch.uff", _write(one, ".uff", "uff58")),
+                      Seed("uff58-3ch.uff", _write(three, ".uff", "uff58"))]
+    seeds["uff58b"] = [Seed("uff58b-1ch.uff", _write(one, ".uff", "uff58b")),
+                       Seed("uff58b-3ch.uff", _write(three, ".uff", "uff58b"))]
+    demo = (SYNTHETIC / "demo_frf.csv").read_text().splitlines()
+    demo_head = "\n".join(demo[:80]) + "\n"
+    f = np.linspace(1.0, 100.0, 40)
+    h = one.response[:40]
+    plain = "frequency_hz,re,im\n" + "".join(f"{a:.10g},{b.real:.10g},{b.imag:.10g}\n" for a, b in zip(f, h))
+    magdeg = "f;mag;phase_deg\n" + "".join(
+        f"{a:.6f};{abs(b):.8e};{np.degrees(np.angle(b)):.6f}\n".replace(".", ",") for a, b in zip(f, h))
+    complex_column = "".join(f"{complex(b)}\n" for b in h)
+    seeds["csv"] = [
+        Seed("csv-writer-3ch.csv", _write(three, ".csv", "csv")),
+        Seed("csv-demo-head.csv", demo_head.encode()),
+        Seed("csv-plain.csv", plain.encode(), {"kind": "accelerance"}),
+        Seed("csv-magdeg-comma.csv", magdeg.encode(), {"kind": "mobility", "delimiter": ";", "decimal": ","}),
+        Seed("csv-complex-column.txt", complex_column.encode(),
+             {"kind": "accelerance", "frequency_step": 0.5, "frequency_start": 0.0}),
+    ]
+    seeds["mat"] = [Seed("mat5-1ch.mat", _write(one, ".mat", "mat")), Seed("mat5-3ch.mat", _write(three, ".mat", "mat"))]
+    seeds["mat73"] = [Seed("mat73-1ch.mat", _write(one, ".mat", "mat73")),
+                      Seed("mat73-3ch.mat", _write(three, ".mat", "mat73"))]
+    seeds["hdf5"] = [Seed("hdf5-1ch.h5", _write(one, ".h5", "hdf5")), Seed("hdf5-3ch.h5", _write(three, ".h5", "hdf5"))]
+    scene_text = (SYNTHETIC / "demo_scene.toml").read_text()
+    seeds["scene"] = [Seed("demo_scene.toml", scene_text.encode())]
+    return seeds
+
+
+# --------------------------------------------------------------------------- mutations
+NUMBER = re.compile(rb"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
+MANGLED = [b"nan", b"NaN", b"inf", b"-inf", b"1e309", b"-1e309", b"1e-320", b"0", b"-0", b"-1", b"-7",
+           b"99999999999999999999999", b"4294967296", b"2147483648", b"", b" ", b"1.2.3", b"0x1F", b"1e", b"--1",
+           b"1,5", b"\xff\xfe", b"\x00", b"9" * 400, b"3.5", b"1e5", b"-1e-5"]
+TOML_VALUES = [b'"x"', b"-1", b"0", b"1e400", b"nan", b"inf", b"true", b"[]", b"[1, 2]", b'["a", 1]', b"{}",
+               b"{ a = 1 }", b'"identified:mode9.stiffness"', b'"drive:speed"', b'"identified:mode1.nothing"',
+               b"1979-05-27", b'""', b"[[1.0, 2.0]]", b"-0.0", b"2147483648", b"99999999999999999999999"]
+
+
+def _bit_flips(data: bytes, rng: random.Random) -> bytes:
+    buf = bytearray(data)
+    for _ in range(rng.randint(1, 8)):
+        i = rng.randrange(len(buf))
+        buf[i] ^= 1 << rng.randrange(8)
+    return bytes(buf)
+
+
+def _truncate(data: bytes, rng: random.Random) -> bytes:
+    return data[: rng.randrange(len(data))]
+
+
+def _insert(data: bytes, rng: random.Random) -> bytes:
+    i = rng.randrange(len(data) + 1)
+    junk = bytes(rng.randrange(256) for _ in range(rng.randint(1, 16)))
+    if rng.random() < 0.3:
+        junk = rng.choice([b"\n", b",", b";", b"\t", b"-1\n", b"#", b"=", b"[", b'"', b"\r\n", b"e"]) * rng.randint(1, 4)
+    return data[:i] + junk + data[i:]
+
+
+def _delete(data: bytes, rng: random.Random) -> bytes:
+    i = rng.randrange(len(data))
+    return data[:i] + data[i + rng.randint(1, 16):]
+
+
+def _lines(data: bytes, rng: random.Random) -> bytes:
+    lines = data.split(b"\n")
+    i = rng.randrange(len(lines))
+    action = rng.random()
+    if action < 0.45:
+        lines.insert(i, lines[i])  # duplicate
+    elif action < 0.8:
+        del lines[i]
+    else:
+        j = rng.randrange(len(lines))
+        lines[i], lines[j] = lines[j], lines[i]
+    return b"\n".join(lines)
+
+
+def _numbers(data: bytes, rng: random.Random) -> bytes:
+    matches = list(NUMBER.finditer(data[:200_000]))
+    if not matches:
+        return _insert(data, rng)
+    m = rng.choice(matches)
+    return data[: m.start()] + rng.choice(MANGLED) + data[m.end():]
+
+
+def _toml_value(data: bytes, rng: random.Random) -> bytes:
+    lines = data.split(b"\n")
+    assigns = [i for i, ln in enumerate(lines) if b"=" in ln and not ln.lstrip().startswith(b"#")]
+    if not assigns:
+        return _lines(data, rng)
+    i = rng.choice(assigns)
+    key = lines[i].split(b"=", 1)[0]
+    if rng.random() < 0.15:
+        key = rng.choice([b"unknown_key ", b"M ", b"n ", b"file ", b"method "])
+    lines[i] = key + b"= " + rng.choice(TOML_VALUES)
+    return b"\n".join(lines)
+
+
+def _hdf5_structure(data: bytes, rng: random.Random) -> bytes:
+    """Delete or retype one dataset or attribute of an HDF5-based file (h5py)."""
+    import h5py
+
+    try:
+        return _hdf5_edit(data, rng, h5py)
+    except Exception:  # noqa: BLE001 - an earlier byte mutation left nothing h5py can edit
+        return data
+
+
+def _hdf5_edit(data: bytes, rng: random.Random, h5py) -> bytes:
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "x.h5"
+        path.write_bytes(data)
+        with h5py.File(path, "r+") as f:  # a v7.3 user block is kept by h5py
+            nodes: list[tuple[str, str | None]] = []
+            f.visititems(lambda name, obj: nodes.extend([(name, None)] + [(name, a) for a in obj.attrs]))
+            nodes += [("/", a) for a in f.attrs]
+            if not nodes:
+                return data
+            name, attr = rng.choice(nodes)
+            obj = f[name]
+            values = [np.array([np.nan, 1.0]), np.array([-1.0]), np.zeros((0,)), np.array([[1, 2], [3, 4]]), "text",
+                      np.int64(-3), np.array([1e308, -1e308]), np.arange(7.0), b"\xff\xfe", np.array([1 + 2j, np.inf])]
+            value = values[rng.randrange(len(values))]
+            if attr is not None:
+                if rng.random() < 0.4:
+                    del obj.attrs[attr]
+                else:
+                    obj.attrs[attr] = value
+            elif isinstance(obj, h5py.Dataset):
+                parent, leaf = obj.parent, name.rsplit("/", 1)[-1]
+                keep = dict(obj.attrs)
+                del parent[leaf]
+                if rng.random() < 0.7:
+                    parent[leaf] = value
+                    for k, v in keep.items():
+                        parent[leaf].attrs[k] = v
+            elif rng.random() < 0.5 and name != "/":
+                del f[name]
+        return path.read_bytes()
+
+
+BYTE_MUTATIONS: dict[str, Callable[[bytes, random.Random], bytes]] = {
+    "bit_flips": _bit_flips, "truncate": _truncate, "insert": _insert, "delete": _delete,
+    "lines": _lines, "numbers": _numbers,
+}
+
+
+def mutations_for(fmt: str) -> dict[str, Callable[[bytes, random.Random], bytes]]:
+    table = dict(BYTE_MUTATIONS)
+    if fmt in ("hdf5", "mat73"):
+        table["hdf5_structure"] = _hdf5_structure
+    if fmt == "scene":
+        table["toml_value"] = _toml_value
+    return table
+
+
+def mutated_input(seeds: dict[str, list[Seed]], fmt: str, index: int) -> tuple[Seed, str, bytes]:
+    """The ``index``-th mutated input of a format: (seed, mutation names, bytes)."""
+    rng = random.Random(f"{fmt}:{index}")
+    seed = seeds[fmt][index % len(seeds[fmt])]
+    table = mutations_for(fmt)
+    names = rng.sample(sorted(table), k=rng.choice([1, 1, 1, 2, 3]))
+    data = seed.data
+    for name in names:
+        data = table[name](data, rng) if data else data
+    return seed, "+".join(names), data
+
+
+# --------------------------------------------------------------------------- harness
+class Hang(Exception):
+    """A reader ran past TIME_LIMIT_S."""
+
+
+def _alarm(signum, frame):  # pragma: no cover - only on a hang
+    raise Hang(f"no result after {TIME_LIMIT_S} s")
+
+
+def read_any(fmt: str, path: Path, hints: dict):
+    if fmt == "scene":
+        from balancer.scene import load_scene
+
+        return load_scene(path)
+    return modal.read_frf(path, **hints)
+
+
+def _signature(exc: BaseException) -> str:
+    frames = traceback.extract_tb(exc.__traceback__)
+    ours = [fr for fr in frames if "/modal/" in fr.filename or "/balancer/" in fr.filename]
+    where = ours[-1] if ours else (frames[-1] if frames else None)
+    place = f"{Path(where.filename).name}:{where.lineno} {where.name}" if where else "?"
+    return f"{type(exc).__name__} at {place}"
+
+
+def _clean(text: str) -> str:
+    return " ".join(str(text).split())[:200]
+
+
+def _read_one(fmt: str, index: int, seed: Seed, path: Path, out) -> None:
+    """Read one input and log its outcome (``W`` lines for foreign warnings, then ``R``)."""
+    from balancer.scene import Scene
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        signal.alarm(TIME_LIMIT_S)
+        try:
+            result = read_any(fmt, path, seed.hints)
+            expected = Scene if fmt == "scene" else modal.FRF
+            if not isinstance(result, expected):
+                outcome = f"finding\treturned {type(result).__name__}\t{_clean(repr(result))}"
+            elif fmt != "scene" and not (np.all(np.isfinite(result.frequency_hz))
+                                         and np.all(np.diff(result.frequency_hz) > 0)
+                                         and np.all(np.isfinite(result.response))):
+                outcome = "finding\tinvalid FRF returned\t"
+            else:
+                outcome = "valid\t\t"
+        except ModalError as exc:
+            outcome = f"{type(exc).__name__}\t\t"
+        except Exception as exc:  # noqa: BLE001 - the finding we are looking for
+            outcome = f"finding\t{_signature(exc)}\t{_clean(exc)}"
+        finally:
+            signal.alarm(0)
+    for w in caught:
+        if not issubclass(w.category, ModalWarning):
+            out.write(f"W\t{index}\t{w.category.__name__}: {_clean(w.message)[:80]}\n")
+    out.write(f"R\t{index}\t{outcome}\n")
+    out.flush()
+
+
+def child(fmt: str, start: int, count: int, folder: Path, log: Path) -> None:
+    """Read inputs ``start..count-1`` of ``fmt``, one log line per outcome.
+
+    Runs in its own process (see :func:`fuzz`), and reads each input in a forked
+    grandchild where ``os.fork`` exists, so that a reader that kills its process (a
+    segfault in a compiled library) is recorded for that input and the run goes on.
+    ``S i`` is written before input ``i`` is read.
+    """
+    seeds = make_seeds()
+    if fmt == "scene":
+        shutil.copy(SYNTHETIC / "demo_frf.csv", folder / "demo_frf.csv")
+    import balancer.scene  # noqa: F401 - loaded once, before forking
+    import modal.io.csv, modal.io.hdf5, modal.io.mat, modal.io.uff  # noqa: E401,F401
+    signal.signal(signal.SIGALRM, _alarm)
+    forking = hasattr(os, "fork")
+    with open(log, "a", encoding="utf-8", buffering=1) as out:
+        for index in range(start, count):
+            seed, how, data = mutated_input(seeds, fmt, index)
+            path = folder / seed.name  # scene: relative file references resolve in the folder
+            path.write_bytes(data)
+            out.write(f"S\t{index}\t{how}\n")
+            out.flush()
+            if not forking:
+                _read_one(fmt, index, seed, path, out)
+                continue
+            pid = os.fork()
+            if pid == 0:  # grandchild: read, log, leave without cleanup
+                code = 0
+                try:
+                    _read_one(fmt, index, seed, path, out)
+                except BaseException:  # noqa: BLE001 - the parent records the death
+                    code = 3
+                os._exit(code)
+            _, status = os.waitpid(pid, 0)
+            if os.WIFSIGNALED(status) or os.waitstatus_to_exitcode(status) != 0:
+                code = os.waitstatus_to_exitcode(status)
+                reason = f"signal {-code}" if code < 0 else f"exit {code}"
+                out.write(f"R\t{index}\tfinding\tprocess died ({reason}) reading the input\t\n")
+                out.flush()
+
+
+@dataclass
+class Tally:
+    """Outcomes of one format's fuzz run."""
+
+    tried: int = 0
+    outcomes: Counter = field(default_factory=Counter)
+    other_warnings: Counter = field(default_factory=Counter)
+    findings: dict = field(default_factory=dict)  # signature -> [count, first index, mutation, message]
+
+    def finding(self, signature: str, index: int, how: str, message: str) -> None:
+        entry = self.findings.setdefault(signature, [0, index, how, message])
+        entry[0] += 1
+        self.outcomes["finding"] += 1
+
+
+def fuzz(fmt: str, count: int, folder: Path) -> Tally:
+    """Read ``count`` mutated inputs of ``fmt`` in child processes; classify every outcome.
+
+    A child that dies (a signal such as SIGSEGV, or an exit without a result)
+    is recorded as a finding for the input it was reading, and a new child
+    carries on with the next input.
+    """
+    tally = Tally()
+    log = folder / f"{fmt}.log"
+    start = 0
+    while start < count:
+        env = {**os.environ, "MPLBACKEND": "Agg"}
+        proc = subprocess.run([sys.executable, __file__, "--child", fmt, str(start), str(count), str(folder), str(log)],
+                              cwd=Path(__file__).resolve().parent.parent, env=env, capture_output=True, text=True,
+                              timeout=count * TIME_LIMIT_S + 120)
+        started: dict[int, str] = {}
+        done: set[int] = set()
+        for line in log.read_text(encoding="utf-8").splitlines():
+            parts = line.split("\t")
+            if parts[0] == "S":
+                started[int(parts[1])] = parts[2]
+            elif parts[0] == "R":
+                done.add(int(parts[1]))
+        missing = sorted(set(started) - done)
+        if proc.returncode == 0 and not missing:
+            break
+        if not missing:  # died before reading anything: a harness problem, not a finding
+            raise RuntimeError(f"fuzz child for {fmt} failed: {proc.stderr[-2000:]}")
+        index = missing[-1]
+        how = started[index]
+        reason = f"signal {-proc.returncode}" if proc.returncode < 0 else f"exit {proc.returncode}"
+        last = [ln for ln in proc.stderr.splitlines() if ln.strip()][-1:] or [""]
+        with open(log, "a", encoding="utf-8") as out:
+            out.write(f"R\t{index}\tfinding\tprocess died ({reason}) reading the input\t{_clean(last[0])}\n")
+        start = index + 1
+    for line in log.read_text(encoding="utf-8").splitlines():
+        parts = line.split("\t")
+        if parts[0] == "S":
+            started_how = parts[2]
+            continue
+        if parts[0] == "W":
+            tally.other_warnings[parts[2]] += 1
+        elif parts[0] == "R":
+            tally.tried += 1
+            if parts[2] == "finding":
+                tally.finding(parts[3], int(parts[1]), started_how, parts[4] if len(parts) > 4 else "")
+            else:
+                tally.outcomes[parts[2]] += 1
+    return tally
+
+
+def report(fmt: str, tally: Tally) -> str:
+    lines = [f"{fmt}: {tally.tried} inputs; outcomes {dict(tally.outcomes)}"]
+    for sig, (n, first, how, message) in sorted(tally.findings.items(), key=lambda kv: -kv[1][0]):
+        lines.append(f"  FINDING {sig}: {n} inputs, first index {first} ({how}): {message}")
+    for text, n in tally.other_warnings.most_common(5):
+        lines.append(f"  non-toolkit warning x{n}: {text}")
+    return "\n".join(lines)
+
+
+@pytest.fixture(scope="module")
+def seeds() -> dict[str, list[Seed]]:
+    made = make_seeds()
+    # every seed must itself be valid, or the fuzzing says nothing
+    with tempfile.TemporaryDirectory() as folder:
+        for fmt, items in made.items():
+            if fmt == "scene":
+                shutil.copy(SYNTHETIC / "demo_frf.csv", Path(folder) / "demo_frf.csv")
+            for seed in items:
+                path = Path(folder) / seed.name
+                path.write_bytes(seed.data)
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore", ModalWarning)
+                    assert read_any(fmt, path, seed.hints) is not None
+    return made
+
+
+def _run(fmt: str, count: int, tmp_path: Path) -> Tally:
+    tally = fuzz(fmt, count, tmp_path)
+    text = report(fmt, tally)
+    print(text)
+    assert tally.tried == count, text
+    # the mutations must reach past the first check: some inputs refused with the toolkit's error
+    assert sum(v for k, v in tally.outcomes.items() if k not in ("valid", "finding")) > 0, text
+    return tally
+
+
+#: findings already reported to the lead (docs/stress.md), tolerated here so that the
+#: fuzzing keeps running; each is pinned by a strict-xfail test below
+KNOWN_FINDINGS = {
+    # scipy.io.loadmat dies on some corrupted MAT v5 files (a char variable whose class
+    # byte says sparse, and similar); modal.io.mat calls it directly
+    "mat": ("process died (signal 11)", "process died (signal 7)"),
+}
+
+
+def _unexpected(fmt: str, tally: Tally) -> list[str]:
+    known = KNOWN_FINDINGS.get(fmt, ())
+    return [sig for sig in tally.findings if not sig.startswith(known)]
+
+
+@pytest.mark.parametrize("fmt", FORMATS)
+def test_fuzz_readers_give_frf_or_toolkit_error(fmt, seeds, tmp_path):
+    tally = _run(fmt, FAST_COUNT, tmp_path)
+    assert not _unexpected(fmt, tally), report(fmt, tally)
+
+
+@pytest.mark.stress
+@pytest.mark.parametrize("fmt", FORMATS)
+def test_stress_fuzz_readers_give_frf_or_toolkit_error(fmt, seeds, tmp_path):
+    tally = _run(fmt, STRESS_COUNT, tmp_path)
+    assert not _unexpected(fmt, tally), report(fmt, tally)
+
+
+_MAT_CRASH = """
+import numpy as np, modal
+f = 4.0 * np.arange(48)
+frf = modal.modal_frf(f, [40.0, 130.0], [0.02, 0.03], [1.0, 0.5], kind="accelerance",
+                      response_points=["1+Z"], reference_points=["1+Z"])
+path = {path!r}
+modal.write_frf(frf, path, format="mat")
+data = bytearray(open(path, "rb").read())
+name = data.index(b"units")
+flags = data.rfind(bytes([6, 0, 0, 0, 8, 0, 0, 0]), 0, name) + 8   # array-flags subelement
+assert data[flags] == 4                                               # mxCHAR_CLASS
+data[flags] = 5                                                       # mxSPARSE_CLASS
+open(path, "wb").write(bytes(data))
+try:
+    modal.read_frf(path)
+except modal.ModalError:
+    pass
+"""
+
+
+@pytest.mark.stress
+@pytest.mark.xfail(strict=True, reason="a MAT v5 file whose char variable is marked sparse kills the process inside "
+                                       "scipy.io.loadmat (SIGSEGV) instead of giving a FormatError (docs/stress.md); "
+                                       "remove this marker and KNOWN_FINDINGS['mat'] once fixed")
+def test_stress_known_mat_v5_sparse_class_crash(tmp_path):
+    proc = subprocess.run([sys.executable, "-c", _MAT_CRASH.format(path=str(tmp_path / "crash.mat"))],
+                          cwd=Path(__file__).resolve().parent.parent, capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, f"exit {proc.returncode}: {proc.stderr[-500:]}"
+
+
+def _main(argv: list[str]) -> None:
+    """``--child FMT START COUNT FOLDER LOG`` (used by :func:`fuzz`), or ``FMT INDEX OUT``
+    to write one mutated input to OUT for a bug report."""
+    if argv[0] == "--child":
+        child(argv[1], int(argv[2]), int(argv[3]), Path(argv[4]), Path(argv[5]))
+        return
+    fmt_arg, index_arg, out_arg = argv[0], int(argv[1]), Path(argv[2])
+    seed_used, how_used, data_used = mutated_input(make_seeds(), fmt_arg, index_arg)
+    out_arg.write_bytes(data_used)
+    print(f"{out_arg}: {fmt_arg} input {index_arg} = {seed_used.name} mutated by {how_used}; "
+          f"read hints {seed_used.hints}")
+
+
+if __name__ == "__main__":
+    _main(sys.argv[1:])
