@@ -923,7 +923,7 @@ def optimal_counterweight(mech: SliderCrank, speed_rpm: float, objective: Object
         objective_value_n=_objective_value(mech, omega, moment, objective),
         counterweight_moment_kg_m=moment, peak_angles_rad=np.sort(angles[active]),
         peak_forces_n=peaks[active][np.argsort(angles[active])],
-        unbalanced_max_force_n=unbalanced, reduction=1.0 - peak / unbalanced,
+        unbalanced_max_force_n=unbalanced, reduction=1.0 - peak / unbalanced if unbalanced > 0 else 0.0,
         speed_rpm=float(speed_rpm), method=method,
         curve=_optimal_curve(mech, alpha, moment, n_points))
 

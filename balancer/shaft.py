@@ -655,9 +655,15 @@ def bending_stiffness_n_per_m(geometry: ShaftGeometry, position_m: float, diamet
     x, span = float(position_m), geometry.span_m
     if layout == "between bearings":
         a, b = x - geometry.bearing_a_m, geometry.bearing_b_m - x
-        return 3.0 * ei * span / (a * a * b * b)
-    c = geometry.bearing_a_m - x if x < geometry.bearing_a_m else x - geometry.bearing_b_m
-    return 3.0 * ei / (c * c * (span + c))
+        stiffness = 3.0 * ei * span / (a * b) / (a * b)  # a*b first: a*a*b*b underflows near a bearing
+    else:
+        c = geometry.bearing_a_m - x if x < geometry.bearing_a_m else x - geometry.bearing_b_m
+        stiffness = 3.0 * ei / c / (c * (span + c))
+    if not math.isfinite(stiffness):
+        raise ParameterError(
+            f"position_m = {position_m!r} m lies (numerically) on a bearing: the shaft's stiffness there is "
+            "unbounded; expected a rotor position away from the bearings")
+    return stiffness
 
 
 def span_critical_speed_rad_s(span_m: float, diameter_m: float, youngs_modulus_pa: float = STEEL_YOUNGS_MODULUS_PA,

@@ -204,7 +204,7 @@ def circle_fit_curve(omega: np.ndarray, mobility: np.ndarray, noise_std: float) 
     if not ok:
         x_n, zeta, psi = p0
         if not (xs[0] <= x_n <= xs[-1]):
-            x_n = xs[i - sel[0]] if sel[0] <= i <= sel[-1] else x_r
+            x_n = xs[int(np.argmin(np.abs(sel - i)))]  # the selected line nearest the peak
         zeta = min(zeta, 1.0)
         flags.append("did_not_converge")
     std_x = std_z = np.nan

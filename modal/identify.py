@@ -49,8 +49,12 @@ def _combine(values, stds, weights):
     good = np.isfinite(s)
     if not good.any():
         return median, np.nan
-    # inverse-variance combination of the channel errors, times the median's 1.25 efficiency loss
-    std = float(1.2533 / np.sqrt(np.sum(1.0 / np.maximum(s[good], 1e-300) ** 2)))
+    # inverse-variance combination of the channel errors, times the median's 1.25 efficiency loss;
+    # scaled by the smallest error so that no square under- or overflows
+    smallest = float(np.min(s[good]))
+    if smallest <= 0:
+        return median, 0.0
+    std = float(1.2533 * smallest / np.sqrt(np.sum((smallest / s[good]) ** 2)))
     return median, std
 
 
