@@ -406,8 +406,16 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--only", nargs="+", choices=["identify", "io", "crank", "adb", "demo"],
                         help="run only these sections")
     parser.add_argument("--out", type=Path, default=HERE / "REPORT.md", help="report file (default benchmarks/REPORT.md)")
+    parser.add_argument("--refresh-stress", action="store_true",
+                        help="only rewrite the report's stress-run section from docs/stress.md")
     args = parser.parse_args(argv)
     os.environ.setdefault("MPLBACKEND", "Agg")
+    if args.refresh_stress:
+        text = args.out.read_text(encoding="utf-8")
+        head = text.split("\n## Stress run\n", 1)[0]
+        args.out.write_text(head + "\n## Stress run\n\n" + stress_summary() + "\n", encoding="utf-8")
+        print(f"[benchmarks] refreshed the stress section of {args.out}", file=sys.stderr)
+        return 0
     wanted = set(args.only or ["identify", "io", "crank", "adb", "demo"])
     runs = max(1, args.runs)
     started = time.perf_counter()

@@ -51,10 +51,6 @@ def mechanisms(draw) -> crank.SliderCrank:
     limit = 6 if series == "leading" else 12
     harmonics = draw(st.one_of(st.just("exact"),
                                st.sets(st.integers(1, limit), min_size=1, max_size=limit).map(tuple)))
-    if series == "leading" and harmonics != "exact" and set(harmonics) <= {3, 5} and m_rot == 0.0:
-        # leading-term series have a_3 = a_5 = 0: no shaking force at all; known
-        # ZeroDivisionError (docs/stress.md), pinned by test_stress_known_zero_unbalanced_force
-        harmonics = tuple(sorted(set(harmonics) | {1}))
     j_ab = draw(st.floats(-1e-2, 1e-2))
     return crank.SliderCrank(r, r / lam, m_rot, m_rec, harmonics=harmonics, rod_inertia_correction_kg_m2=j_ab,
                              series=series)
@@ -279,9 +275,8 @@ def shafts(draw):
     b = length - draw(st.floats(0.0, 0.45)) * length
     geometry = shaft.ShaftGeometry(length, a, b)
     n = draw(st.integers(1, 5))
-    # positions on a 1e-6 grid of the length: exact bearing hits are possible (and must be
-    # refused), sub-1e-154 m distances from a bearing are not (known ZeroDivisionError,
-    # docs/stress.md, pinned by test_stress_known_underflow_next_to_a_bearing)
+    # positions on a 1e-6 grid of the length, so that exact bearing hits occur (and must be
+    # refused); distances below 1e-154 m are covered by test_stiffness_next_to_a_bearing
     loads = [shaft.PointLoad(draw(st.integers(0, 10**6)) * 1e-6 * length, draw(st.floats(-1e5, 1e5)),
                              draw(st.floats(-1e5, 1e5))) for _ in range(n)]
     return geometry, loads
@@ -350,20 +345,15 @@ def test_invalid_shaft_loads_and_sizes_are_parameter_errors():
         shaft.span_critical_speed_rad_s(0.8, 0.0)
 
 
-# --------------------------------------------------------------------------- known failures (docs/stress.md)
-@pytest.mark.stress
-@pytest.mark.xfail(raises=ZeroDivisionError, strict=True,
-                   reason="optimal_counterweight divides by the unbalanced peak force, zero when the kept "
-                          "harmonics carry no force (leading series, harmonics (3,), m_rot = 0); remove once fixed")
-def test_stress_known_zero_unbalanced_force():
+# --------------------------------------------------------------------------- fixed findings
+def test_no_unbalanced_force_gives_a_finite_optimum():
+    """Stress finding (fixed in 5e4b387): harmonics (3,) of the leading series carry no force with
+    m_rot = 0, and the reduction divided by the zero unbalanced force."""
     opt = crank.optimal_counterweight(crank.SliderCrank(1.0, 2.0, 0.0, 1.0, harmonics=(3,)), 1000.0)
-    assert np.isfinite(opt.max_force_n)
+    assert opt.unbalanced_max_force_n == 0.0 and opt.max_force_n == 0.0 and np.isfinite(opt.reduction)
 
 
-@pytest.mark.stress
-@pytest.mark.xfail(raises=ZeroDivisionError, strict=True,
-                   reason="bending_stiffness_n_per_m: a**2 * b**2 underflows to 0 within 1e-154 m of a bearing; "
-                          "expected a ParameterError (or inf); remove once fixed")
-def test_stress_known_underflow_next_to_a_bearing():
+def test_stiffness_next_to_a_bearing():
+    """Stress finding (fixed in 5e4b387): a**2 b**2 underflowed to 0 within 1e-154 m of a bearing."""
     with pytest.raises(ParameterError):
         shaft.bending_stiffness_n_per_m(shaft.ShaftGeometry(1.0, 0.0, 1.0), 1e-200, 0.05)
