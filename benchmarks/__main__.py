@@ -346,6 +346,49 @@ def pareto_front(points: Sequence[tuple[float, float]]) -> list[tuple[float, flo
     return front
 
 
+# --------------------------------------------------------------------------- crank plot
+def crank_plot(runs: int, plots: list[str]) -> str:
+    """Excess of the true peak force over the exact optimum against run time: exact vs grids."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from benchmarks.bench_crank import MECH, SPEED_RPM
+    from balancer.crank import grid_search_counterweight, max_shaking_force, optimal_counterweight
+
+    t_exact, opt = time_runs(lambda: optimal_counterweight(MECH, SPEED_RPM), runs)
+    rows = [("exact", t_exact, 0.0)]
+    r = MECH.crank_radius_m
+    for n, step in ((11, 5.0), (21, 2.0), (51, 1.0), (101, 1.0), (201, 0.5)):
+        ks, radii = np.linspace(0, 1, n), np.linspace(0, r, n)
+        theta = np.deg2rad(np.arange(0.0, 360.0, step))
+        timing, res = time_runs(lambda: grid_search_counterweight(MECH, SPEED_RPM, ks, radii, theta),
+                                max(1, min(runs, 3)))
+        m_c = MECH.rotating_mass_kg + res.k * MECH.reciprocating_mass_kg
+        excess = max_shaking_force(MECH, SPEED_RPM, m_c, res.counterweight_radius_m) - opt.max_force_n
+        rows.append((f"grid {n}x{n}, {step:g} deg", timing, excess))
+    fig, ax = plt.subplots(figsize=(6.5, 4.2), constrained_layout=True)
+    for label, timing, excess in rows:
+        y = max(excess, 1e-12)
+        ax.errorbar(timing.median, y, xerr=[[timing.median - min(timing.samples)], [max(timing.samples) - timing.median]],
+                    fmt="o", capsize=3, label=label)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("wall time (s), median with min–max")
+    ax.set_ylabel("true peak − F* (N)  (exact drawn at 1e-12)")
+    ax.set_title(f"Counterweight optimum vs (k, r_c, θ) grids; F* = {opt.max_force_n:.6f} N", fontsize=10)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7)
+    path = HERE / "crank_error_vs_time.png"
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    plots.append(path.name)
+    lines = ["| method | time | true peak − F* (N) |", "|---|---|---|"]
+    lines += [f"| {label} | {timing.text('s')} | {excess:.2e} |" for label, timing, excess in rows]
+    return "\n".join(lines)
+
+
 # --------------------------------------------------------------------------- other modules
 def module_section(name: str, argv: list[str]) -> tuple[str, str]:
     """Run ``benchmarks.<name>.main(argv)``; (markdown, status line)."""
@@ -448,7 +491,12 @@ def main(argv: list[str] | None = None) -> int:
         sections.append(("File reading and writing (1000 channels × 2001 lines per format)",
                          run_module("bench_io", io_args)))
     if "crank" in wanted:
-        sections.append(("Counterweight optimiser against brute-force grids", run_module("bench_crank", [])))
+        body = run_module("bench_crank", [])
+        try:
+            body += "\n\nError against time (plotted in crank_error_vs_time.png):\n\n" + crank_plot(runs, plots)
+        except Exception:  # noqa: BLE001
+            body += "\n\nThe crank plot failed:\n" + fenced(traceback.format_exc(limit=3))
+        sections.append(("Counterweight optimiser against brute-force grids", body))
     if "adb" in wanted:
         if (HERE / "bench_adb.py").is_file():
             sections.append(("Ball balancer: stability map, batched simulation and stiff drag against plain solve_ivp",
