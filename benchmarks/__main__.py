@@ -231,10 +231,14 @@ def _peer_section(runs: int) -> str:
             return ("### sdypy-EMA\n\nsdypy-EMA is not installed in this environment: the side-by-side run was "
                     "skipped (it is optional and not a dependency; `pip install sdypy-EMA` to include it).")
     version = getattr(ema, "__version__", "?")
+    where = Path(getattr(ema, "__file__", "?")).resolve()
+    inside = str(where).startswith(sys.prefix)
     out = [f"### sdypy-EMA {version} side by side (same FRFs)\n",
            "sdypy-EMA: LSCF poles (model order 30) and the stable poles nearest the true frequencies "
            "(`get_poles`, `select_closest_poles`; no modal constants). modalbal: `identify(frf, 'nls')`, "
            "which also returns modal constants, k, c, m and standard errors. "
+           f"sdypy-EMA imported from {'this environment' if inside else 'a directory on PYTHONPATH outside the project environment'} "
+           "(optional, never a dependency). "
            f"Median of {runs} runs [min–max]; worst relative error over the three modes.\n",
            "| case | tool | time | max fn err | max ζ err |", "|---|---|---|---|---|"]
     from modal import identify
