@@ -45,7 +45,10 @@ _REF = re.compile(r"^(identified):mode(\d+)\.(\w+)$|^(drive):(\w+)$")
 def _num(v, *, positive=False, nonneg=False):
     if isinstance(v, bool) or not isinstance(v, (int, float)):
         raise ValueError("a number")
-    v = float(v)
+    try:
+        v = float(v)
+    except OverflowError:  # TOML integers may be arbitrarily long
+        raise ValueError("a finite number") from None
     if v != v or v in (float("inf"), float("-inf")):
         raise ValueError("a finite number")
     if positive and v <= 0:
@@ -253,7 +256,8 @@ def _validate(node: dict, schema: dict, where: str, src: str) -> dict:
             try:
                 out[key] = rule(value)
             except ValueError as exc:
-                raise SceneError(f"{src}: key '{path}' = {value!r}: expected {exc}") from None
+                shown = repr(value) if len(repr(value)) <= 60 else repr(value)[:57] + "..."
+                raise SceneError(f"{src}: key '{path}' = {shown}: expected {exc}") from None
         if isinstance(rule, dict):
             _require(value, path, path, src)
     return out

@@ -78,13 +78,26 @@ def read_frf_mat(path: str | os.PathLike, **hints: Any) -> FRF:
     return _from_variables(variables, src, hints)
 
 
+#: MATLAB classes an FRF file may hold (whosmat names)
+_V5_CLASSES = frozenset({"double", "single", "char", "cell", "logical", "int8", "uint8", "int16", "uint16",
+                         "int32", "uint32", "int64", "uint64"})
+
+
 def _load_v5(p, src: str) -> dict[str, Any]:
     import scipy.io
 
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
+            # list the variables first: loadmat can crash the process (SIGSEGV) on a damaged
+            # variable of a class we never use (e.g. a char array whose class byte says sparse)
+            for name, _shape, cls in scipy.io.whosmat(os.fspath(p), appendmat=False):
+                if cls not in _V5_CLASSES:
+                    raise FormatError(f"{src}: variable {name!r} has MATLAB class {cls!r}; expected one of "
+                                      f"{', '.join(sorted(_V5_CLASSES))} (numeric arrays, char, cell)")
             raw = scipy.io.loadmat(os.fspath(p), squeeze_me=False, chars_as_strings=True, appendmat=False)
+    except FormatError:
+        raise
     except Exception as exc:  # SciPy raises ValueError, TypeError, OSError... on damaged files
         raise FormatError(f"{src}: not a readable MATLAB v4/v5/v7 file ({type(exc).__name__}: {exc}); "
                           "expected a .mat file saved by MATLAB, Octave or SciPy") from None
