@@ -63,12 +63,28 @@ def _one_sided(u_peak: float, u_cross: float, power: int) -> tuple[float, float]
 
 
 def _refine_peak(omega, mag, i, power):
-    """Exact peak (ω², |H|²) of one viscous mode from three lines around line i."""
+    """Peak (ω², |H|²) of one viscous mode: ω^{2p}/|H|² is exactly a quadratic in ω².
+
+    Three lines around line i fix it exactly on clean data; when more lines lie
+    within 1 dB of the peak line, a least-squares fit over all of them keeps the
+    noise on the highest line (which the arg-max selects for being high) from
+    lifting the −3 dB level.
+    """
     if i == 0 or i == mag.size - 1:
         return omega[i] ** 2, mag[i] ** 2
-    u = omega[i - 1:i + 2] ** 2
-    g = u**power / mag[i - 1:i + 2] ** 2
-    a, b, c = np.linalg.solve(np.vander(u, 3), g)
+    lo, hi = i, i
+    level = mag[i] * 10 ** (-1 / 20)
+    while lo > 0 and mag[lo - 1] >= level:
+        lo -= 1
+    while hi < mag.size - 1 and mag[hi + 1] >= level:
+        hi += 1
+    lo, hi = min(lo, i - 1), max(hi, i + 1)
+    u = omega[lo:hi + 1] ** 2
+    g = u**power / mag[lo:hi + 1] ** 2
+    scale = u[len(u) // 2]
+    coef, *_ = np.linalg.lstsq(np.vander(u / scale, 3), g, rcond=None)
+    a, b, c = coef[0] / scale**2, coef[1] / scale, coef[2]
+    u = omega[i - 1:i + 2] ** 2  # the refined peak must lie between the neighbours of line i
     if power == 0:
         u_star = -b / (2 * a) if a > 0 else np.nan
     elif power == 1:
@@ -87,6 +103,25 @@ def _crossing(omega, db, level_db, j_below, j_above):
     """Frequency where the dB curve crosses ``level_db`` between two lines (linear in dB)."""
     t = (level_db - db[j_below]) / (db[j_above] - db[j_below])
     return omega[j_below] + t * (omega[j_above] - omega[j_below])
+
+
+def _fitted_crossing(omega, db, level_db, guess, window_db=1.0, min_lines=7):
+    """Refine a −3 dB crossing by least squares of a quadratic in ω over the lines within
+    ±``window_db`` of the level on one side of the peak; keeps ``guess`` when too few lines."""
+    near = np.abs(db - level_db) <= window_db
+    if near.sum() < min_lines:
+        return guess
+    w = omega[near]
+    x = (w - guess) / np.ptp(w)
+    coef = np.polyfit(x, db[near] - level_db, 2)
+    roots = np.roots(coef)
+    roots = roots[np.isreal(roots)].real
+    if roots.size == 0:
+        return guess
+    best = roots[np.argmin(np.abs(roots))]
+    if abs(best) > 0.5:  # outside the fitted lines: not a crossing of this side
+        return guess
+    return guess + best * np.ptp(w)
 
 
 def half_power_curve(omega: np.ndarray, h: np.ndarray, power: int, noise_std: float) -> HalfPowerEstimate:
@@ -124,6 +159,13 @@ def half_power_curve(omega: np.ndarray, h: np.ndarray, power: int, noise_std: fl
         flags.append("resolution_limited")
     w1 = _crossing(omega, db, level_db, lo, lo + 1) if lo >= 0 else np.nan
     w2 = _crossing(omega, db, level_db, hi, hi - 1) if hi < n else np.nan
+    # many lines across a crossing: a local quadratic fit of dB against ω averages the
+    # noise (the first line below the level is selected for being low, which narrows the band)
+    noisy = np.isfinite(noise_std) and 6.14 * noise_std / level > 0.01  # σ in dB at the level
+    if noisy and np.isfinite(w1):
+        w1 = _fitted_crossing(omega[:i + 1], db[:i + 1], level_db, w1)
+    if noisy and np.isfinite(w2):
+        w2 = _fitted_crossing(omega[i:], db[i:], level_db, w2)
     if np.isfinite(w1) and np.isfinite(w2):
         wn, zeta = invert_half_power(w1, w2, power)
     elif np.isfinite(w1) or np.isfinite(w2):
