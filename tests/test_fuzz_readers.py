@@ -468,7 +468,12 @@ def _run(fmt: str, count: int, tmp_path: Path) -> Tally:
 
 #: findings reported to the lead and not yet fixed, tolerated here (format -> signature
 #: prefixes) so that the fuzzing keeps running; each should be pinned by a strict xfail
-KNOWN_FINDINGS: dict[str, tuple[str, ...]] = {}
+KNOWN_FINDINGS: dict[str, tuple[str, ...]] = {
+    # scipy.io.loadmat still dies on some corrupted MAT v5 files after da3e38b: whosmat only
+    # checks the top-level classes, and a damaged element inside a cell crashes the parser
+    # (50 of 10 000 mutated inputs); pinned by test_stress_known_mat_v5_cell_crash
+    "mat": ("process died (signal",),
+}
 
 
 def _unexpected(fmt: str, tally: Tally) -> list[str]:
@@ -543,3 +548,34 @@ def test_scene_integer_beyond_float_range_is_a_scene_error():
 
     with pytest.raises(SceneError, match="M"):
         parse_scene({"outputs": {"tables": ["rotor"]}, "rotor": {"M": 10**400, "k": 1e4, "c": 1.0, "e": 1e-4}})
+
+
+_MAT_CELL_CRASH = """
+import numpy as np, modal
+f = 4.0 * np.arange(48)
+frf = modal.modal_frf(f, [40.0, 130.0], [0.02, 0.03], np.ones((3, 2)), kind="mobility",
+                      response_points=["1+Z", "2+Z", "3+Z"], reference_points=["1+Z"] * 3)
+path = {path!r}
+modal.write_frf(frf, path, format="mat")
+data = bytearray(open(path, "rb").read())
+text = data.index(b"3+Z", data.index(b"response_points"))
+assert data[text - 24] == 8
+data[text - 24] = 10          # the third cell's dimensions element claims 10 bytes; it holds 8
+open(path, "wb").write(bytes(data))
+try:
+    modal.read_frf(path)
+    print("read")
+except modal.ModalError as exc:
+    print(type(exc).__name__)
+"""
+
+
+@pytest.mark.stress
+@pytest.mark.xfail(strict=True, reason="a MAT v5 cell element with a wrong dimensions length kills the process inside "
+                                       "scipy.io.loadmat (SIGSEGV), past the whosmat check of da3e38b (docs/stress.md); "
+                                       "remove this marker and KNOWN_FINDINGS['mat'] once fixed")
+def test_stress_known_mat_v5_cell_crash(tmp_path):
+    proc = subprocess.run([sys.executable, "-c", _MAT_CELL_CRASH.format(path=str(tmp_path / "cell.mat"))],
+                          cwd=Path(__file__).resolve().parent.parent, capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, f"exit {proc.returncode}: {proc.stderr[-500:]}"
+    assert "FormatError" in proc.stdout, proc.stdout

@@ -77,7 +77,7 @@ def _finite_run(result) -> None:
         assert value.size and np.all(np.isfinite(value)), name
 
 
-def _energy_property(params: ADBParameters, r0: float, v0: float, direction: float, periods: float) -> None:
+def check_energy(params: ADBParameters, r0: float, v0: float, direction: float, periods: float) -> None:
     note(repr(params))
     wn = params.natural_frequency_rad_s
     t_end = periods * 2 * math.pi / wn
@@ -104,13 +104,13 @@ ENERGY_ARGS = (adb_parameters(), log_uniform(1e-6, 1e-2), log_uniform(1e-6, 1.0)
 @STRESS
 @given(*ENERGY_ARGS)
 def test_stress_energy_bound_without_drive(params, r0, v0, direction, periods):
-    _energy_property(params, r0, v0, direction, periods)
+    check_energy(params, r0, v0, direction, periods)
 
 
 @FAST
 @given(*ENERGY_ARGS)
 def test_energy_bound_without_drive(params, r0, v0, direction, periods):
-    _energy_property(params, r0, v0, direction, periods)
+    check_energy(params, r0, v0, direction, periods)
 
 
 def _deviation(result, balanced: np.ndarray, R: float) -> np.ndarray:
@@ -119,7 +119,7 @@ def _deviation(result, balanced: np.ndarray, R: float) -> np.ndarray:
     return np.sqrt(np.sum(dphi**2, axis=1) + (result.rotor_u_m**2 + result.rotor_v_m**2) / R**2)
 
 
-def _verdict_property(params: ADBParameters, speed_ratio: float, start: tuple[float, float]) -> None:
+def check_verdict(params: ADBParameters, speed_ratio: float, start: tuple[float, float]) -> None:
     note(repr(params))
     speed = speed_ratio * params.natural_frequency_rad_s
     lin = balanced_stability(params, [speed])
@@ -164,16 +164,16 @@ VERDICT_ARGS = (adb_parameters(st.just(2)), st.floats(0.3, 5.0),
 @STRESS
 @given(*VERDICT_ARGS)
 def test_stress_linear_verdict_agrees_with_simulation(params, speed_ratio, start):
-    _verdict_property(params, speed_ratio, start)
+    check_verdict(params, speed_ratio, start)
 
 
 @FAST
 @given(*VERDICT_ARGS)
 def test_linear_verdict_agrees_with_simulation(params, speed_ratio, start):
-    _verdict_property(params, speed_ratio, start)
+    check_verdict(params, speed_ratio, start)
 
 
-def _boundary_property(params: ADBParameters) -> None:
+def check_boundary(params: ADBParameters) -> None:
     note(repr(params))
     wn = params.natural_frequency_rad_s
     intervals = stable_speed_intervals(params, 5.0 * wn, grid_points=400)
@@ -198,13 +198,13 @@ def _boundary_property(params: ADBParameters) -> None:
 @STRESS
 @given(adb_parameters())
 def test_stress_boundaries_are_marginal(params):
-    _boundary_property(params)
+    check_boundary(params)
 
 
 @FAST
 @given(adb_parameters())
 def test_boundaries_are_marginal(params):
-    _boundary_property(params)
+    check_boundary(params)
 
 
 GOOD = dict(M=1.0, m=0.02, n=2, R=0.05, e=0.5e-3, k=1e4, c=20.0, D=1e-3)

@@ -56,7 +56,7 @@ def mechanisms(draw) -> crank.SliderCrank:
                              series=series)
 
 
-def _optimum_property(mech: crank.SliderCrank, speed_rpm: float, objective: str, samples: list) -> None:
+def check_optimum(mech: crank.SliderCrank, speed_rpm: float, objective: str, samples: list) -> None:
     note(repr(mech))
     opt = crank.optimal_counterweight(mech, speed_rpm, objective)
     for name in ("balance_fraction", "max_force_n", "objective_value_n", "counterweight_moment_kg_m",
@@ -89,13 +89,13 @@ SAMPLES = st.lists(st.tuples(st.floats(0.0, 1.0), st.floats(0.0, 1.0)), min_size
 @STRESS
 @given(mechanisms(), log_uniform(10.0, 3e4), st.sampled_from(OBJECTIVES), SAMPLES)
 def test_stress_counterweight_optimum_never_worse_than_samples(mech, speed, objective, samples):
-    _optimum_property(mech, speed, objective, samples)
+    check_optimum(mech, speed, objective, samples)
 
 
 @FAST
 @given(mechanisms(), log_uniform(10.0, 3e4), st.sampled_from(OBJECTIVES), SAMPLES)
 def test_counterweight_optimum_never_worse_than_samples(mech, speed, objective, samples):
-    _optimum_property(mech, speed, objective, samples)
+    check_optimum(mech, speed, objective, samples)
 
 
 def test_optimum_beats_the_papers_grid():
@@ -168,7 +168,7 @@ def stages(draw):
     return d, big, centre
 
 
-def _belt_property(geometry, speed_rpm, power_w, service) -> None:
+def check_belt(geometry, speed_rpm, power_w, service) -> None:
     d, big, centre = geometry
     if abs(big - d) / centre > ARC_TABLE_MAX:
         # a valid geometry outside the catalogue table: the documented answer is a
@@ -201,16 +201,16 @@ SPEED = log_uniform(1.0, 1e5)
 @STRESS
 @given(stages(), SPEED, POWER, st.floats(1.0, 3.0))
 def test_stress_belt_stage_finite_and_consistent(geometry, speed, power, service):
-    _belt_property(geometry, speed, power, service)
+    check_belt(geometry, speed, power, service)
 
 
 @FAST
 @given(stages(), SPEED, POWER, st.floats(1.0, 3.0))
 def test_belt_stage_finite_and_consistent(geometry, speed, power, service):
-    _belt_property(geometry, speed, power, service)
+    check_belt(geometry, speed, power, service)
 
 
-def _drive_property(geometries, efficiencies, speed, power) -> None:
+def check_drive(geometries, efficiencies, speed, power) -> None:
     specs = [drive.BeltStageSpec(d, big, c, efficiency=e,
                                  arc_correction_factor=0.6 if abs(big - d) / c > ARC_TABLE_MAX else None)
              for (d, big, c), e in zip(geometries, efficiencies)]
@@ -227,14 +227,14 @@ def _drive_property(geometries, efficiencies, speed, power) -> None:
 @given(st.lists(stages(), min_size=1, max_size=4), st.lists(st.floats(0.5, 1.0), min_size=4, max_size=4),
        SPEED, POWER)
 def test_stress_belt_drive_chains_speed_and_power(geometries, efficiencies, speed, power):
-    _drive_property(geometries, efficiencies, speed, power)
+    check_drive(geometries, efficiencies, speed, power)
 
 
 @FAST
 @given(st.lists(stages(), min_size=1, max_size=3), st.lists(st.floats(0.5, 1.0), min_size=4, max_size=4),
        SPEED, POWER)
 def test_belt_drive_chains_speed_and_power(geometries, efficiencies, speed, power):
-    _drive_property(geometries, efficiencies, speed, power)
+    check_drive(geometries, efficiencies, speed, power)
 
 
 @pytest.mark.parametrize("args", [
@@ -282,7 +282,7 @@ def shafts(draw):
     return geometry, loads
 
 
-def _shaft_property(geometry, loads, diameter, masses) -> None:
+def check_shaft(geometry, loads, diameter, masses) -> None:
     result = shaft.analyse_shaft(geometry, loads)
     scale = sum(abs(p.vertical_n) + abs(p.horizontal_n) for p in loads) + 1.0
     for comp, reaction_a, reaction_b in (("vertical_n", result.reaction_a_vertical_n, result.reaction_b_vertical_n),
@@ -317,13 +317,13 @@ MASSES = st.lists(log_uniform(0.01, 1e3), min_size=5, max_size=5)
 @STRESS
 @given(shafts(), log_uniform(0.005, 0.5), MASSES)
 def test_stress_shaft_statics_and_dunkerley(case, diameter, masses):
-    _shaft_property(*case, diameter, masses)
+    check_shaft(*case, diameter, masses)
 
 
 @FAST
 @given(shafts(), log_uniform(0.005, 0.5), MASSES)
 def test_shaft_statics_and_dunkerley(case, diameter, masses):
-    _shaft_property(*case, diameter, masses)
+    check_shaft(*case, diameter, masses)
 
 
 @pytest.mark.parametrize("args", [(1.0, 0.6, 0.4), (1.0, -0.1, 0.5), (1.0, 0.2, 1.2), (0.0, 0.0, 0.0),

@@ -238,7 +238,7 @@ def describe(case: Case) -> None:
 
 
 # --------------------------------------------------------------------------- finite + accurate
-def _nls_property(case: Case) -> None:
+def check_nls(case: Case) -> None:
     describe(case)
     result = run(case, "nls")
     if result is not None:
@@ -246,7 +246,7 @@ def _nls_property(case: Case) -> None:
         check_accuracy(case, result)
 
 
-def _circle_property(case: Case) -> None:
+def check_circle(case: Case) -> None:
     describe(case)
     result = run(case, "circle")
     if result is None:
@@ -260,7 +260,7 @@ def _circle_property(case: Case) -> None:
         event("circle with several modes: accuracy not asserted")
 
 
-def _halfpower_property(case: Case) -> None:
+def check_halfpower(case: Case) -> None:
     describe(case)
     result = run(case, "halfpower")
     if result is None:
@@ -278,13 +278,13 @@ def _halfpower_property(case: Case) -> None:
 @STRESS
 @given(cases())
 def test_stress_nls_finite_and_within_sigma_or_flagged(case):
-    _nls_property(case)
+    check_nls(case)
 
 
 @FAST
 @given(cases(max_modes=3))
 def test_nls_finite_and_within_sigma_or_flagged(case):
-    _nls_property(case)
+    check_nls(case)
 
 
 @pytest.mark.stress
@@ -292,13 +292,13 @@ def test_nls_finite_and_within_sigma_or_flagged(case):
 @STRESS
 @given(cases())
 def test_stress_circle_finite_and_within_sigma_or_flagged(case):
-    _circle_property(case)
+    check_circle(case)
 
 
 @FAST
 @given(cases(max_modes=2))
 def test_circle_finite_and_within_sigma_or_flagged(case):
-    _circle_property(case)
+    check_circle(case)
 
 
 @pytest.mark.stress
@@ -306,13 +306,13 @@ def test_circle_finite_and_within_sigma_or_flagged(case):
 @STRESS
 @given(cases())
 def test_stress_halfpower_finite_and_within_sigma_or_flagged(case):
-    _halfpower_property(case)
+    check_halfpower(case)
 
 
 @FAST
 @given(cases(max_modes=1))
 def test_halfpower_finite_and_within_sigma_or_flagged(case):
-    _halfpower_property(case)
+    check_halfpower(case)
 
 
 # --------------------------------------------------------------------------- units
@@ -323,7 +323,7 @@ def test_halfpower_finite_and_within_sigma_or_flagged(case):
 RTOL_UNITS = 1e-7
 
 
-def _units_property(case: Case, s_h: float, s_f: float) -> None:
+def check_units(case: Case, s_h: float, s_f: float) -> None:
     describe(case)
     note(f"H x {s_h:g}, f x {s_f:g}")
     frf = case.frf()
@@ -383,17 +383,17 @@ SCALES = st.tuples(st.sampled_from([1e-6, 1e6]), st.sampled_from([1e-3, 1e3]))
 @STRESS
 @given(cases(), SCALES)
 def test_stress_results_do_not_depend_on_units(case, scales):
-    _units_property(case, *scales)
+    check_units(case, *scales)
 
 
 @FAST
 @given(cases(max_modes=2), SCALES)
 def test_results_do_not_depend_on_units(case, scales):
-    _units_property(case, *scales)
+    check_units(case, *scales)
 
 
 # --------------------------------------------------------------------------- kinds
-def _kinds_property(case: Case) -> None:
+def check_kinds(case: Case) -> None:
     describe(case)
     found = {}
     for kind in KINDS:
@@ -426,13 +426,13 @@ def _kinds_property(case: Case) -> None:
 @STRESS
 @given(cases(explicit=True))
 def test_stress_three_kinds_give_the_same_modes(case):
-    _kinds_property(case)
+    check_kinds(case)
 
 
 @FAST
 @given(cases(max_modes=2, explicit=True))
 def test_three_kinds_give_the_same_modes(case):
-    _kinds_property(case)
+    check_kinds(case)
 
 
 # --------------------------------------------------------------------------- fixed findings
