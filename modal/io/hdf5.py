@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import FormatError
+from ..errors import FormatError, ModalError
 from ..frf import FRF
 from ._atomic import atomic_path
 from ._common import build_frf, check_file, normalise_kind, resolve_kind, source_name
@@ -232,5 +232,7 @@ def read_frf_hdf5(path: str | os.PathLike, **hints: Any) -> FRF:
                 raise FormatError(f"{src}: group /{FRF_GROUP} holds {len(names)} FRFs "
                                   f"({', '.join(names) or 'none'}); expected one, or dataset= naming it")
             return read_frf_group(fh[FRF_GROUP][name], src, hints)
-        except (OSError, KeyError, RuntimeError, TypeError) as exc:  # damaged file or object
+        except ModalError:
+            raise
+        except (OSError, KeyError, RuntimeError, TypeError, ValueError) as exc:  # damaged file or object
             raise FormatError(f"{src}: damaged HDF5 content ({exc}); expected an archive written by modalbal") from None
