@@ -104,43 +104,11 @@ def _load_v5_here(p, src: str) -> dict[str, Any]:
     return {k: _v5_value(v) for k, v in raw.items() if not k.startswith("__")}
 
 
-def _load_v5_child(p, src, conn) -> None:  # pragma: no cover - runs in the forked child
-    try:
-        conn.send(("ok", _load_v5_here(p, src)))
-    except FormatError as exc:
-        conn.send(("error", str(exc)))
-    conn.close()
-
-
 def _load_v5(p, src: str) -> dict[str, Any]:
-    """Load a v4/v5/v7 file; where the OS can fork, in a child process.
+    """Load a v4/v5/v7 file in a forked child (SciPy's reader can crash on a damaged file)."""
+    from ._isolate import call_isolated
 
-    SciPy's MAT reader is compiled code that a damaged file can crash (SIGSEGV on
-    a corrupted cell or char element, found by fuzzing); in a forked child such a
-    crash becomes a FormatError instead of ending the user's process.
-    """
-    import multiprocessing
-
-    if "fork" not in multiprocessing.get_all_start_methods():
-        return _load_v5_here(p, src)
-    ctx = multiprocessing.get_context("fork")
-    parent, child = ctx.Pipe(duplex=False)
-    proc = ctx.Process(target=_load_v5_child, args=(p, src, child), daemon=True)
-    proc.start()
-    child.close()
-    try:
-        status, payload = parent.recv()
-    except EOFError:
-        status, payload = "crashed", None
-    finally:
-        parent.close()
-        proc.join()
-    if status == "ok":
-        return payload
-    if status == "error":
-        raise FormatError(payload)
-    raise FormatError(f"{src}: damaged MATLAB v4/v5/v7 file: SciPy's reader crashed on it (exit code "
-                      f"{proc.exitcode}); expected a .mat file saved by MATLAB, Octave or SciPy")
+    return call_isolated(_load_v5_here, (p, src), src, "MATLAB v4/v5/v7 file")
 
 
 def _v5_value(value: Any) -> Any:
