@@ -22,7 +22,7 @@ def _frf(n_channels: int = 1, kind: str = "accelerance", freq=FREQ) -> FRF:
                      reference_points=["1+Z"] * n_channels)
 
 
-def _fails(path, *fragments, error=FormatError, **hints) -> str:
+def _check_fails(path, *fragments, error=FormatError, **hints) -> str:
     """Read ``path``; check the error type, one line, the file name and each fragment."""
     with pytest.raises(error) as info:
         read_frf(path, **hints)
@@ -49,20 +49,20 @@ def _write(tmp_path, name: str, text: str | bytes):
 
 # ================================================================ any file
 def test_nonexistent_path(tmp_path):
-    _fails(tmp_path / "missing.csv", "no such file")
+    _check_fails(tmp_path / "missing.csv", "no such file")
 
 
 def test_directory_instead_of_a_file(tmp_path):
-    _fails(tmp_path, "is a directory")
+    _check_fails(tmp_path, "is a directory")
 
 
 def test_empty_file(tmp_path):
-    _fails(_write(tmp_path, "empty.uff", ""), "empty file (0 bytes)")
+    _check_fails(_write(tmp_path, "empty.uff", ""), "empty file (0 bytes)")
 
 
 def test_binary_garbage(tmp_path):
     garbage = np.random.default_rng(0).integers(0, 256, 4096, dtype=np.uint8).tobytes() + b"\x00"
-    _fails(_write(tmp_path, "garbage.bin", garbage), "binary content")
+    _check_fails(_write(tmp_path, "garbage.bin", garbage), "binary content")
 
 
 def test_unknown_hint_is_a_type_error(tmp_path):
@@ -88,18 +88,18 @@ def _canonical(tmp_path, n_channels: int = 1) -> tuple[os.PathLike, list[str]]:
 
 
 def test_blank_lines_only(tmp_path):
-    _fails(_write(tmp_path, "blank.csv", "\n   \n\t\n"), "line 1", "only blank lines")
+    _check_fails(_write(tmp_path, "blank.csv", "\n   \n\t\n"), "line 1", "only blank lines")
 
 
 def test_only_a_header(tmp_path):
-    _fails(_write(tmp_path, "hdr.csv", "frequency_hz,re,im\n"), "line 1", "only a header")
+    _check_fails(_write(tmp_path, "hdr.csv", "frequency_hz,re,im\n"), "line 1", "only a header")
 
 
 def test_only_metadata_lines(tmp_path):
     path, lines = _canonical(tmp_path)
     header_at = lines.index("frequency_hz,re_0,im_0")
     _write(tmp_path, "h.csv", "\n".join(lines[:header_at + 1]) + "\n")
-    _fails(path, f"line {header_at + 1}", "no data lines")
+    _check_fails(path, f"line {header_at + 1}", "no data lines")
 
 
 def test_text_in_a_number_field(tmp_path):
@@ -109,25 +109,25 @@ def test_text_in_a_number_field(tmp_path):
     parts[1] = "abc"
     lines[n - 1] = ",".join(parts)
     _write(tmp_path, "h.csv", "\n".join(lines))
-    _fails(path, f"line {n}", "column 're_0'", "'abc' is not a number")
+    _check_fails(path, f"line {n}", "column 're_0'", "'abc' is not a number")
 
 
 def test_empty_field(tmp_path):
-    _fails(_write(tmp_path, "gap.csv", "f,re,im\n1,2,3\n2,,3\n"), "line 3", "column 're'", "is empty")
+    _check_fails(_write(tmp_path, "gap.csv", "f,re,im\n1,2,3\n2,,3\n"), "line 3", "column 're'", "is empty")
 
 
 def test_nan_value(tmp_path):
-    _fails(_write(tmp_path, "nan.csv", "# kind: mobility\nf,re,im\n1,2,3\n2,nan,3\n"),
+    _check_fails(_write(tmp_path, "nan.csv", "# kind: mobility\nf,re,im\n1,2,3\n2,nan,3\n"),
            "line 4", "column 're'", "not finite")
 
 
 def test_inf_value(tmp_path):
-    _fails(_write(tmp_path, "inf.csv", "# kind: mobility\nf,re,im\n1,2,3\n2,1,-inf\n"),
+    _check_fails(_write(tmp_path, "inf.csv", "# kind: mobility\nf,re,im\n1,2,3\n2,1,-inf\n"),
            "line 4", "column 'im'", "not finite")
 
 
 def test_duplicate_frequencies(tmp_path):
-    _fails(_write(tmp_path, "dup.csv", "f,re,im\n1,2,3\n2,1,1\n2,1,1\n3,0,1\n"),
+    _check_fails(_write(tmp_path, "dup.csv", "f,re,im\n1,2,3\n2,1,1\n2,1,1\n3,0,1\n"),
            "frequency_hz", "duplicate", error=FRFValidationError, kind="mobility")
 
 
@@ -139,51 +139,51 @@ def test_unsorted_frequencies_are_sorted_with_a_warning(tmp_path):
 
 
 def test_negative_frequency(tmp_path):
-    _fails(_write(tmp_path, "neg.csv", "f,re,im\n-1,2,3\n2,1,1\n"), "frequency_hz", "negative",
+    _check_fails(_write(tmp_path, "neg.csv", "f,re,im\n-1,2,3\n2,1,1\n"), "frequency_hz", "negative",
            error=FRFValidationError, kind="mobility")
 
 
 def test_mismatched_column_counts(tmp_path):
-    _fails(_write(tmp_path, "cols.csv", "f,re,im\n1,2,3\n2,1\n3,1,1\n"), "line 3", "2 columns", "expected 3")
+    _check_fails(_write(tmp_path, "cols.csv", "f,re,im\n1,2,3\n2,1\n3,1,1\n"), "line 3", "2 columns", "expected 3")
 
 
 def test_header_and_data_disagree(tmp_path):
-    _fails(_write(tmp_path, "hd.csv", "f,re,im,extra\n1,2,3\n2,1,1\n"), "line 2", "names 4")
+    _check_fails(_write(tmp_path, "hd.csv", "f,re,im,extra\n1,2,3\n2,1,1\n"), "line 2", "names 4")
 
 
 def test_columns_do_not_pair_up(tmp_path):
-    _fails(_write(tmp_path, "pairs.csv", "1,2,3,4\n2,1,1,1\n"), "4 columns", "odd number",
+    _check_fails(_write(tmp_path, "pairs.csv", "1,2,3,4\n2,1,1,1\n"), "4 columns", "odd number",
            layout="re_im", kind="mobility")
 
 
 def test_unknown_kind_in_file(tmp_path):
     path, lines = _canonical(tmp_path)
     _write(tmp_path, "h.csv", "\n".join(lines).replace("# kind: accelerance", "# kind: stiffness"))
-    _fails(path, "line 2 (field kind)", "unknown FRF kind 'stiffness'")
+    _check_fails(path, "line 2 (field kind)", "unknown FRF kind 'stiffness'")
 
 
 def test_unknown_kind_hint(tmp_path):
-    _fails(_write(tmp_path, "k.csv", "f,re,im\n1,2,3\n2,1,1\n"), "hint kind=", "'flexibility'",
+    _check_fails(_write(tmp_path, "k.csv", "f,re,im\n1,2,3\n2,1,1\n"), "hint kind=", "'flexibility'",
            kind="flexibility")
 
 
 def test_kind_missing(tmp_path):
-    _fails(_write(tmp_path, "nokind.csv", "f,re,im\n1,2,3\n2,1,1\n"), "cannot be determined", "kind=")
+    _check_fails(_write(tmp_path, "nokind.csv", "f,re,im\n1,2,3\n2,1,1\n"), "cannot be determined", "kind=")
 
 
 def test_kind_hint_contradicts_file(tmp_path):
     path, _ = _canonical(tmp_path)
-    _fails(path, "says accelerance", "kind='mobility'", kind="mobility")
+    _check_fails(path, "says accelerance", "kind='mobility'", kind="mobility")
 
 
 def test_real_columns_without_header_are_ambiguous(tmp_path):
-    _fails(_write(tmp_path, "amb.txt", "1 2 3\n2 1 1\n"), "line 1", "layout=", kind="mobility")
+    _check_fails(_write(tmp_path, "amb.txt", "1 2 3\n2 1 1\n"), "line 1", "layout=", kind="mobility")
 
 
 def test_decimal_comma_without_the_hint(tmp_path):
     text = "Frequency [Hz];Real;Imag\n1,0;0,5;0,25\n2,0;0,75;-1,5\n"
     path = _write(tmp_path, "komma.csv", text)
-    _fails(path, "line 2", "'1,0' is not a number", "decimal=','", kind="receptance")
+    _check_fails(path, "line 2", "'1,0' is not a number", "decimal=','", kind="receptance")
     frf = read_frf(path, kind="receptance", decimal=",")
     assert list(frf.frequency_hz) == [1.0, 2.0] and list(frf.response) == [0.5 + 0.25j, 0.75 - 1.5j]
 
@@ -191,7 +191,7 @@ def test_decimal_comma_without_the_hint(tmp_path):
 def test_newer_canonical_version(tmp_path):
     path, lines = _canonical(tmp_path)
     _write(tmp_path, "h.csv", "\n".join(lines).replace("modalbal-frf-csv 1", "modalbal-frf-csv 2"))
-    _fails(path, "line 1 (field format)", "version 2")
+    _check_fails(path, "line 1 (field format)", "version 2")
 
 
 def test_channel_count_disagrees_with_metadata(tmp_path):
@@ -199,22 +199,22 @@ def test_channel_count_disagrees_with_metadata(tmp_path):
     head = [ln for ln in lines if ln.startswith("#")]
     body = [",".join(ln.split(",")[:3]) for ln in lines if not ln.startswith("#")]
     _write(tmp_path, "h.csv", "\n".join(head + body))
-    _fails(path, "field channels", "holds 1")
+    _check_fails(path, "field channels", "holds 1")
 
 
 def test_point_ids_not_a_list(tmp_path):
     path, lines = _canonical(tmp_path)
     _write(tmp_path, "h.csv", "\n".join(lines).replace('["1+Z"]', "1+Z, 2+Z", 1))
-    _fails(path, "field response_points", "JSON list")
+    _check_fails(path, "field response_points", "JSON list")
 
 
 def test_complex_column_without_frequency_lines(tmp_path):
-    _fails(_write(tmp_path, "c.txt", "(1+2j)\n(2-1j)\n"), "no frequency column", "frequency_step=",
+    _check_fails(_write(tmp_path, "c.txt", "(1+2j)\n(2-1j)\n"), "no frequency column", "frequency_step=",
            kind="accelerance")
 
 
 def test_unknown_frequency_unit(tmp_path):
-    _fails(_write(tmp_path, "u.csv", "f,re,im\n1,2,3\n2,1,1\n"), "hint frequency_axis=", "'furlongs'",
+    _check_fails(_write(tmp_path, "u.csv", "f,re,im\n1,2,3\n2,1,1\n"), "hint frequency_axis=", "'furlongs'",
            kind="mobility", frequency_axis="furlongs")
 
 
@@ -243,7 +243,7 @@ def _set_record6_func_type(lines: list[str], code: int) -> list[str]:
 def test_uff_non_frf_function_types(tmp_path, code, name):
     path, lines = _uff_lines(tmp_path)
     _write(tmp_path, "h.uff", "\n".join(_set_record6_func_type(lines, code)) + "\n")
-    _fails(path, "dataset 1 (line 8, record 6, field func_type)", f"function type {code} ({name}) is not an FRF",
+    _check_fails(path, "dataset 1 (line 8, record 6, field func_type)", f"function type {code} ({name}) is not an FRF",
            "expected 4 (frequency response function)")
 
 
@@ -254,7 +254,7 @@ def test_uff_frf_with_coherence_reads_the_frf_only(tmp_path):
     _write(tmp_path, "h.uff", "\n".join(lines) + "\n")
     frf = read_frf(path)
     assert frf.n_channels == 1 and frf.response_points == ("1+Z",)
-    _fails(path, "dataset 2", "function type 6 (coherence)", dataset=2)
+    _check_fails(path, "dataset 2", "function type 6 (coherence)", dataset=2)
 
 
 def test_uff_kind_not_determinable(tmp_path):
@@ -262,30 +262,30 @@ def test_uff_kind_not_determinable(tmp_path):
     i = _start(lines) + 9  # record 9: ordinate numerator
     lines[i] = f"{0:10d}" + lines[i][10:]
     _write(tmp_path, "h.uff", "\n".join(lines) + "\n")
-    _fails(path, "record 9", "0 (unknown)/13 (excitation force)", "kind= (--kind)")
+    _check_fails(path, "record 9", "0 (unknown)/13 (excitation force)", "kind= (--kind)")
     assert read_frf(path, kind="accelerance").kind == "accelerance"
 
 
 def test_uff_truncated_file(tmp_path):
     path, lines = _uff_lines(tmp_path)
     _write(tmp_path, "h.uff", "\n".join(lines[:-1]) + "\n")
-    _fails(path, "line 1", "no complete dataset", "'    -1'")
+    _check_fails(path, "line 1", "no complete dataset", "'    -1'")
     path, lines = _uff_lines(tmp_path, n_channels=2)
     _write(tmp_path, "h.uff", "\n".join(lines[:-5]) + "\n")
-    _fails(path, "dataset 2 has no closing '    -1' line")
+    _check_fails(path, "dataset 2 has no closing '    -1' line")
 
 
 def test_uff_truncated_data_records(tmp_path):
     path, lines = _uff_lines(tmp_path)
     _write(tmp_path, "h.uff", "\n".join(lines[:20] + lines[-1:]) + "\n")
-    _fails(path, "record 7, field num_pts", "says 41 points", "hold 14")
+    _check_fails(path, "record 7, field num_pts", "says 41 points", "hold 14")
 
 
 def test_uff_odd_value_count(tmp_path):
     path, lines = _uff_lines(tmp_path)
     lines[-2] = lines[-2][:20]  # the last line loses its imaginary part
     _write(tmp_path, "h.uff", "\n".join(lines) + "\n")
-    _fails(path, "field num_pts", "says 41 points", "hold 40")  # pyuff drops the unpaired value
+    _check_fails(path, "field num_pts", "says 41 points", "hold 40")  # pyuff drops the unpaired value
 
 
 def test_uff_wrong_record_length(tmp_path):
@@ -293,14 +293,14 @@ def test_uff_wrong_record_length(tmp_path):
     i = _start(lines) + 7  # record 7 cut after its first field
     lines[i] = lines[i][:10]
     _write(tmp_path, "h.uff", "\n".join(lines) + "\n")
-    _fails(path, "line 9, record 7, field num_pts", "'' is not an integer")
+    _check_fails(path, "line 9, record 7, field num_pts", "'' is not an integer")
 
 
 def test_uff_text_in_a_data_field(tmp_path):
     path, lines = _uff_lines(tmp_path)
     lines[16] = "        not-a-number" + lines[16][20:]
     _write(tmp_path, "h.uff", "\n".join(lines) + "\n")
-    _fails(path, "line 17, data record", "'not-a-number' is not a number")
+    _check_fails(path, "line 17, data record", "'not-a-number' is not a number")
 
 
 def test_uff_text_in_a_header_field(tmp_path):
@@ -308,14 +308,14 @@ def test_uff_text_in_a_header_field(tmp_path):
     i = _start(lines) + 6
     lines[i] = lines[i][:41] + "      node" + lines[i][51:]
     _write(tmp_path, "h.uff", "\n".join(lines) + "\n")
-    _fails(path, "record 6, field rsp_node", "'node' is not an integer")
+    _check_fails(path, "record 6, field rsp_node", "'node' is not an integer")
 
 
 def test_uff_nan_in_data(tmp_path):
     path, lines = _uff_lines(tmp_path)
     lines[16] = f"{'nan':>20s}" + lines[16][20:]
     _write(tmp_path, "h.uff", "\n".join(lines) + "\n")
-    _fails(path, "dataset 1", "not finite")
+    _check_fails(path, "dataset 1", "not finite")
 
 
 def test_uff_datasets_on_different_axes(tmp_path):
@@ -323,9 +323,9 @@ def test_uff_datasets_on_different_axes(tmp_path):
     write_frf(_frf(), a)
     write_frf(_frf(freq=FREQ + 1.0), b)
     both = _write(tmp_path, "both.uff", a.read_text() + b.read_text())
-    _fails(both, "dataset 2", "differs from dataset 1", "dataset=")
+    _check_fails(both, "dataset 2", "differs from dataset 1", "dataset=")
     assert read_frf(both, dataset=2).frequency_hz[0] == FREQ[0] + 1.0
-    _fails(both, "hint dataset=7", "1..2", dataset=7)
+    _check_fails(both, "hint dataset=7", "1..2", dataset=7)
 
 
 def test_uff_real_ordinate_is_not_an_frf(tmp_path):
@@ -336,7 +336,7 @@ def test_uff_real_ordinate_is_not_an_frf(tmp_path):
         "type": 58, "func_type": 4, "rsp_node": 1, "rsp_dir": 3, "ref_node": 1, "ref_dir": 3,
         "abscissa_spacing": 1, "abscissa_spec_data_type": 18, "ordinate_spec_data_type": 12,
         "orddenom_spec_data_type": 13, "x": FREQ, "data": np.abs(_frf().response)}], mode="add")
-    _fails(path, "field ord_data_type", "4 (real double)", "complex")
+    _check_fails(path, "field ord_data_type", "4 (real double)", "complex")
 
 
 def test_uff_without_dataset_58(tmp_path):
@@ -345,7 +345,7 @@ def test_uff_without_dataset_58(tmp_path):
     path = tmp_path / "header_only.uff"
     pyuff.UFF(str(path)).write_sets([{"type": 151, "model_name": "beam", "description": "no data",
                                       "db_app": "x", "program": "y"}], mode="add")
-    _fails(path, "no dataset 58", "types 151")
+    _check_fails(path, "no dataset 58", "types 151")
 
 
 def test_uff58b_damaged_binary(tmp_path):
@@ -354,7 +354,7 @@ def test_uff58b_damaged_binary(tmp_path):
     raw = path.read_bytes()
     cut = raw.index(b"    -1", 10)
     _write(tmp_path, "b.uff", raw[:cut - 100] + raw[cut:])
-    _fails(path, "field num_pts", "says 41 points")
+    _check_fails(path, "field num_pts", "says 41 points")
 
 
 # ================================================================ MATLAB
@@ -363,10 +363,10 @@ def test_mat_missing_variable(tmp_path):
 
     path = tmp_path / "m.mat"
     scipy.io.savemat(path, {"f": FREQ, "Y": _frf().response})
-    msg = _fails(path, "no variable 'response' or 'frf' or 'FRF' or 'H' or 'h' for the response",
+    msg = _check_fails(path, "no variable 'response' or 'frf' or 'FRF' or 'H' or 'h' for the response",
                  "the file has: Y (1x41 complex), f (1x41 double)", "variables=")
     assert "f (1x41 double)" in msg
-    _fails(path, "no variable 'omega'", variables={"frequency": "omega", "response": "Y"})
+    _check_fails(path, "no variable 'omega'", variables={"frequency": "omega", "response": "Y"})
 
 
 def test_mat_response_not_complex(tmp_path):
@@ -374,7 +374,7 @@ def test_mat_response_not_complex(tmp_path):
 
     path = tmp_path / "m.mat"
     scipy.io.savemat(path, {"f": FREQ, "H": np.abs(_frf().response)})
-    _fails(path, "variable 'H' (1x41 double)", "real values", "complex", kind="accelerance")
+    _check_fails(path, "variable 'H' (1x41 double)", "real values", "complex", kind="accelerance")
 
 
 def test_mat_response_wrong_shape(tmp_path):
@@ -382,7 +382,7 @@ def test_mat_response_wrong_shape(tmp_path):
 
     path = tmp_path / "m.mat"
     scipy.io.savemat(path, {"f": FREQ, "H": np.ones((3, 40), dtype=complex)})
-    _fails(path, "variable 'H' (3x40 complex)", "does not match 'f' (41 lines)", kind="accelerance")
+    _check_fails(path, "variable 'H' (3x40 complex)", "does not match 'f' (41 lines)", kind="accelerance")
 
 
 def test_mat_frequency_not_a_vector(tmp_path):
@@ -390,20 +390,20 @@ def test_mat_frequency_not_a_vector(tmp_path):
 
     path = tmp_path / "m.mat"
     scipy.io.savemat(path, {"f": np.ones((3, 41)), "H": _frf().response})
-    _fails(path, "variable 'f' (3x41 double)", "real vector", kind="accelerance")
+    _check_fails(path, "variable 'f' (3x41 double)", "real vector", kind="accelerance")
 
 
 def test_mat_truncated(tmp_path):
     path = tmp_path / "m.mat"
     write_frf(_frf(2), path)
     _write(tmp_path, "m.mat", path.read_bytes()[:300])
-    _fails(path, "not a readable MATLAB")
+    _check_fails(path, "not a readable MATLAB")
 
 
 def test_mat73_missing_variable(tmp_path):
     path = tmp_path / "m.mat"
     write_frf(_frf(), path, format="mat73")
-    _fails(path, "no variable 'Hxy'", "response (41x1 complex)", variables={"response": "Hxy"})
+    _check_fails(path, "no variable 'Hxy'", "response (41x1 complex)", variables={"response": "Hxy"})
 
 
 # ================================================================ HDF5
@@ -416,7 +416,7 @@ def test_hdf5_without_frf_group(tmp_path):
     with h5py.File(path, "w") as fh:
         write_root_attrs(fh)
         fh.create_group("identification")
-    _fails(path, "no group /frf", "identification")
+    _check_fails(path, "no group /frf", "identification")
 
 
 def test_hdf5_unknown_schema_major_version(tmp_path):
@@ -426,7 +426,7 @@ def test_hdf5_unknown_schema_major_version(tmp_path):
     write_frf(_frf(), path)
     with h5py.File(path, "r+") as fh:
         fh.attrs["schema_version"] = "2.0"
-    _fails(path, "schema_version is '2.0'", "major version 1")
+    _check_fails(path, "schema_version is '2.0'", "major version 1")
 
 
 def test_hdf5_of_another_program(tmp_path):
@@ -435,14 +435,14 @@ def test_hdf5_of_another_program(tmp_path):
     path = tmp_path / "other.h5"
     with h5py.File(path, "w") as fh:
         fh["x"] = np.arange(3)
-    _fails(path, "root attribute schema is None", "modalbal-archive")
+    _check_fails(path, "root attribute schema is None", "modalbal-archive")
 
 
 def test_hdf5_truncated(tmp_path):
     path = tmp_path / "a.h5"
     write_frf(_frf(2), path)
     _write(tmp_path, "a.h5", path.read_bytes()[:1500])
-    _fails(path, "HDF5")
+    _check_fails(path, "HDF5")
 
 
 def test_hdf5_real_response(tmp_path):
@@ -453,7 +453,7 @@ def test_hdf5_real_response(tmp_path):
     with h5py.File(path, "r+") as fh:
         del fh["frf/0/response"]
         fh["frf/0/response"] = np.ones(FREQ.size)
-    _fails(path, "group /frf/0/response", "dtype float64", "complex128")
+    _check_fails(path, "group /frf/0/response", "dtype float64", "complex128")
 
 
 def test_hdf5_missing_dataset(tmp_path):
@@ -463,7 +463,7 @@ def test_hdf5_missing_dataset(tmp_path):
     write_frf(_frf(), path)
     with h5py.File(path, "r+") as fh:
         del fh["frf/0/frequency_hz"]
-    _fails(path, "group /frf/0", "no dataset 'frequency_hz'")
+    _check_fails(path, "group /frf/0", "no dataset 'frequency_hz'")
 
 
 # ================================================================ writers

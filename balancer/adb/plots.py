@@ -1,6 +1,6 @@
 """Plots of ADB results.  Each function takes a result and an optional Axes and returns the
 Figure; without Axes it builds ``matplotlib.figure.Figure()`` itself, so pyplot's global
-state is never touched (no ``plt.show()``, no rcParams changes)."""
+state is never touched (nothing is shown, no rcParams changes)."""
 from __future__ import annotations
 
 import numpy as np
