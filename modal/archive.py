@@ -30,12 +30,11 @@ import h5py
 import numpy as np
 
 from .errors import ArchiveError
+from .io.hdf5 import SCHEMA, SCHEMA_VERSION, check_schema, read_frf_group, write_frf_group, write_root_attrs
 
 __all__ = ["SCHEMA", "SCHEMA_VERSION", "Archive", "write_archive", "read_archive", "write_node", "read_node",
            "units_of"]
 
-SCHEMA = "modalbal-archive"
-SCHEMA_VERSION = "1.0"
 _ALLOWED_MODULES = ("modal.", "balancer.")
 _COMPRESS_BYTES = 16384  # gzip+shuffle only where it pays: arrays above 16 kB
 
@@ -81,8 +80,6 @@ def write_node(parent: h5py.Group, name: str, obj: Any) -> None:
     from .frf import FRF
 
     if isinstance(obj, FRF):
-        from .io.hdf5 import write_frf_group
-
         group = parent.create_group(name)
         write_frf_group(group, obj)
         group.attrs["__type__"] = "frf"
@@ -169,8 +166,6 @@ def read_node(node) -> Any:
     if isinstance(kind, bytes):
         kind = kind.decode()
     if kind == "frf":
-        from .io.hdf5 import read_frf_group
-
         return read_frf_group(node, source=node.file.filename)
     if kind == "dataclass":
         cls = _class_from(str(node.attrs["__class__"]))
@@ -205,19 +200,6 @@ def read_node(node) -> Any:
     raise ArchiveError(f"{node.file.filename}: node {node.name} has unknown type {kind!r}")
 
 
-def _check_schema(f: h5py.File, src: str) -> None:
-    schema = f.attrs.get("schema")
-    version = str(f.attrs.get("schema_version", ""))
-    if schema != SCHEMA:
-        raise ArchiveError(f"{src}: attribute 'schema' is {schema!r}; expected {SCHEMA!r} (not an archive of this toolkit)")
-    major = version.split(".")[0]
-    if major != SCHEMA_VERSION.split(".")[0]:
-        raise ArchiveError(
-            f"{src}: attribute 'schema_version' is {version!r}; this toolkit reads major version "
-            f"{SCHEMA_VERSION.split('.')[0]} (upgrade the toolkit to read it)"
-        )
-
-
 def write_archive(path: str | os.PathLike, items: dict[str, Any], scene_text: str | None = None,
                   inputs_hash: dict[str, str] | None = None, created: str | None = None) -> Path:
     """Write result objects to an HDF5 archive, crash-safely.
@@ -235,7 +217,6 @@ def write_archive(path: str | os.PathLike, items: dict[str, Any], scene_text: st
     created : str, optional
         ISO 8601 creation time; default now (UTC).
     """
-    from . import __version__
     from .io._atomic import atomic_path
 
     path = Path(path)
@@ -243,16 +224,14 @@ def write_archive(path: str | os.PathLike, items: dict[str, Any], scene_text: st
 
     def verify(tmp: Path) -> None:
         with h5py.File(tmp, "r") as f:
-            _check_schema(f, str(path))
+            check_schema(f, str(path), error=ArchiveError)
             missing = [name for name in items if name not in f]
             if missing:
                 raise ArchiveError(f"{path}: verification after writing found no group {missing[0]!r}")
 
     with atomic_path(path, verify=verify) as tmp:
         with h5py.File(tmp, "w", track_order=True) as f:
-            f.attrs["schema"] = SCHEMA
-            f.attrs["schema_version"] = SCHEMA_VERSION
-            f.attrs["software_version"] = __version__
+            write_root_attrs(f)
             f.attrs["created"] = created or _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
             if scene_text is not None:
                 f.create_dataset("scene", data=scene_text, dtype=h5py.string_dtype())
@@ -275,7 +254,7 @@ def read_archive(path: str | os.PathLike) -> Archive:
     except OSError as exc:
         raise ArchiveError(f"{src}: not a readable HDF5 file ({exc})") from None
     with f:
-        _check_schema(f, src)
+        check_schema(f, src, error=ArchiveError)
         attrs = {k: str(v) for k, v in f.attrs.items()}
         scene = None
         if "scene" in f:

@@ -1,6 +1,8 @@
 """``identify``: from an FRF to every mode's ωn, ζ, modal constant and k, c, m."""
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
 from .circlefit import circle_fit_curve
@@ -172,8 +174,6 @@ def _start_pole(frf, band, power, noise):
     candidates = []
     for method in ("halfpower", "circle"):
         with np.errstate(all="ignore"):
-            import warnings
-
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
                 wn, zeta, *_ = _sdof_estimates(frf, band, power, noise, method, channels=strongest)

@@ -426,7 +426,6 @@ def fuzz(fmt: str, count: int, folder: Path) -> Tally:
         if not missing:  # died before reading anything: a harness problem, not a finding
             raise RuntimeError(f"fuzz child for {fmt} failed: {proc.stderr[-2000:]}")
         index = missing[-1]
-        how = started[index]
         reason = f"signal {-proc.returncode}" if proc.returncode < 0 else f"exit {proc.returncode}"
         last = [ln for ln in proc.stderr.splitlines() if ln.strip()][-1:] or [""]
         with open(log, "a", encoding="utf-8") as out:

@@ -138,10 +138,10 @@ def _open_earlier(path) -> h5py.File | None:
         f = h5py.File(path, "r")
     except OSError as exc:
         raise ArchiveError(f"{path}: not a readable HDF5 archive ({exc})") from None
-    from modal.archive import _check_schema
+    from modal.io.hdf5 import check_schema
 
     try:
-        _check_schema(f, str(path))
+        check_schema(f, str(path), error=ArchiveError)
     except ArchiveError:
         f.close()
         raise

@@ -172,7 +172,7 @@ def check_schema(h5file, source: str, error: type[Exception] = FormatError) -> s
     schema = _str_attr(h5file.attrs["schema"]) if "schema" in h5file.attrs else None
     if schema != SCHEMA:
         raise error(f"{source}: root attribute schema is {schema!r}; expected {SCHEMA!r} "
-                    "(an HDF5 file written by this toolkit)")
+                    "(not an archive of this toolkit)")
     version = _str_attr(h5file.attrs.get("schema_version", "?"))
     major = version.split(".")[0]
     if major != SCHEMA_VERSION.split(".")[0]:
