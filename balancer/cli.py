@@ -8,25 +8,13 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import sys
 import warnings
 
 from modal.errors import ModalError
+from modal.report import jsonable
 
 __all__ = ["main"]
-
-
-def _clean(obj):
-    if isinstance(obj, dict):
-        return {k: _clean(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_clean(v) for v in obj]
-    if isinstance(obj, complex):
-        return {"re": obj.real, "im": obj.imag}
-    if isinstance(obj, float) and not math.isfinite(obj):
-        return None
-    return obj
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -60,7 +48,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.json:
         doc = {"scene": args.scene, "stages": run.stages, "archive": run.archive_path, "plots": list(run.plot_paths),
                "timings_s": run.timings_s, "results": {s: digest(s, r) for s, r in run.results.items()}}
-        json.dump(_clean(doc), sys.stdout, indent=1, allow_nan=False)
+        json.dump(jsonable(doc), sys.stdout, indent=1, allow_nan=False)
         sys.stdout.write("\n")
     else:
         print(run.summary)

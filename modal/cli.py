@@ -13,28 +13,12 @@ import sys
 import warnings
 from pathlib import Path
 
-import numpy as np
 
 from .errors import ModalError
 from .frf import FRF_KINDS
+from .report import jsonable
 
 __all__ = ["main", "build_parser"]
-
-
-def _complex_to_json(value):
-    if isinstance(value, complex):
-        return {"re": value.real, "im": value.imag}
-    if isinstance(value, float) and not np.isfinite(value):
-        return None
-    return value
-
-
-def _jsonable(obj):
-    if isinstance(obj, dict):
-        return {k: _jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_jsonable(v) for v in obj]
-    return _complex_to_json(obj)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -87,7 +71,7 @@ def _fit(args) -> int:
         rows = [row for result in results for row in result.rows()]
         doc = {"file": args.path[0] if len(args.path) == 1 else list(args.path), "kind": frf.kind, "n_channels": frf.n_channels,
                "methods": methods, "modes": rows}
-        json.dump(_jsonable(doc), sys.stdout, indent=1, allow_nan=False)
+        json.dump(jsonable(doc), sys.stdout, indent=1, allow_nan=False)
         sys.stdout.write("\n")
     else:
         from .report import format_table

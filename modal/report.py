@@ -5,7 +5,7 @@ import numpy as np
 
 from .results import IdentificationResult
 
-__all__ = ["format_table"]
+__all__ = ["format_table", "jsonable"]
 
 
 def _pm(value: float, std: float, fmt: str) -> str:
@@ -41,3 +41,17 @@ def format_table(result: IdentificationResult, point_ids: list[str] | None = Non
                 f"{_pm(row['mass_kg'], std['mass_kg'], '.5g'):>20}  {flags}"
             )
     return "\n".join(lines)
+
+
+def jsonable(obj):
+    """Nested dicts/lists ready for ``json.dump(..., allow_nan=False)``: complex numbers as
+    ``{"re", "im"}``, NaN and ±Inf as None (JSON has no such numbers)."""
+    if isinstance(obj, dict):
+        return {k: jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [jsonable(v) for v in obj]
+    if isinstance(obj, complex):
+        return {"re": obj.real, "im": obj.imag}
+    if isinstance(obj, float) and not np.isfinite(obj):
+        return None
+    return obj
