@@ -15,6 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .model import cramer_rao_sdof
+
 __all__ = ["CircleEstimate", "fit_circle", "circle_fit_curve"]
 
 
@@ -138,6 +140,15 @@ def _levenberg_marquardt(p0, xs, theta, max_iter=100):
     return p, r, _angle_jac(p, xs), ok
 
 
+def _circle_bound(omega, omega_n, zeta, modal_constant, noise_std):
+    """Cramér–Rao standard deviations of (ωn, ζ) for a mobility circle with offset."""
+    try:
+        with np.errstate(all="ignore"):
+            return cramer_rao_sdof(omega, omega_n, zeta, modal_constant, 1, noise_std, offset=True)[:2]
+    except (np.linalg.LinAlgError, ValueError, FloatingPointError):
+        return np.array([np.nan, np.nan])
+
+
 def circle_fit_curve(omega: np.ndarray, mobility: np.ndarray, noise_std: float) -> CircleEstimate:
     """Circle fit of the strongest mode in a band, on one channel of mobility.
 
@@ -148,7 +159,8 @@ def circle_fit_curve(omega: np.ndarray, mobility: np.ndarray, noise_std: float) 
     mobility : ndarray of complex
         Mobility on those lines (convert other kinds exactly first).
     noise_std : float
-        σ of the complex noise on the mobility (used only for the flags).
+        σ of the complex noise on the mobility (for the Cramér–Rao floor of the
+        standard errors).
     """
     mag = np.abs(mobility)
     n = mag.size
@@ -216,6 +228,14 @@ def circle_fit_curve(omega: np.ndarray, mobility: np.ndarray, noise_std: float) 
             std_x, std_z = np.sqrt(max(cov[0, 0], 0)), np.sqrt(max(cov[1, 1], 0))
         except np.linalg.LinAlgError:
             pass
+    if ok and np.isfinite(noise_std) and noise_std > 0:
+        # the angle residuals ignore the error of the fitted centre, which moves every
+        # angle together (observed scatter ≈ 1.5× that error): the Cramér–Rao bound of
+        # the circle (mode + offset) on the same lines is the floor
+        bound = _circle_bound(w, x_n * w_ref, zeta, 2 * zeta * x_n * w_ref * 2 * rho * np.exp(1j * psi), noise_std)
+        if np.all(np.isfinite(bound)):
+            std_x = max(std_x, bound[0] / w_ref) if np.isfinite(std_x) else bound[0] / w_ref
+            std_z = max(std_z, bound[1]) if np.isfinite(std_z) else bound[1]
     if "resolution_limited" in flags or not ok:
         # unresolved peak: the line spacing bounds what the data can say (quantisation)
         spacing = float(np.min(np.diff(xs)))

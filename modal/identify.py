@@ -24,6 +24,9 @@ CHI2_LIMIT = 3.0
 REL_STD_LIMIT = 0.1
 #: channels (strongest first) used for the NLS start values
 START_CHANNELS = 8
+#: half-power and circle fits: an estimate further than this many of its own standard
+#: errors from the least-squares refinement of the same modes is flagged ``method_bias``
+BIAS_LIMIT = 3.0
 #: half-power and circle fits: the pole comes from at most this many strongest channels;
 #: the other channels' modal constants are solved linearly with that pole
 POLE_CHANNELS = 32
@@ -46,17 +49,21 @@ def _combine(values, stds, weights):
         return np.nan, np.nan
     v, w, s = values[ok], weights[ok], stds[ok]
     order = np.argsort(v)
-    cum = np.cumsum(w[order])
-    median = float(v[order][np.searchsorted(cum, 0.5 * cum[-1])])
+    v, w = v[order], w[order]
+    # midpoint weighted median: each value sits at the middle of its weight; one channel
+    # gives its own value, two give a weighted mean, many the robust median
+    position = (np.cumsum(w) - w / 2) / np.sum(w)
+    median = float(np.interp(0.5, position, v))
     good = np.isfinite(s)
     if not good.any():
         return median, np.nan
-    # inverse-variance combination of the channel errors, times the median's 1.25 efficiency loss;
-    # scaled by the smallest error so that no square under- or overflows
+    # inverse-variance combination of the channel errors, times the median's 1.25 efficiency
+    # loss from three channels on; scaled by the smallest error so that no square under- or overflows
     smallest = float(np.min(s[good]))
     if smallest <= 0:
         return median, 0.0
-    std = float(1.2533 * smallest / np.sqrt(np.sum((smallest / s[good]) ** 2)))
+    efficiency = 1.2533 if v.size >= 3 else 1.0
+    std = float(efficiency * smallest / np.sqrt(np.sum((smallest / s[good]) ** 2)))
     return median, std
 
 
@@ -186,6 +193,83 @@ def _start_pole(frf, band, power, noise):
     return best
 
 
+def _sdof_covariance(frf, band, power, wn, zeta, s_wn, s_z):
+    """Covariance (n_ch, 4, 4) of (ωn, ζ, Re A, Im A) for a pole from a single-mode method.
+
+    A is solved linearly for the pole, so its error is the linear solve's own
+    plus the pole's errors carried through ∂A/∂ωn and ∂A/∂ζ (central
+    differences); ωn and ζ are taken as uncorrelated.
+    """
+    n_ch = frf.n_channels
+    cov = np.zeros((n_ch, 4, 4))
+    cov[:, 0, 0], cov[:, 1, 1] = s_wn**2, s_z**2
+    if not (np.isfinite(wn) and np.isfinite(zeta) and wn > 0 and zeta > 0):
+        cov[:, 2:, 2:] = np.nan
+        return cov
+    omega, h = _mode_arrays(frf, band)
+    _, var_a, _ = _linear_constants(omega, h, power, wn, zeta)
+    jac = np.zeros((n_ch, 2, 2))  # rows Re A, Im A; columns ωn, ζ
+    for j, (pole, sigma) in enumerate(((wn, s_wn), (zeta, s_z))):
+        if not np.isfinite(sigma) or sigma == 0:
+            continue
+        step = 1e-6 * pole
+        args = [wn, zeta]
+        args[j] = pole + step
+        plus = _linear_constants(omega, h, power, *args)[0]
+        args[j] = pole - step
+        minus = _linear_constants(omega, h, power, *args)[0]
+        slope = (plus - minus) / (2 * step)
+        jac[:, 0, j], jac[:, 1, j] = slope.real, slope.imag
+    pole_var = np.diag([np.nan_to_num(s_wn) ** 2, np.nan_to_num(s_z) ** 2])
+    cov[:, 2:, 2:] = jac @ pole_var @ jac.transpose(0, 2, 1)
+    cov[:, 2, 2] += var_a / 2
+    cov[:, 3, 3] += var_a / 2
+    cov[:, :2, 2:] = (jac @ pole_var).transpose(0, 2, 1)
+    cov[:, 2:, :2] = jac @ pole_var
+    return cov
+
+
+def _refinement_check(frf, bands, power, poles, consts, noise, estimated_noise):
+    """Compare single-mode estimates with the least-squares refinement of the same modes.
+
+    All modes are refined together by :func:`fit_modes`, started from the
+    single-mode poles, on the strongest channels (at most ``POLE_CHANNELS``).
+    Returns per mode (ωn − ωn_ref, ζ − ζ_ref, A − A_ref per channel, χ²,
+    std ωn_ref, std ζ_ref), where χ² is the refined model's residual variance
+    over the noise variance (the same test as for ``"nls"``: whether viscous
+    modes explain the band at all) and the standard errors are the refinement's
+    (Cramér–Rao) ones. Differences and errors are 0 when the refinement does not
+    stand (did not converge, or left a band).
+    """
+    n_modes = len(bands)
+    none = [(0.0, 0.0, np.zeros(frf.n_channels, complex), np.nan, 0.0, 0.0)] * n_modes
+    wn0 = np.array([p[0] for p in poles])
+    z0 = np.array([p[1] for p in poles])
+    if not (np.all(np.isfinite(wn0)) and np.all(np.isfinite(z0)) and np.all(wn0 > 0)
+            and np.all((z0 > 0) & (z0 < 1))):
+        return none
+    keep, region = _regions(bands, frf.frequency_hz)
+    strongest = np.argsort(np.max(np.abs(frf.channels[:, keep]) / np.where(noise > 0, noise, 1.0)[:, None],
+                                  axis=1))[::-1][:POLE_CHANNELS]
+    with np.errstate(all="ignore"):
+        fit = fit_modes(frf.omega_rad_s[keep], frf.channels[np.ix_(strongest, keep)], power, wn0, z0,
+                        region=region)
+        chi2_ch = fit.noise_var / np.where(estimated_noise[strongest] > 0, estimated_noise[strongest], np.nan) ** 2
+    chi2 = float(np.nanmedian(chi2_ch)) if np.isfinite(chi2_ch).any() else np.nan
+    std_ref = np.sqrt(np.abs(fit.mode_cov[:, 0, [0, 1], [0, 1]]))  # (n_modes, 2)
+    inside = [b.low_hz <= w / TWO_PI <= b.high_hz for b, w in zip(bands, fit.omega_n)]
+    stands = (fit.converged and all(inside) and np.all(np.isfinite(fit.omega_n))
+              and np.all(fit.damping_ratio > 0) and np.all(np.isfinite(std_ref)))
+    if not stands:
+        return [(0.0, 0.0, np.zeros(frf.n_channels, complex), chi2, 0.0, 0.0)] * n_modes
+    const_ref = _constants_all_poles(frf, bands, power, fit.omega_n, fit.damping_ratio)
+    out = []
+    for r, (wn, zeta, *_) in enumerate(poles):
+        d_const = np.where(np.isfinite(consts[r]) & np.isfinite(const_ref[r]), consts[r] - const_ref[r], 0)
+        out.append((wn - fit.omega_n[r], zeta - fit.damping_ratio[r], d_const, chi2, *std_ref[r]))
+    return out
+
+
 def _physical(frf, wn, zeta, const, cov, driving, flags):
     (k, c, m), (sk, sc, sm) = physical_parameters(wn, zeta, const, cov)
     const = np.asarray(const)
@@ -268,28 +352,41 @@ def identify(frf: FRF, method: str = "nls", bands_hz=None, *, noise_std=None, dr
 
     per_mode = []  # (wn, zeta, const (n_ch,), cov (n_ch,4,4) or None, std_wn, std_z, flags, quality, chi2)
     if method in ("halfpower", "circle"):
+        poles = []
         for band in bands:
             strongest = None
             if n_ch > POLE_CHANNELS:
                 strongest = np.argsort(_channel_weights(frf, band, noise))[::-1][:POLE_CHANNELS]
-            wn, zeta, s_wn, s_z, const, flags, q = _sdof_estimates(frf, band, power, noise, method, strongest)
-            cov = np.zeros((n_ch, 4, 4))
-            cov[:, 0, 0], cov[:, 1, 1] = s_wn**2, s_z**2
-            omega, h = _mode_arrays(frf, band)
-            _, var_a, _ = _linear_constants(omega, h, power, wn, zeta) if np.isfinite(wn) and np.isfinite(zeta) else (None, np.full(n_ch, np.nan), None)
-            cov[:, 2, 2] = cov[:, 3, 3] = var_a / 2
-            per_mode.append((wn, zeta, const, cov, s_wn, s_z, flags, q, np.nan))
-        missing = np.array([~np.isfinite(m[2]) for m in per_mode])  # (n_modes, n_ch)
+            poles.append(_sdof_estimates(frf, band, power, noise, method, strongest))
+        consts = np.array([p[4] for p in poles])  # (n_modes, n_ch)
+        missing = ~np.isfinite(consts)
         if method == "halfpower":
             # half-power gives poles only: every constant from one solve with all the poles
             # (a peak-height constant ignores the neighbours' contribution)
             missing[:] = True
         if missing.any():
-            filled = _constants_all_poles(frf, bands, power, [m[0] for m in per_mode], [m[1] for m in per_mode])
-            for r, m in enumerate(per_mode):
-                const = m[2].copy()
-                const[missing[r]] = filled[r][missing[r]]
-                per_mode[r] = (m[0], m[1], const) + m[3:]
+            filled = _constants_all_poles(frf, bands, power, [p[0] for p in poles], [p[1] for p in poles])
+            consts[missing] = filled[missing]
+        check = _refinement_check(frf, bands, power, poles, consts, noise, estimated_noise)
+        for band, (wn, zeta, s_wn, s_z, _, flags, q), const, (d_wn, d_z, d_const, chi2, bound_wn, bound_z) in zip(
+                bands, poles, consts, check):
+            if np.isfinite(chi2) and chi2 > CHI2_LIMIT:
+                flags.add("model_inadequate")
+            # no estimator beats the Cramér–Rao bound of the refinement: a smaller own
+            # error (a formula that sees only a few lines) is raised to it
+            scale_wn = np.nanmax([s_wn, bound_wn, 0.0])
+            scale_z = np.nanmax([s_z, bound_z, 0.0])
+            s_wn = scale_wn if np.isfinite(s_wn) or bound_wn > 0 else s_wn
+            s_z = scale_z if np.isfinite(s_z) or bound_z > 0 else s_z
+            extra = np.zeros((n_ch, 2))
+            if abs(d_wn) > BIAS_LIMIT * scale_wn or abs(d_z) > BIAS_LIMIT * scale_z:
+                # the method's own bias dominates its noise error: fold it into the errors
+                flags.add("method_bias")
+                s_wn, s_z = float(np.hypot(scale_wn, d_wn)), float(np.hypot(scale_z, d_z))
+                extra = np.column_stack([d_const.real, d_const.imag])
+            cov = _sdof_covariance(frf, band, power, wn, zeta, s_wn, s_z)
+            cov[:, 2:, 2:] += extra[:, :, None] * extra[:, None, :]  # along the difference
+            per_mode.append((wn, zeta, const, cov, s_wn, s_z, flags, q, chi2))
     else:
         starts = [_start_pole(frf, band, power, noise) for band in bands]
         keep, region = _regions(bands, frf.frequency_hz)
