@@ -5,6 +5,7 @@ import warnings
 
 import numpy as np
 
+from .checks import find_missing_mode
 from .circlefit import circle_fit_curve
 from .errors import IdentificationError, QualityWarning, ResolutionWarning, warn
 from .frf import FRF, KIND_POWER
@@ -247,7 +248,7 @@ def _refinement_check(frf, bands, power, poles, consts, noise, estimated_noise):
     z0 = np.array([p[1] for p in poles])
     if not (np.all(np.isfinite(wn0)) and np.all(np.isfinite(z0)) and np.all(wn0 > 0)
             and np.all((z0 > 0) & (z0 < 1))):
-        return none
+        return none, None
     keep, region = _regions(bands, frf.frequency_hz)
     strongest = np.argsort(np.max(np.abs(frf.channels[:, keep]) / np.where(noise > 0, noise, 1.0)[:, None],
                                   axis=1))[::-1][:POLE_CHANNELS]
@@ -261,13 +262,23 @@ def _refinement_check(frf, bands, power, poles, consts, noise, estimated_noise):
     stands = (fit.converged and all(inside) and np.all(np.isfinite(fit.omega_n))
               and np.all(fit.damping_ratio > 0) and np.all(np.isfinite(std_ref)))
     if not stands:
-        return [(0.0, 0.0, np.zeros(frf.n_channels, complex), chi2, 0.0, 0.0)] * n_modes
+        return [(0.0, 0.0, np.zeros(frf.n_channels, complex), chi2, 0.0, 0.0)] * n_modes, None
+    missing = _missing_mode(frf, bands, power, fit.omega_n, fit.damping_ratio, estimated_noise)
     const_ref = _constants_all_poles(frf, bands, power, fit.omega_n, fit.damping_ratio)
     out = []
     for r, (wn, zeta, *_) in enumerate(poles):
         d_const = np.where(np.isfinite(consts[r]) & np.isfinite(const_ref[r]), consts[r] - const_ref[r], 0)
         out.append((wn - fit.omega_n[r], zeta - fit.damping_ratio[r], d_const, chi2, *std_ref[r]))
-    return out
+    return out, missing
+
+
+def _missing_mode(frf, bands, power, omega_n, damping_ratio, estimated_noise):
+    """:func:`modal.checks.find_missing_mode` on the lines of the bands."""
+    keep, region = _regions(bands, frf.frequency_hz)
+    bands_rad = [(TWO_PI * b.low_hz, TWO_PI * b.high_hz) for b in bands]
+    with np.errstate(all="ignore"):
+        return find_missing_mode(frf.omega_rad_s[keep], frf.channels[:, keep], power, region,
+                                 omega_n, damping_ratio, estimated_noise, bands_rad)
 
 
 def _physical(frf, wn, zeta, const, cov, driving, flags):
@@ -367,7 +378,7 @@ def identify(frf: FRF, method: str = "nls", bands_hz=None, *, noise_std=None, dr
         if missing.any():
             filled = _constants_all_poles(frf, bands, power, [p[0] for p in poles], [p[1] for p in poles])
             consts[missing] = filled[missing]
-        check = _refinement_check(frf, bands, power, poles, consts, noise, estimated_noise)
+        check, missing_mode = _refinement_check(frf, bands, power, poles, consts, noise, estimated_noise)
         for band, (wn, zeta, s_wn, s_z, _, flags, q), const, (d_wn, d_z, d_const, chi2, bound_wn, bound_z) in zip(
                 bands, poles, consts, check):
             if np.isfinite(chi2) and chi2 > CHI2_LIMIT:
@@ -378,14 +389,21 @@ def identify(frf: FRF, method: str = "nls", bands_hz=None, *, noise_std=None, dr
             scale_z = np.nanmax([s_z, bound_z, 0.0])
             s_wn = scale_wn if np.isfinite(s_wn) or bound_wn > 0 else s_wn
             s_z = scale_z if np.isfinite(s_z) or bound_z > 0 else s_z
-            extra = np.zeros((n_ch, 2))
-            if abs(d_wn) > BIAS_LIMIT * scale_wn or abs(d_z) > BIAS_LIMIT * scale_z:
+            pole_biased = abs(d_wn) > BIAS_LIMIT * scale_wn or abs(d_z) > BIAS_LIMIT * scale_z
+            if pole_biased:
                 # the method's own bias dominates its noise error: fold it into the errors
-                flags.add("method_bias")
                 s_wn, s_z = float(np.hypot(scale_wn, d_wn)), float(np.hypot(scale_z, d_z))
-                extra = np.column_stack([d_const.real, d_const.imag])
             cov = _sdof_covariance(frf, band, power, wn, zeta, s_wn, s_z)
-            cov[:, 2:, 2:] += extra[:, :, None] * extra[:, None, :]  # along the difference
+            # modal constants against each channel's own error (the circle's come from its
+            # geometry, which a neighbour bends even when the pole passes)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                z_const = np.abs(d_const) / np.sqrt(cov[:, 2, 2] + cov[:, 3, 3])
+            const_biased = pole_biased | (z_const > BIAS_LIMIT)
+            diff = np.column_stack([d_const.real, d_const.imag])[const_biased]
+            cov[const_biased, 2:, 2:] += diff[:, :, None] * diff[:, None, :]  # along the difference
+            finite = z_const[np.isfinite(z_const)]
+            if pole_biased or (finite.size and np.median(finite) > BIAS_LIMIT):
+                flags.add("method_bias")
             per_mode.append((wn, zeta, const, cov, s_wn, s_z, flags, q, chi2))
     else:
         starts = [_start_pole(frf, band, power, noise) for band in bands]
@@ -395,6 +413,7 @@ def identify(frf: FRF, method: str = "nls", bands_hz=None, *, noise_std=None, dr
         with np.errstate(divide="ignore", invalid="ignore"):
             chi2_ch = fit.noise_var / np.where(estimated_noise > 0, estimated_noise, np.nan) ** 2
         chi2 = float(np.nanmedian(chi2_ch)) if np.isfinite(chi2_ch).any() else np.nan
+        missing_mode = _missing_mode(frf, bands, power, fit.omega_n, fit.damping_ratio, estimated_noise)
         for r, band in enumerate(bands):
             flags: set[str] = set()
             if not fit.converged:
@@ -410,8 +429,12 @@ def identify(frf: FRF, method: str = "nls", bands_hz=None, *, noise_std=None, dr
             per_mode.append((wn, zeta, fit.modal_constant[r], cov, s_wn, s_z, flags, chi2, chi2))
 
     modes = []
-    for band, (wn, zeta, const, cov, s_wn, s_z, flags, quality, chi2) in zip(bands, per_mode):
+    for index, (band, (wn, zeta, const, cov, s_wn, s_z, flags, quality, chi2)) in enumerate(zip(bands, per_mode)):
         flags = set(flags)
+        detail = {}
+        if missing_mode is not None and missing_mode.band == index:
+            flags.add("missing_mode")
+            detail["missing_mode"] = f" (near {missing_mode.frequency_hz:.6g} Hz, zeta {missing_mode.damping_ratio:.3g})"
         const = np.asarray(const, complex)
         if np.isfinite(s_z) and np.isfinite(zeta) and zeta > 0 and s_z / zeta > REL_STD_LIMIT:
             flags.add("high_uncertainty")
@@ -439,6 +462,6 @@ def identify(frf: FRF, method: str = "nls", bands_hz=None, *, noise_std=None, dr
         serious = set(flags_t) - {"driving_point_assumed", "not_driving_point"}
         if serious:
             category = ResolutionWarning if serious & _RESOLUTION_FLAGS else QualityWarning
-            reasons = "; ".join(f"{f}: {FLAG_TEXT[f]}" for f in sorted(serious))
+            reasons = "; ".join(f"{f}: {FLAG_TEXT[f]}{detail.get(f, '')}" for f in sorted(serious))
             warn(f"{frf.source}: {method} mode near {wn / TWO_PI:.6g} Hz is flagged ({reasons})", category)
     return IdentificationResult(tuple(modes), method, frf.kind, n_ch, noise_std=estimated_noise)

@@ -30,6 +30,9 @@ FLAG_TEXT = {
     "complex_mode": "modal constant of a driving point is far from real (phase > 10 deg): k, c, m are approximate",
     "non_positive_constant": "driving-point modal constant has a negative real part: k, c, m not defined",
     "close_modes": "another mode lies within this mode's fitting band",
+    "missing_mode": ("the residual holds another mode inside this band that peak detection missed (one more mode "
+                     "reduces it significantly, F-test at 1e-6); the estimates are biased by it: give bands_hz for "
+                     "both modes or lower min_prominence_db"),
     "method_bias": ("half-power or circle estimate lies more than 3 of its standard errors from the least-squares "
                     "refinement of the same modes (the method's own bias: line spacing, noise at the peak, "
                     "a neighbouring mode); its standard errors include the difference, method 'nls' gives the refined values"),

@@ -23,11 +23,10 @@ Invariants checked:
 The stress variants (``-m stress``) draw hundreds of cases; the default run keeps a
 few derandomised examples of each so the invariants are exercised on every run.
 
-Known violations are *not* asserted here (see docs/stress.md, "Findings"):
-when automatic peak detection reports fewer modes than the FRF holds
-(unresolved or hidden neighbours) the remaining estimates can be far outside
-their standard errors without a flag.  Those cases are counted with
-``hypothesis.event`` but not asserted.
+Accuracy is asserted for modes separated by an overlap up to ``OVERLAP_ASSERTED``
+(docs/stress.md, finding 12), including when peak detection misses a mode: each
+reported mode is then compared with the nearest true one, and a hidden neighbour
+that biases it has to raise ``missing_mode``.
 """
 from __future__ import annotations
 
@@ -205,12 +204,16 @@ def check_accuracy(case: Case, result) -> None:
     if case.overlap > OVERLAP_ASSERTED:
         event("overlapping modes: accuracy not asserted")
         return
-    if len(result) != case.fn.size:
-        # finding (docs/stress.md): with modes missing the others may be biased unflagged
-        event("modes missing: accuracy not asserted")
-        return
-    event("all modes reported")
-    for r, mode in enumerate(result):
+    if len(result) == case.fn.size:
+        event("all modes reported")
+        truth = range(case.fn.size)
+    else:
+        # peak detection missed a mode (or found a spurious one): each reported mode is
+        # compared with the nearest true one; a hidden neighbour that biases it must show
+        # in the residual check (flag missing_mode)
+        event("modes missing: nearest true mode compared")
+        truth = [int(np.argmin(np.abs(mode.natural_frequency_hz - case.fn) / (case.zeta * case.fn))) for mode in result]
+    for r, mode in zip(truth, result):
         if serious(mode):
             event("flagged")
             continue
