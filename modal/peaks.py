@@ -104,7 +104,8 @@ def find_modes(frf: FRF, min_prominence_db: float = 6.0, noise_factor: float = 1
     A peak of the mode indicator counts when it stands ``min_prominence_db``
     above its surroundings and ``noise_factor`` times above the noise level.
     Its band is ±``bandwidths`` half-power widths (at least ±5 lines), clipped
-    halfway to the neighbouring peaks and to the data.
+    halfway to the neighbouring peaks and to the data, with its edges moved
+    halfway between lines (see :func:`_edges_between_lines`).
     """
     freq = frf.frequency_hz
     ind = mode_indicator(frf)
@@ -135,8 +136,25 @@ def find_modes(frf: FRF, min_prominence_db: float = 6.0, noise_factor: float = 1
             low = max(low, 0.5 * (freq[idx[j - 1]] + freq[i]))
         if j < idx.size - 1:
             high = min(high, 0.5 * (freq[idx[j + 1]] + freq[i]))
-        out.append(ModeBand(float(freq[i]), float(max(low, freq[0])), float(min(high, freq[-1])), float(width)))
+        low, high = _edges_between_lines(freq, low, high)
+        out.append(ModeBand(float(freq[i]), low, high, float(width)))
     return out
+
+
+def _edges_between_lines(freq: np.ndarray, low: float, high: float) -> tuple[float, float]:
+    """Move band edges halfway to the next line out, so no line sits on an edge.
+
+    Edges often fall on a line (±3 half-power widths is often a whole number of
+    spacings); whether ``freq >= low`` keeps that line would then depend on
+    rounding, e.g. of an axis rescaled from Hz to kHz. A line within 1e-3 of a
+    spacing of an edge counts as inside.
+    """
+    tol = 1e-3 * float(np.min(np.diff(freq)))
+    first = int(np.searchsorted(freq, low - tol, side="left"))
+    last = int(np.searchsorted(freq, high + tol, side="right")) - 1
+    low = freq[0] if first == 0 else 0.5 * (freq[first - 1] + freq[first])
+    high = freq[-1] if last == freq.size - 1 else 0.5 * (freq[last] + freq[last + 1])
+    return float(low), float(high)
 
 
 def bands_from_hz(frf: FRF, bands_hz) -> list[ModeBand]:
@@ -153,7 +171,8 @@ def bands_from_hz(frf: FRF, bands_hz) -> list[ModeBand]:
     for low, high in pairs:
         if not (np.isfinite(low) and np.isfinite(high) and low < high):
             raise IdentificationError(f"band ({low}, {high}) Hz: expected finite f_low < f_high")
-        inside = np.flatnonzero((freq >= low) & (freq <= high))
+        tol = 1e-3 * float(np.min(np.diff(freq)))  # as _edges_between_lines
+        inside = np.flatnonzero((freq >= low - tol) & (freq <= high + tol))
         if inside.size < 3:
             raise IdentificationError(
                 f"{frf.source}: band ({low}, {high}) Hz holds {inside.size} lines; expected at least 3 "
@@ -161,5 +180,5 @@ def bands_from_hz(frf: FRF, bands_hz) -> list[ModeBand]:
             )
         i = inside[np.argmax(ind[inside])]
         width = max(_half_power_width(freq, ind, i), np.min(np.diff(freq)))
-        out.append(ModeBand(float(freq[i]), low, high, float(width), user_given=True))
+        out.append(ModeBand(float(freq[i]), *_edges_between_lines(freq, low, high), float(width), user_given=True))
     return sorted(out, key=lambda b: b.peak_hz)

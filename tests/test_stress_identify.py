@@ -331,22 +331,13 @@ def check_units(case: Case, s_h: float, s_f: float) -> None:
     if base is None:
         return
     assert len(base) == len(other)
-    if len(base) != case.fn.size:
-        # finding (docs/stress.md): with unresolved modes the start values (circle fit)
-        # depend on the frequency unit and the fit lands elsewhere; asserted where all
-        # modes are found
-        event("units: modes missing (values not compared)")
-        return
     p = KIND_POWER[case.kind]
     # H = (iω)^p A / (ωn² − ω² + 2iζωnω): A' = s_h s_f^(2−p) A, m = 1/|A|, k = m ωn²
     m_factor = 1.0 / (s_h * s_f ** (2 - p))
     k_factor = s_f**p / s_h
-    # finding (docs/stress.md): band edges fall exactly on lines, so rounding of the scaled
-    # axis decides whether an edge line is in; the fits (joint over merged bands) then see
-    # different data, and the comparison is made to half a standard error instead
-    edge = any(a.n_lines != b.n_lines for a, b in zip(base, other))
-    if edge:
-        event("units: known band-edge rounding (different lines in a band)")
+    # band edges lie halfway between lines (finding 13, fixed), so both scales fit the same lines
+    for a, b in zip(base, other):
+        assert a.n_lines == b.n_lines, (a.band_hz, b.band_hz)
     for a, b in zip(base, other):
         if {"did_not_converge", "model_inadequate"} & (set(a.flags) | set(b.flags)):
             # a model that does not fit leaves a flat valley: where LM stops then depends on
@@ -354,7 +345,7 @@ def check_units(case: Case, s_h: float, s_f: float) -> None:
             event("units: did_not_converge/model_inadequate (stopping point may differ)")
             continue
         # a fraction of sigma: the part of the difference that rounding may carry
-        share = 0.5 if edge else 1e-3
+        share = 1e-3
         tol_z = RTOL_UNITS * a.damping_ratio + share * a.std.damping_ratio
         assert abs(b.damping_ratio - a.damping_ratio) <= tol_z, (a.damping_ratio, b.damping_ratio)
         tol_f = RTOL_UNITS * a.natural_frequency_hz + share * a.std.natural_frequency_hz
