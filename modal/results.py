@@ -29,7 +29,8 @@ FLAG_TEXT = {
     "not_driving_point": "transfer FRF (response point differs from reference): k, c, m are not defined for it",
     "complex_mode": "modal constant of a driving point is far from real (phase > 10 deg): k, c, m are approximate",
     "non_positive_constant": "driving-point modal constant has a negative real part: k, c, m not defined",
-    "close_modes": "another mode lies within this mode's fitting band",
+    "close_modes": ("another mode lies within this mode's fitting band, or overlaps it (2*zeta*wn/delta_wn > 1.5): "
+                    "the standard errors understate the scatter"),
     "missing_mode": ("the residual holds another mode inside this band that peak detection missed (one more mode "
                      "reduces it significantly, F-test at 1e-6); the estimates are biased by it: give bands_hz for "
                      "both modes or lower min_prominence_db"),
