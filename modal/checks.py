@@ -15,8 +15,8 @@ mode only when three things hold:
   reduction in residual significant at 1e-6;
 * the new mode's half-power band reaches a fitting band that resolves it (its
   half-power width is at most half that band);
-* it is separated from every fitted pole by more than their half-power
-  half-widths.
+* its modal overlap 2·max(ζωn)/Δωn with every fitted pole is at most 1.5
+  (closer, it cannot be told from a split of that mode).
 
 Structure that is not a mode (the slope of a mode outside the bands, rounding
 on exact data) fails these conditions. The result is a flag (``missing_mode``)
@@ -38,6 +38,9 @@ __all__ = ["MissingMode", "find_missing_mode", "SIGNIFICANCE"]
 
 #: false-alarm probability of each test for one added mode
 SIGNIFICANCE = 1e-6
+#: an added mode overlapping a fitted one more than this (2·max(ζωn)/Δωn) counts as a
+#: split of it, not another mode (the same limit as identify's close_modes)
+SPLIT_OVERLAP = 1.5
 #: channels (strongest first) the check works on
 CHECK_CHANNELS = 8
 
@@ -152,8 +155,9 @@ def find_missing_mode(omega: np.ndarray, response: np.ndarray, power: int, regio
     if gaps[band] > new_zeta * new_wn or 2 * new_zeta * new_wn > 0.5 * (hi - lo):
         return None  # away from the bands, or broader than a band can resolve
     others_wn, others_zeta = fit.omega_n[:-1], fit.damping_ratio[:-1]
-    if np.any(np.abs(others_wn - new_wn) <= others_zeta * others_wn + new_zeta * new_wn):
-        return None  # overlaps a fitted mode: a split of it, not another mode
+    overlap = 2 * np.maximum(others_zeta * others_wn, new_zeta * new_wn) / np.abs(others_wn - new_wn)
+    if np.any(overlap > SPLIT_OVERLAP):
+        return None  # too close to a fitted mode to tell from a split of it
     res1 = _residual(omega, Y, fit.omega_n, fit.damping_ratio, power, region)
     rss0 = np.sum(np.abs(res) ** 2, axis=1)
     rss1 = np.sum(np.abs(res1) ** 2, axis=1)

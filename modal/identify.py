@@ -243,8 +243,8 @@ def _refinement_check(frf, bands, power, poles, consts, noise, estimated_noise):
     std ωn_ref, std ζ_ref), where χ² is the refined model's residual variance
     over the noise variance (the same test as for ``"nls"``: whether viscous
     modes explain the band at all) and the standard errors are the refinement's
-    (Cramér–Rao) ones. Differences and errors are 0 when the refinement does not
-    stand (did not converge, or left a band).
+    (Cramér–Rao) ones. Differences and errors are 0 where the refinement does
+    not stand (did not converge; for one mode: its refined pole left its band).
     """
     n_modes = len(bands)
     none = [(0.0, 0.0, np.zeros(frf.n_channels, complex), np.nan, 0.0, 0.0)] * n_modes
@@ -261,18 +261,22 @@ def _refinement_check(frf, bands, power, poles, consts, noise, estimated_noise):
                         region=region)
         chi2_ch = fit.noise_var / np.where(estimated_noise[strongest] > 0, estimated_noise[strongest], np.nan) ** 2
     chi2 = float(np.nanmedian(chi2_ch)) if np.isfinite(chi2_ch).any() else np.nan
-    std_ref = np.sqrt(np.abs(fit.mode_cov[:, 0, [0, 1], [0, 1]]))  # (n_modes, 2)
-    inside = [b.low_hz <= w / TWO_PI <= b.high_hz for b, w in zip(bands, fit.omega_n)]
-    stands = (fit.converged and all(inside) and np.all(np.isfinite(fit.omega_n))
-              and np.all(fit.damping_ratio > 0) and np.all(np.isfinite(std_ref)))
-    if not stands:
+    # the refinement may return the modes in another order (two close poles crossing)
+    order = np.argsort(fit.omega_n)
+    omega_n, damping_ratio = fit.omega_n[order], fit.damping_ratio[order]
+    std_ref = np.sqrt(np.abs(fit.mode_cov[order][:, 0, [0, 1], [0, 1]]))  # (n_modes, 2)
+    if not (fit.converged and np.all(np.isfinite(omega_n)) and np.all(damping_ratio > 0)):
         return [(0.0, 0.0, np.zeros(frf.n_channels, complex), chi2, 0.0, 0.0)] * n_modes, None
-    missing = _missing_mode(frf, bands, power, fit.omega_n, fit.damping_ratio, estimated_noise)
-    const_ref = _constants_all_poles(frf, bands, power, fit.omega_n, fit.damping_ratio)
+    missing = _missing_mode(frf, bands, power, omega_n, damping_ratio, estimated_noise)
+    const_ref = _constants_all_poles(frf, bands, power, omega_n, damping_ratio)
     out = []
     for r, (wn, zeta, *_) in enumerate(poles):
+        band = bands[r]
+        if not (band.low_hz <= omega_n[r] / TWO_PI <= band.high_hz and np.all(np.isfinite(std_ref[r]))):
+            out.append((0.0, 0.0, np.zeros(frf.n_channels, complex), chi2, 0.0, 0.0))  # no reference here
+            continue
         d_const = np.where(np.isfinite(consts[r]) & np.isfinite(const_ref[r]), consts[r] - const_ref[r], 0)
-        out.append((wn - fit.omega_n[r], zeta - fit.damping_ratio[r], d_const, chi2, *std_ref[r]))
+        out.append((wn - omega_n[r], zeta - damping_ratio[r], d_const, chi2, *std_ref[r]))
     return out, missing
 
 
@@ -431,7 +435,8 @@ def identify(frf: FRF, method: str = "nls", bands_hz=None, *, noise_std=None, dr
             chi2_ch = fit.noise_var / np.where(estimated_noise > 0, estimated_noise, np.nan) ** 2
         chi2 = float(np.nanmedian(chi2_ch)) if np.isfinite(chi2_ch).any() else np.nan
         missing_mode = _missing_mode(frf, bands, power, fit.omega_n, fit.damping_ratio, estimated_noise)
-        for r, band in enumerate(bands):
+        order = np.argsort(fit.omega_n)  # two close poles may cross during the fit
+        for band, r in zip(bands, order):
             flags: set[str] = set()
             if not fit.converged:
                 flags.add("did_not_converge")

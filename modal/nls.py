@@ -49,6 +49,10 @@ class NLSFit:
     n_iter: int
 
 
+#: largest damping ratio the fit may reach (far past critical: the mode is then a slope)
+ZETA_MAX = 10.0
+
+
 def _design(x, params, power, region, n_regions):
     n_modes = params.size // 2
     xr, zeta = params[0::2], params[1::2]
@@ -132,6 +136,9 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
     n_modes = params.size // 2
     n_theta = params.size
 
+    x_lo, x_hi = 0.5 * x.min(), 2.0 * x.max()
+    params[0::2] = np.clip(params[0::2], x_lo, x_hi)
+    params[1::2] = np.clip(params[1::2], 1e-300, ZETA_MAX)
     Y_full = Y
     n_b_guess = n_modes + n_regions
     Y = _compress(Y, 2 * n_b_guess + 8)
@@ -169,9 +176,14 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
                 break  # the Gauss–Newton step is below rounding: converged, nothing to evaluate
             # a pole the step would push to ζ ≤ 0 (a mode below the noise sliding onto a
             # spike) moves to a tenth of its value instead; rejecting the whole step drove λ
-            # up until every other mode stalled where it started (stress finding 12)
-            trial[0::2] = np.where(trial[0::2] > 0, trial[0::2], params[0::2] / 2)
-            trial[1::2] = np.where(trial[1::2] > 0, trial[1::2], params[1::2] / 10)
+            # up until every other mode stalled where it started (stress finding 12). Poles
+            # kept inside a box (ωn within a factor 2 of the lines, ζ ≤ ZETA_MAX) move halfway
+            # to the bound, so an unidentifiable mode cannot run off to overflow
+            x_r, zeta_t = trial[0::2], trial[1::2]
+            x_r = np.where(x_r < x_lo, (params[0::2] + x_lo) / 2, np.where(x_r > x_hi, (params[0::2] + x_hi) / 2, x_r))
+            zeta_t = np.where(zeta_t > 0, zeta_t, params[1::2] / 10)
+            zeta_t = np.where(zeta_t > ZETA_MAX, (params[1::2] + ZETA_MAX) / 2, zeta_t)
+            trial[0::2], trial[1::2] = x_r, zeta_t
             step = trial - params
             if np.all(np.isfinite(trial)):
                 new_state = evaluate(trial)
