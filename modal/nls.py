@@ -137,8 +137,11 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
     n_theta = params.size
 
     x_lo, x_hi = 0.5 * x.min(), 2.0 * x.max()
+    # a mode below the noise can be driven towards ζ = 0 step after step; it stops at a
+    # half-power width of 1e-6 line spacings, far below anything the lines resolve
+    zeta_lo = 1e-6 * float(np.min(np.diff(x))) / (2 * x.max()) if x.size > 1 else 1e-12
     params[0::2] = np.clip(params[0::2], x_lo, x_hi)
-    params[1::2] = np.clip(params[1::2], 1e-300, ZETA_MAX)
+    params[1::2] = np.clip(params[1::2], zeta_lo, ZETA_MAX)
     Y_full = Y
     n_b_guess = n_modes + n_regions
     Y = _compress(Y, 2 * n_b_guess + 8)
@@ -181,7 +184,7 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
             # to the bound, so an unidentifiable mode cannot run off to overflow
             x_r, zeta_t = trial[0::2], trial[1::2]
             x_r = np.where(x_r < x_lo, (params[0::2] + x_lo) / 2, np.where(x_r > x_hi, (params[0::2] + x_hi) / 2, x_r))
-            zeta_t = np.where(zeta_t > 0, zeta_t, params[1::2] / 10)
+            zeta_t = np.where(zeta_t > 0, zeta_t, np.maximum(params[1::2] / 10, zeta_lo))
             zeta_t = np.where(zeta_t > ZETA_MAX, (params[1::2] + ZETA_MAX) / 2, zeta_t)
             trial[0::2], trial[1::2] = x_r, zeta_t
             step = trial - params
