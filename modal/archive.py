@@ -19,7 +19,6 @@ reopened and checked, then renamed over it.
 from __future__ import annotations
 
 import dataclasses
-import datetime as _dt
 import importlib
 import os
 from dataclasses import dataclass, field
@@ -215,7 +214,7 @@ def write_archive(path: str | os.PathLike, items: dict[str, Any], scene_text: st
     inputs_hash : dict, optional
         Stage name → hash of its inputs, stored as ``@inputs_hash``.
     created : str, optional
-        ISO 8601 creation time; default now (UTC).
+        ISO 8601 creation time; default now (UTC, ``YYYY-MM-DDTHH:MM:SSZ``).
     """
     from .io._atomic import atomic_path
 
@@ -231,8 +230,7 @@ def write_archive(path: str | os.PathLike, items: dict[str, Any], scene_text: st
 
     with atomic_path(path, verify=verify) as tmp:
         with h5py.File(tmp, "w", track_order=True) as f:
-            write_root_attrs(f)
-            f.attrs["created"] = created or _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
+            write_root_attrs(f, created)
             if scene_text is not None:
                 f.create_dataset("scene", data=scene_text, dtype=h5py.string_dtype())
             for name, obj in items.items():

@@ -141,14 +141,19 @@ def read_frf_group(group, source: str, hints: dict[str, Any] | None = None) -> F
 
 
 # ------------------------------------------------------------------ files
-def write_root_attrs(h5file) -> None:
-    """Set the archive's root attributes: schema, schema_version, software_version, created (UTC)."""
+def write_root_attrs(h5file, created: str | None = None) -> None:
+    """Set the archive's root attributes: schema, schema_version, software_version, created.
+
+    ``created`` defaults to now, UTC, as ``YYYY-MM-DDTHH:MM:SSZ``. It is written
+    once: a variable-length string overwritten leaves its old bytes in the file's
+    global heap, so two archives written a second apart would differ there.
+    """
     from .. import __version__
 
     h5file.attrs["schema"] = SCHEMA
     h5file.attrs["schema_version"] = SCHEMA_VERSION
     h5file.attrs["software_version"] = __version__
-    h5file.attrs["created"] = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
+    h5file.attrs["created"] = created or datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
 
 
 def check_schema(h5file, source: str, error: type[Exception] = FormatError) -> str:
