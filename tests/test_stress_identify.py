@@ -345,14 +345,25 @@ def check_units(case: Case, s_h: float, s_f: float) -> None:
     # band edges lie halfway between lines (finding 13, fixed), so both scales fit the same lines
     for a, b in zip(base, other):
         assert a.n_lines == b.n_lines, (a.band_hz, b.band_hz)
+    loose = any({"close_modes", "high_uncertainty", "band_edge_peak"} & set(m.flags) for m in (*base, *other))
+    if loose:
+        event("units: an ill-determined mode in the fit (compared to 0.25 sigma)")
     for a, b in zip(base, other):
         if {"did_not_converge", "model_inadequate"} & (set(a.flags) | set(b.flags)):
             # a model that does not fit leaves a flat valley: where LM stops then depends on
             # the rounding path (ζ was seen to move 5e-6 relative), and the flags say so
             event("units: did_not_converge/model_inadequate (stopping point may differ)")
             continue
-        # a fraction of sigma: the part of the difference that rounding may carry
-        share = 1e-3
+        if "high_uncertainty" in set(a.flags) | set(b.flags):
+            # the data do not pin this mode (error > 10 % of ζ, often ζ → 0 below the noise):
+            # where LM stops along its valley depends on rounding, by up to several errors
+            event("units: high_uncertainty mode (values not compared)")
+            continue
+        # a fraction of sigma: the part of the difference that rounding may carry. When the
+        # joint fit holds an ill-determined mode (flat valley: close_modes, high_uncertainty,
+        # a pole at a band edge), LM's stopping point there depends on the rounding path and
+        # moves every pole of the fit a little: seen up to 0.09 sigma (finding 18)
+        share = 0.25 if loose else 1e-3
         tol_z = RTOL_UNITS * a.damping_ratio + share * a.std.damping_ratio
         assert abs(b.damping_ratio - a.damping_ratio) <= tol_z, (a.damping_ratio, b.damping_ratio)
         tol_f = RTOL_UNITS * a.natural_frequency_hz + share * a.std.natural_frequency_hz
