@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import special
 
-from .model import mode_basis
+from .model import mode_basis, solve_linear
 from .nls import fit_modes
 from .units import TWO_PI
 
@@ -77,7 +77,7 @@ def _design(omega, omega_n, zeta, power, region):
 
 def _residual(omega, response, omega_n, zeta, power, region):
     design = _design(omega, omega_n, zeta, power, region)
-    coef, *_ = np.linalg.lstsq(design, response.T, rcond=None)
+    coef = solve_linear(design, response.T)
     return response - (design @ coef).T
 
 

@@ -10,7 +10,7 @@ from .circlefit import circle_fit_curve
 from .errors import IdentificationError, QualityWarning, ResolutionWarning, warn
 from .frf import FRF, KIND_POWER
 from .halfpower import half_power_curve
-from .model import mode_basis
+from .model import mode_basis, solve_linear
 from .nls import fit_modes
 from .peaks import ModeBand, bands_from_hz, estimate_noise_std, find_modes
 from .results import FLAG_TEXT, IdentificationResult, ModeResult, ModeStd, physical_parameters
@@ -76,7 +76,7 @@ def _linear_constants(omega, h, power, wn, zeta):
     """Modal constant per channel for a given pole, with a band offset; and its variance."""
     phi = mode_basis(omega, wn, zeta, power)[0]
     Phi = np.column_stack([phi, np.ones_like(phi)])
-    coef, *_ = np.linalg.lstsq(Phi, h.T, rcond=None)
+    coef = solve_linear(Phi, h.T)
     res = h.T - Phi @ coef
     dof = max(omega.size - 2, 1)
     noise_var = np.sum(np.abs(res) ** 2, axis=0) / dof
@@ -93,7 +93,7 @@ def _constants_all_poles(frf, bands, power, omega_n, damping_ratio):
     phi = mode_basis(omega, np.asarray(omega_n)[ok], np.asarray(damping_ratio)[ok], power).T
     offsets = np.zeros((omega.size, region.max() + 1), dtype=complex)
     offsets[np.arange(omega.size), region] = 1.0
-    coef, *_ = np.linalg.lstsq(np.hstack([phi, offsets]), frf.channels[:, keep].T, rcond=None)
+    coef = solve_linear(np.hstack([phi, offsets]), frf.channels[:, keep].T)
     out = np.full((len(bands), frf.n_channels), np.nan, dtype=complex)
     out[ok] = coef[:ok.sum()]
     return out

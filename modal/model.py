@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["mode_basis", "mode_basis_derivatives", "fisher_information", "cramer_rao_sdof"]
+__all__ = ["mode_basis", "mode_basis_derivatives", "fisher_information", "cramer_rao_sdof", "solve_linear"]
 
 
 def mode_basis(omega: np.ndarray, wn, zeta, power: int) -> np.ndarray:
@@ -76,3 +76,17 @@ def cramer_rao_sdof(omega, wn, zeta, modal_constant, power, noise_std, offset=Fa
     scale = np.sqrt(np.diag(F))
     cov = np.linalg.inv(F / np.outer(scale, scale)) / np.outer(scale, scale)
     return np.sqrt(np.diag(cov))
+
+
+def solve_linear(design: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+    """Least-squares coefficients of ``design @ coef ≈ rhs`` with the columns scaled first.
+
+    Mode columns (iω)^p/(ωr² − ω² + 2iζωrω) and offset columns of ones differ by
+    ω^{2−p}: 1e16 at ω ≈ 1e8 rad/s in receptance, which is past the rank cut-off
+    of an unscaled ``lstsq`` (the mode columns were dropped, and results depended
+    on the frequency unit). Scaling every column to unit norm removes that.
+    """
+    norms = np.linalg.norm(design, axis=0)
+    norms[norms == 0] = 1.0
+    coef, *_ = np.linalg.lstsq(design / norms, rhs, rcond=None)
+    return coef / (norms[:, None] if coef.ndim == 2 else norms)

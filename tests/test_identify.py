@@ -420,3 +420,29 @@ def test_two_modes_merged_into_one_peak_are_flagged_missing_mode():
     with pytest.warns(QualityWarning, match=r"missing_mode.*near 1\.\d+ Hz"):
         result = identify(modal_frf(f, [1.0, 1.2], [0.1, 0.1], [39.4784176] * 2))
     assert len(result) == 1 and "missing_mode" in result[0].flags
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_linear_solves_do_not_depend_on_the_units(method):
+    # receptance at 1e7 Hz (f × 1e3): mode columns ~1e-16 beside the offset column of ones
+    # fell below lstsq's rank cut-off, half-power masses came out 1e29 off and missing_mode
+    # depended on the unit (units property, STRESS_SEED=7). Columns are now scaled first.
+    f = np.linspace(5e3, 2e4, 600)
+    frf = add_noise(modal_frf(f, [1e4, 1.3e4], [0.05, 0.05], [1e4, 1e4]), 0.01, seed=2)
+    scaled = modal.FRF(f * 1e3, frf.response * 1e-6, kind=frf.kind)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", modal.ModalWarning)
+        base, other = identify(frf, method), identify(scaled, method)
+    for a, b in zip(base, other):
+        # receptance A' = s_h s_f² A = A here: the same masses, up to rounding and LM paths
+        assert abs(b.mass_kg / a.mass_kg - 1) < 1e-9
+        assert a.flags == b.flags
+
+
+def test_solve_linear_scales_columns():
+    from modal.model import solve_linear
+
+    x = np.linspace(1, 2, 50)
+    design = np.column_stack([1e-17 / x**2, np.ones_like(x)])
+    coef = np.array([3e16, 2.0])
+    np.testing.assert_allclose(solve_linear(design, design @ coef), coef, rtol=1e-12)
