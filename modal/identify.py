@@ -443,6 +443,8 @@ def identify(frf: FRF, method: str = "nls", bands_hz=None, *, noise_std=None, dr
             flags: set[str] = set()
             if not fit.converged:
                 flags.add("did_not_converge")
+            if not np.all(np.isfinite(fit.noise_var)):
+                flags.add("too_few_points")  # no lines left over for a residual: no errors
             if np.isfinite(chi2) and chi2 > CHI2_LIMIT:
                 flags.add("model_inadequate")
             cov = fit.mode_cov[r]

@@ -221,9 +221,11 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
     E = dphi - Q @ (Q.conj().T @ dphi)
     mode_of = np.repeat(np.arange(n_modes), 2)
     Cm = C[mode_of]
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         weights = np.where(noise_var > 0, 1.0 / noise_var, np.inf)
-    F = 2 * np.real((E.conj().T @ E) * ((Cm.conj() * weights) @ Cm.T))
+        # a channel fitted exactly (residual 0) has infinite weight: F is then not finite and
+        # the covariance is zero (below); inf·0 inside the product is expected, not an error
+        F = 2 * np.real((E.conj().T @ E) * ((Cm.conj() * weights) @ Cm.T))
     cov_theta = np.full((n_theta, n_theta), np.nan)
     if np.all(np.isfinite(F)):
         s = np.sqrt(np.abs(np.diag(F)))

@@ -446,3 +446,21 @@ def test_solve_linear_scales_columns():
     design = np.column_stack([1e-17 / x**2, np.ones_like(x)])
     coef = np.array([3e16, 2.0])
     np.testing.assert_allclose(solve_linear(design, design @ coef), coef, rtol=1e-12)
+
+
+def test_no_lines_left_for_errors_is_flagged():
+    # exact data, two modes with ζ = 0.001 on 0.0052 Hz lines and bands of ±6ζfn: five lines
+    # for two modes and two offsets leave no degree of freedom for a residual. The Fisher
+    # product then met inf·0 (RuntimeWarning) and the errors were NaN without a flag.
+    f = 0.99 + 0.0052423755 * np.arange(16)
+    fn = np.array([1.0, 1.0632455542666133])
+    frf = modal_frf(f, fn, [0.001, 0.001], [39.4784176] * 2)
+    bands = [(fr * (1 - 0.006), fr * (1 + 0.006)) for fr in fn]
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        warnings.simplefilter("error", RuntimeWarning)
+        result = identify(frf, bands_hz=bands)
+    assert any(issubclass(w.category, ResolutionWarning) for w in caught)
+    for mode, truth in zip(result, fn):
+        assert "too_few_points" in mode.flags
+        assert abs(mode.natural_frequency_hz / truth - 1) < 1e-9  # exact data: still exact

@@ -7,7 +7,9 @@ re-issued in the parent; the toolkit's own errors come back as they were raised.
 """
 from __future__ import annotations
 
+import math
 import multiprocessing
+import signal
 import warnings
 from typing import Any, Callable
 
@@ -18,9 +20,16 @@ __all__ = ["call_isolated"]
 _IN_CHILD = False
 
 
-def _child(func: Callable, args: tuple, conn) -> None:  # pragma: no cover - runs in the child
+def _child(func: Callable, args: tuple, conn, timeout_s: float) -> None:  # pragma: no cover - runs in the child
     global _IN_CHILD
     _IN_CHILD = True
+    if hasattr(signal, "alarm"):
+        # end on our own shortly after the parent's deadline: if the parent is killed
+        # meanwhile (Ctrl-C, a harness timeout), a reader hung in compiled code would
+        # otherwise live on as an orphan, spinning for ever (the stress fuzzer left dozens).
+        # The default action of SIGALRM ends the process even inside C code.
+        signal.signal(signal.SIGALRM, signal.SIG_DFL)
+        signal.alarm(int(math.ceil(timeout_s)) + 2)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
@@ -39,7 +48,7 @@ def call_isolated(func: Callable[..., Any], args: tuple, src: str, what: str, ti
         return func(*args)
     ctx = multiprocessing.get_context("fork")
     parent, child = ctx.Pipe(duplex=False)
-    proc = ctx.Process(target=_child, args=(func, args, child), daemon=True)
+    proc = ctx.Process(target=_child, args=(func, args, child, timeout_s), daemon=True)
     proc.start()
     child.close()
     try:

@@ -1,0 +1,56 @@
+"""The forked reader of MAT v5 and HDF5 files ends even when its parent is killed."""
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+
+_SCRIPT = """
+import os, sys
+from modal.io._isolate import call_isolated
+
+def hang(path):
+    with open(path, "w") as f:
+        f.write(str(os.getpid()))
+    while True:  # a reader stuck for ever (libhdf5 looping on a damaged file)
+        pass
+
+call_isolated(hang, (sys.argv[1],), "x.h5", "HDF5 file", timeout_s=1.0)
+"""
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    # a zombie (ended, not yet reaped by init) counts as ended
+    try:
+        with open(f"/proc/{pid}/stat") as f:
+            return f.read().split(")")[-1].split()[0] != "Z"
+    except OSError:
+        return True
+
+
+@pytest.mark.skipif(not hasattr(signal, "alarm") or sys.platform != "linux", reason="POSIX fork and /proc")
+def test_orphaned_reader_ends_itself(tmp_path):
+    # the stress fuzzer killed its reader after 5 s; the reader's own forked child, hung in
+    # libhdf5, then lived on as an orphan spinning at full CPU (dozens of them). The child
+    # now ends by SIGALRM 2 s after its parent's deadline, whatever happened to the parent.
+    pid_file = tmp_path / "pid"
+    proc = subprocess.Popen([sys.executable, "-c", _SCRIPT, str(pid_file)])
+    deadline = time.monotonic() + 30
+    while not (pid_file.exists() and pid_file.read_text()) and time.monotonic() < deadline:
+        time.sleep(0.01)
+    child = int(pid_file.read_text())
+    proc.kill()  # the parent dies before its own 1 s deadline could end the child
+    proc.wait()
+    ends = time.monotonic() + 10  # alarm at ceil(1) + 2 = 3 s after the child started
+    while _alive(child) and time.monotonic() < ends:
+        time.sleep(0.05)
+    alive = _alive(child)
+    if alive:
+        os.kill(child, signal.SIGKILL)
+    assert not alive
