@@ -247,20 +247,22 @@ def _refinement_check(frf, bands, power, poles, consts, noise, estimated_noise):
     not stand (for one mode: its refined pole left its band or has no finite error).
     """
     n_modes = len(bands)
-    none = [(0.0, 0.0, np.zeros(frf.n_channels, complex), np.nan, 0.0, 0.0)] * n_modes
+
+    def no_reference(chi2):
+        return (0.0, 0.0, np.zeros(frf.n_channels, complex), chi2, 0.0, 0.0)
+
     wn0 = np.array([p[0] for p in poles])
     z0 = np.array([p[1] for p in poles])
     if not (np.all(np.isfinite(wn0)) and np.all(np.isfinite(z0)) and np.all(wn0 > 0)
             and np.all((z0 > 0) & (z0 < 1))):
-        return none, None
+        return [no_reference(np.nan)] * n_modes, None
     keep, region = _regions(bands, frf.frequency_hz)
     strongest = np.argsort(np.max(np.abs(frf.channels[:, keep]) / np.where(noise > 0, noise, 1.0)[:, None],
                                   axis=1))[::-1][:POLE_CHANNELS]
     with np.errstate(all="ignore"):
         fit = fit_modes(frf.omega_rad_s[keep], frf.channels[np.ix_(strongest, keep)], power, wn0, z0,
                         region=region)
-        chi2_ch = fit.noise_var / np.where(estimated_noise[strongest] > 0, estimated_noise[strongest], np.nan) ** 2
-    chi2 = float(np.nanmedian(chi2_ch)) if np.isfinite(chi2_ch).any() else np.nan
+    chi2 = _chi2(fit.noise_var, estimated_noise[strongest])
     # the refinement may return the modes in another order (two close poles crossing)
     order = np.argsort(fit.omega_n)
     omega_n, damping_ratio = fit.omega_n[order], fit.damping_ratio[order]
@@ -269,18 +271,25 @@ def _refinement_check(frf, bands, power, poles, consts, noise, estimated_noise):
     # valley keeps LM from stopping while the other poles are long settled; the check only
     # adds flags and widens errors
     if not (np.all(np.isfinite(omega_n)) and np.all(damping_ratio > 0)):
-        return [(0.0, 0.0, np.zeros(frf.n_channels, complex), chi2, 0.0, 0.0)] * n_modes, None
+        return [no_reference(chi2)] * n_modes, None
     missing = _missing_mode(frf, bands, power, omega_n, damping_ratio, estimated_noise)
     const_ref = _constants_all_poles(frf, bands, power, omega_n, damping_ratio)
     out = []
     for r, (wn, zeta, *_) in enumerate(poles):
         band = bands[r]
         if not (band.low_hz <= omega_n[r] / TWO_PI <= band.high_hz and np.all(np.isfinite(std_ref[r]))):
-            out.append((0.0, 0.0, np.zeros(frf.n_channels, complex), chi2, 0.0, 0.0))  # no reference here
+            out.append(no_reference(chi2))
             continue
         d_const = np.where(np.isfinite(consts[r]) & np.isfinite(const_ref[r]), consts[r] - const_ref[r], 0)
         out.append((wn - omega_n[r], zeta - damping_ratio[r], d_const, chi2, *std_ref[r]))
     return out, missing
+
+
+def _chi2(residual_var, noise_std) -> float:
+    """Median over channels of the residual variance over the estimated noise variance."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = residual_var / np.where(noise_std > 0, noise_std, np.nan) ** 2
+    return float(np.nanmedian(ratio)) if np.isfinite(ratio).any() else np.nan
 
 
 def _missing_mode(frf, bands, power, omega_n, damping_ratio, estimated_noise):
@@ -434,9 +443,7 @@ def identify(frf: FRF, method: str = "nls", bands_hz=None, *, noise_std=None, dr
         keep, region = _regions(bands, frf.frequency_hz)
         fit = fit_modes(frf.omega_rad_s[keep], frf.channels[:, keep], power,
                         [s[0] for s in starts], [s[1] for s in starts], region=region)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            chi2_ch = fit.noise_var / np.where(estimated_noise > 0, estimated_noise, np.nan) ** 2
-        chi2 = float(np.nanmedian(chi2_ch)) if np.isfinite(chi2_ch).any() else np.nan
+        chi2 = _chi2(fit.noise_var, estimated_noise)
         missing_mode = _missing_mode(frf, bands, power, fit.omega_n, fit.damping_ratio, estimated_noise)
         order = np.argsort(fit.omega_n)  # two close poles may cross during the fit
         for band, r in zip(bands, order):
