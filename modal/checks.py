@@ -11,8 +11,11 @@ mode's width, is largest, it adds one mode and refits. It then keeps the added
 mode only when three things hold:
 
 * both an F-test (self-normalised: it needs no noise estimate) and the
-  likelihood ratio against the independently estimated noise find the
-  reduction in residual significant at 1e-6;
+  likelihood ratio against the noise find the reduction in residual
+  significant at 1e-6. The noise is the smaller of the estimate from the raw
+  data and the same neighbour-misfit estimate on the residual (on a coarse
+  axis the raw estimate is the resonances' curvature, which the fitted modes
+  remove), and at least sqrt(eps)·max|H| (below that, structure is rounding);
 * the new mode's half-power band reaches a fitting band that resolves it (its
   half-power width is at most half that band);
 * its modal overlap 2·max(ζωn)/Δωn with every fitted pole is at most 1.5
@@ -32,6 +35,7 @@ from scipy import special
 
 from .model import mode_basis, solve_linear
 from .nls import fit_modes
+from .peaks import neighbour_noise_std
 from .units import TWO_PI
 
 __all__ = ["MissingMode", "find_missing_mode", "SIGNIFICANCE"]
@@ -43,6 +47,9 @@ SIGNIFICANCE = 1e-6
 SPLIT_OVERLAP = 1.5
 #: channels (strongest first) the check works on
 CHECK_CHANNELS = 8
+#: noise is taken to be at least this fraction of a channel's max|H| (sqrt of the float64
+#: epsilon): structure below it is the rounding of the fit, not the data
+ARITHMETIC_FLOOR = float(np.sqrt(np.finfo(float).eps))
 
 
 @dataclass(frozen=True)
@@ -124,19 +131,31 @@ def find_missing_mode(omega: np.ndarray, response: np.ndarray, power: int, regio
     if not (np.all(np.isfinite(noise_std)) and np.all(noise_std > 0) and omega.size > 8):
         return None
     strongest = np.argsort(np.max(np.abs(response), axis=1) / noise_std)[::-1][:CHECK_CHANNELS]
-    Y, sigma2 = response[strongest], noise_std[strongest] ** 2
+    Y = response[strongest]
     n_ch = Y.shape[0]
     res = _residual(omega, Y, omega_n, zeta, power, region)
+    # the raw-data estimate takes in the resonances' curvature where the lines are coarse
+    # (finding 17); the residual's own neighbour misfit has that curvature removed by the
+    # fitted modes, and a misfit that is smooth on the lines does not enter it either. Below
+    # sqrt(eps)·max|H| a residual's structure is the arithmetic of the fit (exact data fit
+    # to rounding, 1e-16·|H|, leave a structured residual an added mode takes up), not data
+    floor = ARITHMETIC_FLOOR * np.max(np.abs(Y), axis=1)
+    sigma2 = np.maximum(np.minimum(noise_std[strongest], neighbour_noise_std(omega, res)), floor) ** 2
+    if not np.all(sigma2 > 0):
+        return None
     energy = np.mean(np.abs(res) ** 2 / sigma2[:, None], axis=0)
     spacing = float(np.median(np.diff(omega)))
     width = int(np.clip(np.round(np.median(2 * zeta * omega_n) / spacing), 3, max(3, omega.size // 4)))
     smooth = _smoothed(energy, region, width)
     # screen (cheap): the smoothed residual must rise above its noise level by 4 of its
     # standard deviations (1/sqrt(lines × channels) of an Exp(1) mean); the level is the
-    # independent noise estimate or, when the residual's own median says more (noise the
-    # estimate misses), that median (|r|²/σ² ~ Exp(1) has median ln 2)
+    # noise above or, when the residual's own median says more (noise the
+    # estimate misses), that median (|r|²/σ² ~ Exp(1) has median ln 2). A misfit spread over
+    # the whole band (few lines) passes when the mean residual is above the noise by 4 of
+    # its standard deviations
     level = max(1.0, float(np.median(energy)) / np.log(2))
-    if not smooth.max() > level * (1 + 4 / np.sqrt(width * n_ch)):
+    peaked = smooth.max() > level * (1 + 4 / np.sqrt(width * n_ch))
+    if not (peaked or np.mean(energy) > 1 + 4 / np.sqrt(energy.size * n_ch)):
         return None
     i = int(np.argmax(smooth))
     start_wn = np.append(omega_n, omega[i])
@@ -168,7 +187,7 @@ def find_missing_mode(omega: np.ndarray, response: np.ndarray, power: int, regio
         return None
     f_stat = float((np.sum(rss0 - rss1) / q) / (np.sum(rss1) / dof))
     f_limit = float(special.fdtri(q, dof, 1 - SIGNIFICANCE))
-    # against the independent noise estimate: each real part of the noise has variance σ²/2
+    # against the noise above: each real part of the noise has variance σ²/2
     ratio = float(np.sum(2 * (rss0 - rss1) / sigma2))
     ratio_limit = float(special.chdtri(q, SIGNIFICANCE))
     if f_stat > f_limit and ratio > ratio_limit:

@@ -349,7 +349,7 @@ def identify(frf: FRF, method: str = "nls", bands_hz=None, *, noise_std=None, dr
         half-power widths, clipped halfway to its neighbours.
     noise_std : float or array_like over channels, optional
         Known noise σ (E|n|² = σ²) in the FRF's unit; default estimated from
-        second differences of the data.
+        each line's misfit to its neighbours (:func:`modal.peaks.neighbour_noise_std`).
     driving_point : bool or array_like of bool, optional
         Overrides which channels are driving points (k, c, m defined).
     min_prominence_db : float

@@ -11,22 +11,46 @@ from .frf import FRF
 __all__ = ["estimate_noise_std", "mode_indicator", "find_modes", "ModeBand", "bands_from_hz"]
 
 
-def estimate_noise_std(frf: FRF) -> np.ndarray:
-    """Noise standard deviation per channel (E|n|² = σ²), from second differences.
+def neighbour_noise_std(frequency: np.ndarray, values: np.ndarray) -> np.ndarray:
+    """Noise standard deviation per row (E|n|² = σ²), from each line's misfit to its neighbours.
 
-    For white noise the second difference has E|Δ²n|² = 6σ² and, being
-    circular Gaussian, |Δ²n|² has median 6σ² ln 2. The median over the whole
-    axis ignores the few lines where the signal itself curves (resonances).
-    Noise-free data give the (small) curvature floor instead of zero.
+    Each inner line is compared with the straight line through its two
+    neighbours, e = H_i − (w_l H_{i−1} + w_r H_{i+1}) with weights from the
+    line spacing, so a linear trend cancels on any axis (a plain second
+    difference on a jittered axis keeps the slope times the spacing change and
+    takes it for noise). For white noise E|e|² = (1 + w_l² + w_r²)σ² and,
+    being circular Gaussian, |e|² has median ln 2 times that. The median over
+    the axis ignores the few lines where the signal itself curves. On a
+    uniform axis this is the classical second-difference estimate.
+
+    Parameters
+    ----------
+    frequency : ndarray, shape (n_freq,)
+        Increasing axis (any unit).
+    values : ndarray, shape (n_rows, n_freq)
+        Complex data per row; at least 5 lines, else NaN.
     """
-    h = frf.channels
-    if h.shape[1] < 5:
-        return np.abs(h).max(axis=1) * np.nan
-    d2 = h[:, 2:] - 2 * h[:, 1:-1] + h[:, :-2]
-    power = d2.real**2 + d2.imag**2
+    values = np.atleast_2d(values)
+    if values.shape[1] < 5:
+        return np.abs(values).max(axis=1) * np.nan
+    step = np.diff(np.asarray(frequency, float))
+    w_left = step[1:] / (step[:-1] + step[1:])
+    w_right = 1.0 - w_left
+    misfit = values[:, 1:-1] - w_left * values[:, :-2] - w_right * values[:, 2:]
+    power = (misfit.real**2 + misfit.imag**2) / (1.0 + w_left**2 + w_right**2)
     mid = power.shape[1] // 2
     median = np.partition(power, mid, axis=1)[:, mid]
-    return np.sqrt(median / (6 * np.log(2)))
+    return np.sqrt(median / np.log(2))
+
+
+def estimate_noise_std(frf: FRF) -> np.ndarray:
+    """Noise standard deviation per channel (E|n|² = σ²) of the raw data.
+
+    :func:`neighbour_noise_std` over the whole axis. Noise-free data give the
+    (small) curvature floor of the resonances instead of zero; on an axis so
+    coarse that most lines lie on a resonance this floor is the estimate.
+    """
+    return neighbour_noise_std(frf.frequency_hz, frf.channels)
 
 
 def mode_indicator(frf: FRF) -> np.ndarray:

@@ -464,3 +464,41 @@ def test_no_lines_left_for_errors_is_flagged():
     for mode, truth in zip(result, fn):
         assert "too_few_points" in mode.flags
         assert abs(mode.natural_frequency_hz / truth - 1) < 1e-9  # exact data: still exact
+
+
+def test_merged_modes_on_a_coarse_jittered_axis_are_flagged():
+    # finding 17: exact data, modes at 1 and 1.2 Hz (ζ = 0.1, A 1:10) on 16 jittered lines.
+    # Peak detection sees one peak and its fitted ζ is ~5 of its errors off. The raw-data noise
+    # estimate is the resonance's curvature there, which hid the misfit; the check now takes
+    # the residual's own neighbour misfit. Of the 60 cases below, 55 were unflagged before
+    # (5 flagged); now the few unflagged ones are those where the added mode's reduction is at
+    # the level of the data's roughness on the lines (docs/stress.md), so at least 90 % flagged.
+    f_lo, step = 0.05, 2.35 / 16
+    flagged = total = 0
+    for seed in range(20):
+        rng = np.random.default_rng(seed)
+        f = f_lo + rng.uniform(0, 0.999) * step + np.r_[0.0, np.cumsum(rng.uniform(0.5, 1.5, 15) * step)]
+        for kind in ("receptance", "mobility", "accelerance"):
+            frf = modal_frf(f, [1.0, 1.2], [0.1, 0.1], [39.4784176, 394.784176], kind=kind)
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", modal.ModalWarning)
+                result = identify(frf)
+            if len(result) == 1:
+                total += 1
+                flagged += "missing_mode" in result[0].flags
+    assert total >= 50 and flagged >= 0.9 * total
+
+
+def test_structure_at_the_rounding_level_is_not_a_missing_mode():
+    # exact one-mode data plus a mode-shaped disturbance at 1e-12 of the signal: the residual's
+    # neighbour misfit is at rounding (1e-16), so without a floor the added mode was
+    # "significant"; below sqrt(eps)·max|H| structure is the arithmetic of a fit, not data
+    f = np.linspace(80, 120, 801)
+    clean = modal_frf(f, [100.0], [0.02], [1.0])
+    bump = modal_frf(f, [95.0], [0.01], [1.0])
+    frf = modal.FRF(f, clean.response + 1e-12 * bump.response / np.abs(bump.response).max()
+                    * np.abs(clean.response).max())
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", modal.ModalWarning)
+        result = identify(frf, bands_hz=[(80, 120)])
+    assert "missing_mode" not in result[0].flags

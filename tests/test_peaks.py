@@ -20,3 +20,18 @@ def test_noise_estimate_matches_the_added_noise():
     sigma = 0.01 * np.abs(modal_frf(f, [50.0, 120.0], [0.02, 0.02], [1.0, 1.0]).response).max()
     # median of ~4000 exponential samples: relative error ~ 1.2/sqrt(4000) ≈ 2 %; resonances bias it slightly up
     assert abs(estimate_noise_std(frf)[0] / sigma - 1) < 0.1
+
+
+def test_noise_estimate_ignores_a_trend_on_a_jittered_axis():
+    # a line through its neighbours cancels any straight trend whatever the spacing; the plain
+    # second difference kept slope × (change of spacing) and called it noise (finding 17)
+    from modal import FRF
+
+    rng = np.random.default_rng(3)
+    f = 10 + np.cumsum(rng.uniform(0.5, 1.5, 2000))
+    trend = (2 + 3j) * f
+    assert estimate_noise_std(FRF(f, trend))[0] < 1e-12 * np.abs(trend).max()
+    # white noise on that axis: the estimate is σ to the median's 1.2/sqrt(n) ≈ 3 % (4 of them)
+    sigma = 0.1
+    noise = sigma / np.sqrt(2) * (rng.standard_normal(f.size) + 1j * rng.standard_normal(f.size))
+    assert abs(estimate_noise_std(FRF(f, trend + noise))[0] / sigma - 1) < 4 * 1.2 / np.sqrt(f.size)
