@@ -38,7 +38,7 @@ from .nls import fit_modes
 from .peaks import neighbour_noise_std
 from .units import TWO_PI
 
-__all__ = ["MissingMode", "find_missing_mode", "SIGNIFICANCE"]
+__all__ = ["MissingMode", "find_missing_mode", "residual_noise_std", "SIGNIFICANCE"]
 
 #: false-alarm probability of each test for one added mode
 SIGNIFICANCE = 1e-6
@@ -100,6 +100,41 @@ def _smoothed(values: np.ndarray, region: np.ndarray, width: int) -> np.ndarray:
     return out
 
 
+def _seen_through(res, omega, response, noise_std):
+    floor = ARITHMETIC_FLOOR * np.max(np.abs(response), axis=1)
+    return np.maximum(np.minimum(noise_std, neighbour_noise_std(omega, res)), floor)
+
+
+def residual_noise_std(omega: np.ndarray, response: np.ndarray, power: int, region: np.ndarray,
+                       omega_n, damping_ratio, noise_std) -> np.ndarray:
+    """Noise σ per channel as the fit's residual shows it.
+
+    The raw-data estimate (:func:`modal.peaks.estimate_noise_std`) takes in the
+    resonances' curvature where the lines are coarse: 3.7σ at 16 lines across
+    a band of ±5 half-power widths (finding 17 of docs/stress.md). The same
+    neighbour-misfit estimate on the residual of the fitted modes has that
+    curvature removed, and a misfit that is smooth on the lines does not enter
+    it either (1.02σ there). The result is the smaller of the two, and at least
+    ``ARITHMETIC_FLOOR``·max|H|: exact data fit to rounding leave a structured
+    residual at 1e-16·|H| which is the arithmetic of the fit, not data.
+
+    Parameters
+    ----------
+    omega, response, power, region, omega_n, damping_ratio
+        As for :func:`find_missing_mode`.
+    noise_std : ndarray, shape (n_channels,)
+        Raw-data estimate per channel.
+
+    Returns
+    -------
+    ndarray, shape (n_channels,)
+    """
+    omega_n = np.atleast_1d(np.asarray(omega_n, float))
+    zeta = np.atleast_1d(np.asarray(damping_ratio, float))
+    res = _residual(omega, response, omega_n, zeta, power, region)
+    return _seen_through(res, omega, response, np.asarray(noise_std, float))
+
+
 def find_missing_mode(omega: np.ndarray, response: np.ndarray, power: int, region: np.ndarray,
                       omega_n, damping_ratio, noise_std, bands_rad) -> MissingMode | None:
     """Test the residual of fitted modes for one more mode.
@@ -117,7 +152,8 @@ def find_missing_mode(omega: np.ndarray, response: np.ndarray, power: int, regio
     omega_n, damping_ratio : array_like, shape (n_modes,)
         Fitted poles (rad/s, dimensionless).
     noise_std : ndarray, shape (n_channels,)
-        Independently estimated noise σ per channel (E|n|² = σ²).
+        Raw-data noise estimate σ per channel (E|n|² = σ²); the check uses the
+        noise as the residual shows it (:func:`residual_noise_std`).
     bands_rad : list of (low, high)
         The fitting bands, rad/s.
 
@@ -134,13 +170,7 @@ def find_missing_mode(omega: np.ndarray, response: np.ndarray, power: int, regio
     Y = response[strongest]
     n_ch = Y.shape[0]
     res = _residual(omega, Y, omega_n, zeta, power, region)
-    # the raw-data estimate takes in the resonances' curvature where the lines are coarse
-    # (finding 17); the residual's own neighbour misfit has that curvature removed by the
-    # fitted modes, and a misfit that is smooth on the lines does not enter it either. Below
-    # sqrt(eps)·max|H| a residual's structure is the arithmetic of the fit (exact data fit
-    # to rounding, 1e-16·|H|, leave a structured residual an added mode takes up), not data
-    floor = ARITHMETIC_FLOOR * np.max(np.abs(Y), axis=1)
-    sigma2 = np.maximum(np.minimum(noise_std[strongest], neighbour_noise_std(omega, res)), floor) ** 2
+    sigma2 = _seen_through(res, omega, Y, noise_std[strongest]) ** 2
     if not np.all(sigma2 > 0):
         return None
     energy = np.mean(np.abs(res) ** 2 / sigma2[:, None], axis=0)

@@ -5,7 +5,7 @@ import warnings
 
 import numpy as np
 
-from .checks import find_missing_mode
+from .checks import find_missing_mode, residual_noise_std
 from .circlefit import circle_fit_curve
 from .errors import IdentificationError, QualityWarning, ResolutionWarning, warn
 from .frf import FRF, KIND_POWER
@@ -262,7 +262,9 @@ def _refinement_check(frf, bands, power, poles, consts, noise, estimated_noise):
     with np.errstate(all="ignore"):
         fit = fit_modes(frf.omega_rad_s[keep], frf.channels[np.ix_(strongest, keep)], power, wn0, z0,
                         region=region)
-    chi2 = _chi2(fit.noise_var, estimated_noise[strongest])
+    # the noise as the fit's residual shows it (the raw estimate takes in curvature on coarse axes)
+    chi2 = _chi2(fit.noise_var, _fit_noise(frf, bands, power, fit.omega_n, fit.damping_ratio,
+                                           estimated_noise, strongest))
     # the refinement may return the modes in another order (two close poles crossing)
     order = np.argsort(fit.omega_n)
     omega_n, damping_ratio = fit.omega_n[order], fit.damping_ratio[order]
@@ -290,6 +292,15 @@ def _chi2(residual_var, noise_std) -> float:
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = residual_var / np.where(noise_std > 0, noise_std, np.nan) ** 2
     return float(np.nanmedian(ratio)) if np.isfinite(ratio).any() else np.nan
+
+
+def _fit_noise(frf, bands, power, omega_n, damping_ratio, estimated_noise, channels=None):
+    """:func:`modal.checks.residual_noise_std` on the lines of the bands (all or some channels)."""
+    keep, region = _regions(bands, frf.frequency_hz)
+    rows = slice(None) if channels is None else channels
+    with np.errstate(all="ignore"):
+        return residual_noise_std(frf.omega_rad_s[keep], frf.channels[rows][:, keep], power, region,
+                                  omega_n, damping_ratio, estimated_noise[rows])
 
 
 def _missing_mode(frf, bands, power, omega_n, damping_ratio, estimated_noise):
@@ -443,7 +454,8 @@ def identify(frf: FRF, method: str = "nls", bands_hz=None, *, noise_std=None, dr
         keep, region = _regions(bands, frf.frequency_hz)
         fit = fit_modes(frf.omega_rad_s[keep], frf.channels[:, keep], power,
                         [s[0] for s in starts], [s[1] for s in starts], region=region)
-        chi2 = _chi2(fit.noise_var, estimated_noise)
+        chi2 = _chi2(fit.noise_var, _fit_noise(frf, bands, power, fit.omega_n, fit.damping_ratio,
+                                               estimated_noise))
         missing_mode = _missing_mode(frf, bands, power, fit.omega_n, fit.damping_ratio, estimated_noise)
         order = np.argsort(fit.omega_n)  # two close poles may cross during the fit
         for band, r in zip(bands, order):

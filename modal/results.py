@@ -86,8 +86,11 @@ class ModeResult:
     lines_per_bandwidth : float
         Lines per half-power bandwidth 2ζfn (resolution; < 3 is coarse).
     chi2 : float
-        Residual variance over the independently estimated noise variance
-        (≈ 1 when the model explains the data; NaN when not computed).
+        Residual variance over the noise variance (≈ 1 when the model explains
+        the data; NaN when not computed). The noise is estimated without the
+        model: each line against the straight line through its neighbours, on
+        the raw data and on the residual, the smaller of the two
+        (:func:`modal.checks.residual_noise_std`).
     driving_point : bool or ndarray of bool
         Per channel: whether k, c, m are defined.
     quality : float

@@ -502,3 +502,15 @@ def test_structure_at_the_rounding_level_is_not_a_missing_mode():
         warnings.simplefilter("ignore", modal.ModalWarning)
         result = identify(frf, bands_hz=[(80, 120)])
     assert "missing_mode" not in result[0].flags
+
+
+def test_three_modes_merged_into_one_peak_are_flagged():
+    # stress case (overlap 1.2, 16 lines, exact data): 1, 1.2 and 1.44 Hz, ζ = 0.1, seen as
+    # one peak. One added mode overlaps the fitted one by 1.7 (a split, so not missing_mode),
+    # but the residual is 5σ of the noise the residual shows (the raw estimate, 6× larger
+    # there, is the resonance's curvature): model_inadequate
+    f = 0.05 + 0.17687500036 * np.arange(16)
+    frf = modal_frf(f, [1.0, 1.2, 1.44], [0.1] * 3, [39.4784176, 394.784176, 39.4784176])
+    with pytest.warns(QualityWarning, match="model_inadequate"):
+        result = identify(frf)
+    assert len(result) == 1 and "model_inadequate" in result[0].flags and result[0].chi2 > 3

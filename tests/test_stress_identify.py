@@ -53,7 +53,10 @@ RTOL_EXACT = 1e-9
 #: accuracy is asserted for modes this well separated (overlap 2ζωn/Δω); identify flags
 #: close_modes above 1.5, where the NLS errors turn optimistic (finding 12 in docs/stress.md)
 OVERLAP_ASSERTED = 1.2
-#: when peak detection misses a mode, accuracy is asserted up to this overlap
+#: when peak detection misses a mode, accuracy is asserted up to this overlap. Closer, modes
+#: merged into one peak can look like one broader mode within the noise: 1, 1.2 and 1.44 Hz at
+#: ζ = 0.1 (A 1:10:1), 6 % noise, 10 lines per band give chi2 1.0-1.5 while ζ is 6-9 of its
+#: errors off (STRESS_SEED=7 with this limit at 1.2; docs/stress.md, finding 17)
 HIDDEN_OVERLAP_ASSERTED = 0.3
 #: cap on the number of lines so that one case takes well under a second or two
 N_MAX = 3000
@@ -210,8 +213,8 @@ def check_accuracy(case: Case, result) -> None:
         event("all modes reported")
         truth = range(case.fn.size)
     elif case.overlap > HIDDEN_OVERLAP_ASSERTED:
-        # a weak mode merged into a strong one's peak: on a coarse axis the second-difference
-        # noise estimate takes in the curvature and the misfit hides below it (open, docs/stress.md)
+        # modes merged into one peak: flagged where the residual shows it (missing_mode,
+        # model_inadequate), but a merged peak within the noise is not told from one mode
         event("modes missing and overlapping: accuracy not asserted")
         return
     else:
