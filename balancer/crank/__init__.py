@@ -1,0 +1,105 @@
+"""Slider-crank shaking forces and the crank counterweight that minimises them.
+
+Model (seed 000, eqs. 1 and 9-11; seed 004, eqs. 3-5)
+-----------------------------------------------------
+A crank of radius ``r`` turns at a constant angular speed ``omega``; the crank
+angle ``theta`` is measured from top dead centre, the piston moves along ``y``
+and ``x`` is perpendicular to the stroke in the plane of the crank.  The rod is
+split into two lumped masses (:func:`two_mass_split`), so the mechanism is a
+rotating mass ``m_rot`` at the crank pin and a reciprocating mass ``m_rec`` at
+the wrist pin.  A counterweight of mass ``m_c`` at radius ``r_c`` sits opposite
+the crank pin.  The shaking force on the frame is::
+
+    F_x = (m_c r_c - m_rot r) omega**2 sin(theta)
+    F_y = (m_rot r - m_c r_c) omega**2 cos(theta) + m_rec r omega**2 A(theta)
+
+with the piston's acceleration factor ``A`` (``-r omega**2 A`` is the piston
+acceleration).  Exactly, with ``lam = r / l`` and ``D = sqrt(1 - lam**2 sin**2)``::
+
+    A = cos(theta) + lam cos(2 theta) / D + lam**3 sin(2 theta)**2 / (4 D**3)
+
+or as a harmonic series ``A = sum_h a_h cos(h theta)``.  The papers keep
+``h = 1, 2`` with the leading coefficients ``a_1 = 1, a_2 = lam``
+(``a_4 = -lam**3/4``, ``a_6 = 9 lam**5/128``).  The rod-inertia couple of the
+two-mass model is ``M_z = -J_AB lam omega**2 B(theta)`` with
+``B = (1 - lam**2) sin(theta) / D**3`` exactly, or the series
+``sin(theta) - (3 lam**2/8) sin(3 theta) + (15 lam**4/128) sin(5 theta)``.
+
+The force depends on the counterweight only through ``u = m_c r_c``.  The
+*balance fraction* ``alpha`` is defined by ``u = (m_rot + alpha m_rec) r``.  The
+resultant scaled by ``m_rec r omega**2`` depends only on ``alpha`` and
+``lam``, so the optimal ``alpha`` does not depend on speed.  The peak resultant
+force over a revolution is convex in ``alpha`` (a maximum of norms of affine
+maps), so :func:`optimal_counterweight` solves it exactly.
+
+Everything is SI inside (m, kg, N, rad, rad/s); rpm appears only in argument
+names ``speed_rpm``.  ``|F|`` is even in ``theta`` for every model here, so
+maxima over a revolution are searched on ``[0, pi]``.
+
+The package has three parts: :mod:`~balancer.crank.model` (the mechanism and its
+kinematics), :mod:`~balancer.crank.forces` (shaking force, harmonics, exact
+maxima) and :mod:`~balancer.crank.counterweight` (evaluation, optimum, grid).
+Everything public is importable from ``balancer.crank``.
+"""
+from __future__ import annotations
+
+from .model import (
+    OBJECTIVES,
+    Objective as Objective,  # the objective names, for type hints
+    PAPER_RULES,
+    RodSplit,
+    SliderCrank,
+    balance_fraction,
+    counterweight_mass,
+    counterweight_moment,
+    slider_crank_from_components,
+    two_mass_split,
+)
+from .forces import (
+    ShakingForce,
+    ShakingHarmonics,
+    max_shaking_force,
+    shaking_force,
+    shaking_harmonics,
+    shaking_objective,
+)
+from .counterweight import (
+    Counterweight,
+    CounterweightEvaluation,
+    GridSearchResult,
+    OptimalCounterweight,
+    OptimalCurve,
+    counterweight_on_curve,
+    evaluate_balance_fraction,
+    evaluate_counterweight,
+    grid_search_counterweight,
+    optimal_counterweight,
+)
+
+__all__ = [
+    "SliderCrank",
+    "RodSplit",
+    "ShakingForce",
+    "ShakingHarmonics",
+    "CounterweightEvaluation",
+    "OptimalCurve",
+    "OptimalCounterweight",
+    "Counterweight",
+    "GridSearchResult",
+    "PAPER_RULES",
+    "OBJECTIVES",
+    "two_mass_split",
+    "slider_crank_from_components",
+    "balance_fraction",
+    "counterweight_mass",
+    "counterweight_moment",
+    "shaking_force",
+    "shaking_harmonics",
+    "max_shaking_force",
+    "shaking_objective",
+    "evaluate_counterweight",
+    "evaluate_balance_fraction",
+    "optimal_counterweight",
+    "counterweight_on_curve",
+    "grid_search_counterweight",
+]
