@@ -30,14 +30,20 @@ def neighbour_noise_std(frequency: np.ndarray, values: np.ndarray) -> np.ndarray
     values : ndarray, shape (n_rows, n_freq)
         Complex data per row; at least 5 lines, else NaN.
     """
-    values = np.atleast_2d(values)
+    values = np.atleast_2d(np.asarray(values, dtype=complex))
     if values.shape[1] < 5:
         return np.abs(values).max(axis=1) * np.nan
     step = np.diff(np.asarray(frequency, float))
     w_left = step[1:] / (step[:-1] + step[1:])
     w_right = 1.0 - w_left
-    misfit = values[:, 1:-1] - w_left * values[:, :-2] - w_right * values[:, 2:]
-    power = (misfit.real**2 + misfit.imag**2) / (1.0 + w_left**2 + w_right**2)
+    # in place: 1000 channels × 2000 lines are 32 MB per temporary
+    misfit = np.multiply(values[:, :-2], w_left, out=np.empty((values.shape[0], w_left.size), complex))
+    misfit += values[:, 2:] * w_right
+    np.subtract(values[:, 1:-1], misfit, out=misfit)
+    parts = misfit.view(float)
+    np.square(parts, out=parts)
+    power = parts[:, 0::2] + parts[:, 1::2]
+    power *= 1.0 / (1.0 + w_left**2 + w_right**2)
     mid = power.shape[1] // 2
     median = np.partition(power, mid, axis=1)[:, mid]
     return np.sqrt(median / np.log(2))
