@@ -8,7 +8,7 @@ import numpy as np
 from .errors import IdentificationError
 from .frf import FRF
 
-__all__ = ["estimate_noise_std", "mode_indicator", "find_modes", "ModeBand", "bands_from_hz"]
+__all__ = ["estimate_noise_std", "neighbour_noise_std", "mode_indicator", "find_modes", "ModeBand", "bands_from_hz"]
 
 
 def neighbour_noise_std(frequency: np.ndarray, values: np.ndarray) -> np.ndarray:
