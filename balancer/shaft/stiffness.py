@@ -1,0 +1,278 @@
+"""Shaft stiffness at the rotor, first critical speed (Dunkerley) and the margin of the
+running speed from it."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Sequence
+
+import numpy as np
+
+from modal.errors import ParameterError
+from modal.units import rad_s_to_rpm
+
+from ..drive import _non_negative, _positive
+from .statics import STEEL_DENSITY_KG_M3, STEEL_YOUNGS_MODULUS_PA, ShaftGeometry, _check_position
+
+__all__ = [
+    "CriticalSpeed",
+    "SpeedMargin",
+    "second_moment_of_area_m4",
+    "rotor_layout",
+    "bending_stiffness_n_per_m",
+    "span_critical_speed_rad_s",
+    "critical_speed",
+    "speed_margin",
+]
+
+
+# --------------------------------------------------------------------------- stiffness
+def second_moment_of_area_m4(diameter_m: float) -> float:
+    """``I = pi d**4 / 64`` of a solid round shaft, m^4 (``diameter_m`` in m)."""
+    d = _positive("diameter_m", diameter_m, "m")
+    return math.pi * d**4 / 64.0
+
+
+def rotor_layout(geometry: ShaftGeometry, position_m: float) -> str:
+    """Where a rotor sits relative to the bearings.
+
+    Parameters
+    ----------
+    geometry : ShaftGeometry
+        Shaft and bearings.
+    position_m : float
+        Rotor position, m.
+
+    Returns
+    -------
+    str
+        ``"between bearings"`` or ``"overhung"``.
+
+    Raises
+    ------
+    ParameterError
+        At a bearing (a simply supported shaft is rigid there) or off the shaft.
+    """
+    x = _check_position(geometry, "position_m", position_m)
+    if x == geometry.bearing_a_m or x == geometry.bearing_b_m:
+        raise ParameterError(
+            f"position_m = {x:.6g} m is at a bearing, where a simply supported shaft is rigid; "
+            "expected a position between the bearings or on an overhang"
+        )
+    return "between bearings" if geometry.bearing_a_m < x < geometry.bearing_b_m else "overhung"
+
+
+def bending_stiffness_n_per_m(geometry: ShaftGeometry, position_m: float, diameter_m: float,
+                              youngs_modulus_pa: float = STEEL_YOUNGS_MODULUS_PA) -> float:
+    """Transverse bending stiffness of a uniform shaft at ``position_m`` (load and deflection there).
+
+    Between the bearings, a from A and b from B on span L: ``k = 3 E I L / (a**2 b**2)``
+    (``48 E I / L**3`` at mid-span).  Overhang c beyond a bearing:
+    ``k = 3 E I / (c**2 (L + c))``.
+
+    Parameters
+    ----------
+    geometry : ShaftGeometry
+        Shaft and bearings (simple supports).
+    position_m : float
+        Where the rotor sits, m.
+    diameter_m : float
+        Shaft diameter, m.
+    youngs_modulus_pa : float
+        Young's modulus, Pa.
+
+    Returns
+    -------
+    float
+        Stiffness, N/m.
+    """
+    layout = rotor_layout(geometry, position_m)
+    ei = _positive("youngs_modulus_pa", youngs_modulus_pa, "Pa") * second_moment_of_area_m4(diameter_m)
+    x, span = float(position_m), geometry.span_m
+    if layout == "between bearings":
+        a, b = x - geometry.bearing_a_m, geometry.bearing_b_m - x
+        stiffness = 3.0 * ei * span / (a * b) / (a * b)  # a*b first: a*a*b*b underflows near a bearing
+    else:
+        c = geometry.bearing_a_m - x if x < geometry.bearing_a_m else x - geometry.bearing_b_m
+        stiffness = 3.0 * ei / c / (c * (span + c))
+    if not math.isfinite(stiffness):
+        raise ParameterError(
+            f"position_m = {position_m!r} m lies (numerically) on a bearing: the shaft's stiffness there is "
+            "unbounded; expected a rotor position away from the bearings")
+    return stiffness
+
+
+def span_critical_speed_rad_s(span_m: float, diameter_m: float, youngs_modulus_pa: float = STEEL_YOUNGS_MODULUS_PA,
+                              density_kg_m3: float = STEEL_DENSITY_KG_M3) -> float:
+    """First bending critical speed of the bare shaft span, simply supported:
+    ``omega = (pi/L)**2 sqrt(E I / (rho A))`` (overhang mass ignored).
+
+    Parameters
+    ----------
+    span_m : float
+        Bearing span, m.
+    diameter_m : float
+        Shaft diameter, m.
+    youngs_modulus_pa : float
+        Young's modulus, Pa.
+    density_kg_m3 : float
+        Density, kg/m^3.
+
+    Returns
+    -------
+    float
+        Critical speed, rad/s.
+    """
+    span = _positive("span_m", span_m, "m")
+    e = _positive("youngs_modulus_pa", youngs_modulus_pa, "Pa")
+    rho = _positive("density_kg_m3", density_kg_m3, "kg/m^3")
+    d = _positive("diameter_m", diameter_m, "m")
+    area = math.pi * d * d / 4.0
+    return (math.pi / span) ** 2 * math.sqrt(e * second_moment_of_area_m4(d) / (rho * area))
+
+
+@dataclass(frozen=True, slots=True)
+class CriticalSpeed:
+    """First critical speed by Dunkerley's combination ``1/w**2 = sum 1/w_i**2``
+    (a lower bound on the true first critical speed).
+
+    Attributes
+    ----------
+    partial_labels : tuple of str
+        What each partial speed is (``"shaft span"``, ``"mass 1 at 1.3 m"``...).
+    partial_speeds_rad_s : numpy.ndarray
+        Each mass alone on the massless shaft, ``sqrt(k_ii / m_i)``, and the bare shaft, rad/s.
+    critical_speed_rad_s : float
+        Dunkerley's combination, rad/s.
+    critical_speed_rpm : float
+        The same, rev/min.
+    """
+
+    partial_labels: tuple[str, ...]
+    partial_speeds_rad_s: np.ndarray
+    critical_speed_rad_s: float
+    critical_speed_rpm: float
+
+
+def critical_speed(geometry: ShaftGeometry, diameter_m: float, masses_kg: Sequence[float], positions_m: Sequence[float],
+                   youngs_modulus_pa: float = STEEL_YOUNGS_MODULUS_PA, density_kg_m3: float = STEEL_DENSITY_KG_M3,
+                   include_shaft_mass: bool = True) -> CriticalSpeed:
+    """First critical speed of a shaft carrying point masses, by Dunkerley.
+
+    Parameters
+    ----------
+    geometry : ShaftGeometry
+        Shaft and bearings.
+    diameter_m : float
+        Shaft diameter, m.
+    masses_kg : sequence of float
+        Point masses (rotors, pulleys), kg, > 0.
+    positions_m : sequence of float
+        Their positions, m (not at a bearing).
+    youngs_modulus_pa : float
+        Young's modulus, Pa.
+    density_kg_m3 : float
+        Shaft density, kg/m^3 (used when ``include_shaft_mass``).
+    include_shaft_mass : bool
+        Whether the bare span's own first mode enters the combination.
+
+    Returns
+    -------
+    CriticalSpeed
+        Partial speeds and their combination.
+    """
+    if len(masses_kg) != len(positions_m):
+        raise ParameterError(
+            f"masses_kg has {len(masses_kg)} values and positions_m {len(positions_m)}; expected equal lengths"
+        )
+    if len(masses_kg) == 0 and not include_shaft_mass:
+        raise ParameterError("masses_kg = [] and include_shaft_mass = False; expected something that vibrates")
+    labels: list[str] = []
+    speeds: list[float] = []
+    for index, (mass, position) in enumerate(zip(masses_kg, positions_m)):
+        m = _positive(f"masses_kg[{index}]", mass, "kg")
+        x = _check_position(geometry, f"positions_m[{index}]", position)
+        k = bending_stiffness_n_per_m(geometry, x, diameter_m, youngs_modulus_pa)
+        labels.append(f"mass {index + 1} ({m:g} kg at {x:g} m, {rotor_layout(geometry, x)})")
+        speeds.append(math.sqrt(k / m))
+    if include_shaft_mass:
+        labels.append("shaft span (simply supported)")
+        speeds.append(span_critical_speed_rad_s(geometry.span_m, diameter_m, youngs_modulus_pa, density_kg_m3))
+    partial = np.asarray(speeds)
+    combined = float(1.0 / math.sqrt(float(np.sum(1.0 / partial**2))))
+    return CriticalSpeed(
+        partial_labels=tuple(labels),
+        partial_speeds_rad_s=partial,
+        critical_speed_rad_s=combined,
+        critical_speed_rpm=float(rad_s_to_rpm(combined)),
+    )
+
+
+@dataclass(frozen=True, slots=True)
+class SpeedMargin:
+    """Separation of the running speed (1x) and its double (2x) from a critical speed.
+
+    Separation at harmonic h is ``|w_c / (h W) - 1|``: the critical speed's distance
+    from the excitation frequency ``h W``, as a fraction of it.
+
+    Attributes
+    ----------
+    running_speed_rad_s, critical_speed_rad_s : float
+        W and w_c, rad/s.
+    critical_to_running_ratio : float
+        ``w_c / W``.
+    separation_1x, separation_2x : float
+        Separations at 1x and 2x (dimensionless).
+    required_separation : float
+        The margin asked for (dimensionless).
+    ok_1x, ok_2x : bool
+        Whether each separation meets it.
+    supercritical : bool
+        Whether the shaft runs above the critical speed (W > w_c), which an
+        automatic ball balancer needs in order to balance.
+    """
+
+    running_speed_rad_s: float
+    critical_speed_rad_s: float
+    critical_to_running_ratio: float
+    separation_1x: float
+    separation_2x: float
+    required_separation: float
+    ok_1x: bool
+    ok_2x: bool
+    supercritical: bool
+
+
+def speed_margin(running_speed_rad_s: float, critical_speed_rad_s: float, required_separation: float = 0.2) -> SpeedMargin:
+    """Check the running speed and twice it against a critical speed.
+
+    Parameters
+    ----------
+    running_speed_rad_s : float
+        Shaft speed W, rad/s.
+    critical_speed_rad_s : float
+        First critical speed w_c, rad/s.
+    required_separation : float
+        Minimum ``|w_c/(h W) - 1|`` (default 0.2, i.e. 20 %).
+
+    Returns
+    -------
+    SpeedMargin
+        Ratios and pass/fail flags at 1x and 2x.
+    """
+    w = _positive("running_speed_rad_s", running_speed_rad_s, "rad/s")
+    wc = _positive("critical_speed_rad_s", critical_speed_rad_s, "rad/s")
+    required = _non_negative("required_separation", required_separation, "(dimensionless)")
+    s1 = abs(wc / w - 1.0)
+    s2 = abs(wc / (2.0 * w) - 1.0)
+    return SpeedMargin(
+        running_speed_rad_s=w,
+        critical_speed_rad_s=wc,
+        critical_to_running_ratio=wc / w,
+        separation_1x=s1,
+        separation_2x=s2,
+        required_separation=required,
+        ok_1x=bool(s1 >= required),
+        ok_2x=bool(s2 >= required),
+        supercritical=bool(w > wc),
+    )
