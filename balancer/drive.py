@@ -30,6 +30,8 @@ import numpy as np
 from modal.errors import ParameterError
 from modal.units import rpm_to_rad_s
 
+from ._checks import finite, non_negative, positive
+
 __all__ = [
     "BELT_LENGTH_ARC_COEFFICIENT",
     "ARC_CORRECTION_VV",
@@ -50,31 +52,6 @@ __all__ = [
 #: Coefficient of ``(D + d)`` in the catalogue pitch-length formula (pi/2 rounded
 #: to 1.57, as in belt catalogues and the report).
 BELT_LENGTH_ARC_COEFFICIENT = 1.57
-
-
-# --------------------------------------------------------------------------- checks
-def _finite(name: str, value: float, unit: str) -> float:
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        raise ParameterError(f"{name} = {value!r} is not a number; expected a value in {unit}") from None
-    if not math.isfinite(number):
-        raise ParameterError(f"{name} = {number} {unit} is not finite; expected a finite value")
-    return number
-
-
-def _positive(name: str, value: float, unit: str) -> float:
-    number = _finite(name, value, unit)
-    if number <= 0.0:
-        raise ParameterError(f"{name} = {number} {unit} must be > 0")
-    return number
-
-
-def _non_negative(name: str, value: float, unit: str) -> float:
-    number = _finite(name, value, unit)
-    if number < 0.0:
-        raise ParameterError(f"{name} = {number} {unit} must be >= 0")
-    return number
 
 
 # --------------------------------------------------------------------------- tables
@@ -120,7 +97,7 @@ class CorrectionTable:
     def lookup(self, value: float) -> float:
         """Factor at ``value`` (linear interpolation); raises
         :class:`~modal.errors.ParameterError` outside the table."""
-        number = _finite(self.variable, value, "(table variable)")
+        number = finite(self.variable, value, "(table variable)")
         if number < self.x[0] or number > self.x[-1]:
             raise ParameterError(
                 f"{self.variable} = {number:.6g} is outside the correction table "
@@ -143,9 +120,9 @@ ARC_CORRECTION_VV = CorrectionTable(
 
 # --------------------------------------------------------------------------- geometry
 def _check_pulleys(driver_diameter_m: float, driven_diameter_m: float, center_distance_m: float) -> tuple[float, float, float]:
-    d1 = _positive("driver_diameter_m", driver_diameter_m, "m")
-    d2 = _positive("driven_diameter_m", driven_diameter_m, "m")
-    c = _positive("center_distance_m", center_distance_m, "m")
+    d1 = positive("driver_diameter_m", driver_diameter_m, "m")
+    d2 = positive("driven_diameter_m", driven_diameter_m, "m")
+    c = positive("center_distance_m", center_distance_m, "m")
     if c <= 0.5 * (d1 + d2):
         raise ParameterError(
             f"center_distance_m = {c:.6g} m is too small for pulleys of {d1:.6g} m and {d2:.6g} m: "
@@ -195,9 +172,9 @@ def center_distance_for_length_m(belt_length_m: float, driver_diameter_m: float,
     ParameterError
         If the belt is too short to wrap the two pulleys without overlap.
     """
-    length = _positive("belt_length_m", belt_length_m, "m")
-    d1 = _positive("driver_diameter_m", driver_diameter_m, "m")
-    d2 = _positive("driven_diameter_m", driven_diameter_m, "m")
+    length = positive("belt_length_m", belt_length_m, "m")
+    d1 = positive("driver_diameter_m", driver_diameter_m, "m")
+    d2 = positive("driven_diameter_m", driven_diameter_m, "m")
     b = 4.0 * length - 4.0 * BELT_LENGTH_ARC_COEFFICIENT * (d1 + d2)
     discriminant = b * b - 32.0 * (d2 - d1) ** 2
     c = (b + math.sqrt(discriminant)) / 16.0 if discriminant >= 0.0 and b > 0.0 else -1.0
@@ -251,7 +228,7 @@ def next_standard_size(value: float, series: Sequence[float], name: str = "value
     ParameterError
         If every member of the series is smaller than ``value``.
     """
-    value = _finite(name, value, "(size)")
+    value = finite(name, value, "(size)")
     try:
         sizes = np.sort(np.asarray(series, dtype=float))
     except (TypeError, ValueError):
@@ -279,7 +256,7 @@ def tension_sum_factor_from_ratio(tension_ratio: float) -> float:
     float
         ``k1`` such that ``T1 + T2 = k1 F_e`` (``R = 5`` gives 1.5).
     """
-    ratio = _finite("tension_ratio", tension_ratio, "(dimensionless)")
+    ratio = finite("tension_ratio", tension_ratio, "(dimensionless)")
     if ratio <= 1.0:
         raise ParameterError(f"tension_ratio = {ratio} must be > 1 (tight side tighter than slack side)")
     return (ratio + 1.0) / (ratio - 1.0)
@@ -302,9 +279,9 @@ def tension_ratio_from_friction(friction_coefficient: float, arc_of_contact_rad:
     float
         The tension ratio ``T1/T2`` (dimensionless).
     """
-    mu = _positive("friction_coefficient", friction_coefficient, "(dimensionless)")
-    theta = _positive("arc_of_contact_rad", arc_of_contact_rad, "rad")
-    beta = _positive("groove_angle_rad", groove_angle_rad, "rad")
+    mu = positive("friction_coefficient", friction_coefficient, "(dimensionless)")
+    theta = positive("arc_of_contact_rad", arc_of_contact_rad, "rad")
+    beta = positive("groove_angle_rad", groove_angle_rad, "rad")
     if theta >= 2.0 * math.pi or beta >= math.pi:
         raise ParameterError(
             f"arc_of_contact_rad = {theta:.6g}, groove_angle_rad = {beta:.6g}; expected theta < 2 pi and beta < pi"
@@ -474,18 +451,18 @@ def belt_stage(
         given belt count below the required count.
     """
     d1, d2, c = _check_pulleys(driver_diameter_m, driven_diameter_m, center_distance_m)
-    n1_rpm = _positive("driver_speed_rpm", driver_speed_rpm, "rpm")
-    power = _positive("power_w", power_w, "W")
-    factor = _positive("service_factor", service_factor, "(dimensionless)")
-    k1 = _finite("tension_sum_factor", tension_sum_factor, "(dimensionless)")
+    n1_rpm = positive("driver_speed_rpm", driver_speed_rpm, "rpm")
+    power = positive("power_w", power_w, "W")
+    factor = positive("service_factor", service_factor, "(dimensionless)")
+    k1 = finite("tension_sum_factor", tension_sum_factor, "(dimensionless)")
     if k1 <= 1.0:
         raise ParameterError(f"tension_sum_factor = {k1} must be > 1 ((T1 + T2)/(T1 - T2) with T2 > 0)")
-    k2 = _non_negative("centrifugal_factor_kg_per_m", centrifugal_factor_kg_per_m, "kg/m")
-    k_length = _positive("length_correction_factor", length_correction_factor, "(dimensionless)")
+    k2 = non_negative("centrifugal_factor_kg_per_m", centrifugal_factor_kg_per_m, "kg/m")
+    k_length = positive("length_correction_factor", length_correction_factor, "(dimensionless)")
     if arc_correction_factor is None:
         k_arc = arc_correction_table.lookup(abs(d2 - d1) / c)
     else:
-        k_arc = _positive("arc_correction_factor", arc_correction_factor, "(dimensionless)")
+        k_arc = positive("arc_correction_factor", arc_correction_factor, "(dimensionless)")
 
     omega1 = float(rpm_to_rad_s(n1_rpm))
     ratio = d2 / d1
@@ -502,7 +479,7 @@ def belt_stage(
     pull = power / speed
 
     if per_belt_rating_w is not None:
-        rating = _positive("per_belt_rating_w", per_belt_rating_w, "W")
+        rating = positive("per_belt_rating_w", per_belt_rating_w, "W")
         required = design_power / (rating * k_arc * k_length)
         minimum_count = max(1, math.ceil(required * (1.0 - 1e-9)))
     else:
@@ -650,13 +627,13 @@ def belt_drive(motor_speed_rpm: float, power_w: float, stages: Sequence[BeltStag
     stages = tuple(stages)
     if len(stages) == 0:
         raise ParameterError("stages = []; expected at least one BeltStageSpec")
-    speed_rpm = _positive("motor_speed_rpm", motor_speed_rpm, "rpm")
-    power = _positive("power_w", power_w, "W")
+    speed_rpm = positive("motor_speed_rpm", motor_speed_rpm, "rpm")
+    power = positive("power_w", power_w, "W")
     results: list[BeltStage] = []
     for index, spec in enumerate(stages):
         if not isinstance(spec, BeltStageSpec):
             raise ParameterError(f"stages[{index}] is a {type(spec).__name__}; expected a BeltStageSpec")
-        efficiency = _positive(f"stages[{index}].efficiency", spec.efficiency, "(dimensionless)")
+        efficiency = positive(f"stages[{index}].efficiency", spec.efficiency, "(dimensionless)")
         if efficiency > 1.0:
             raise ParameterError(f"stages[{index}].efficiency = {efficiency} must be in (0, 1]")
         stage = belt_stage(

@@ -7,7 +7,7 @@ from typing import Sequence
 
 from modal.units import rad_s_to_rpm
 
-from ..drive import _positive
+from .._checks import positive
 from .statics import STEEL_DENSITY_KG_M3, STEEL_YOUNGS_MODULUS_PA, ShaftGeometry, _check_position
 from .stiffness import (
     CriticalSpeed,
@@ -106,8 +106,8 @@ def rotor_handover(shaft_speed_rad_s: float, geometry: ShaftGeometry, diameter_m
     RotorHandover
         Speed (rad/s), stiffness (N/m), mass and the margins.
     """
-    speed = _positive("shaft_speed_rad_s", shaft_speed_rad_s, "rad/s")
-    mass = _positive("rotor_mass_kg", rotor_mass_kg, "kg")
+    speed = positive("shaft_speed_rad_s", shaft_speed_rad_s, "rad/s")
+    mass = positive("rotor_mass_kg", rotor_mass_kg, "kg")
     position = _check_position(geometry, "rotor_position_m", rotor_position_m)
     k = bending_stiffness_n_per_m(geometry, position, diameter_m, youngs_modulus_pa)
     critical = critical_speed(

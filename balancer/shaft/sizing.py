@@ -8,7 +8,8 @@ from typing import Sequence
 
 from modal.errors import ParameterError
 
-from ..drive import _non_negative, _positive, next_standard_size
+from .._checks import non_negative, positive
+from ..drive import next_standard_size
 from .statics import STANDARD_SHAFT_DIAMETERS_M
 
 __all__ = [
@@ -40,10 +41,10 @@ def endurance_limit_pa(ultimate_strength_pa: float, surface_factor: float = 1.0,
     float
         Endurance limit, Pa.
     """
-    value = _positive("ultimate_strength_pa", ultimate_strength_pa, "Pa")
+    value = positive("ultimate_strength_pa", ultimate_strength_pa, "Pa")
     for name, factor in (("surface_factor", surface_factor), ("size_factor", size_factor),
                          ("other_factor", other_factor), ("endurance_ratio", endurance_ratio)):
-        f = _positive(name, factor, "(dimensionless)")
+        f = positive(name, factor, "(dimensionless)")
         if f > 1.0:
             raise ParameterError(f"{name} = {f} must be in (0, 1]")
         value *= f
@@ -68,11 +69,11 @@ def allowable_shear_stress_pa(yield_strength_pa: float, safety_factor: float, sh
     float
         Allowable shear stress, Pa.
     """
-    yield_strength = _positive("yield_strength_pa", yield_strength_pa, "Pa")
-    n = _positive("safety_factor", safety_factor, "(dimensionless)")
+    yield_strength = positive("yield_strength_pa", yield_strength_pa, "Pa")
+    n = positive("safety_factor", safety_factor, "(dimensionless)")
     if n < 1.0:
         raise ParameterError(f"safety_factor = {n} must be >= 1")
-    ratio = _positive("shear_yield_ratio", shear_yield_ratio, "(dimensionless)")
+    ratio = positive("shear_yield_ratio", shear_yield_ratio, "(dimensionless)")
     return ratio * yield_strength / n
 
 
@@ -91,8 +92,8 @@ def asme_allowable_shear_stress_pa(yield_strength_pa: float, ultimate_strength_p
     float
         Allowable shear stress, Pa.
     """
-    sy = _positive("yield_strength_pa", yield_strength_pa, "Pa")
-    su = _positive("ultimate_strength_pa", ultimate_strength_pa, "Pa")
+    sy = positive("yield_strength_pa", yield_strength_pa, "Pa")
+    su = positive("ultimate_strength_pa", ultimate_strength_pa, "Pa")
     return min(0.30 * sy, 0.18 * su) * (0.75 if keyway else 1.0)
 
 
@@ -184,12 +185,12 @@ def shaft_diameter_soderberg(moment_n_m: float, torque_n_m: float, yield_strengt
     ShaftSizing
         Diameter and next standard size (method ``"soderberg"``).
     """
-    moment = _non_negative("moment_n_m", moment_n_m, "N m")
-    torque = _non_negative("torque_n_m", torque_n_m, "N m")
-    sy = _positive("yield_strength_pa", yield_strength_pa, "Pa")
-    se = _positive("endurance_limit_pa", endurance_limit_pa, "Pa")
-    tau = _positive("allowable_shear_pa", allowable_shear_pa, "Pa")
-    k = _positive("bending_factor", bending_factor, "(dimensionless)")
+    moment = non_negative("moment_n_m", moment_n_m, "N m")
+    torque = non_negative("torque_n_m", torque_n_m, "N m")
+    sy = positive("yield_strength_pa", yield_strength_pa, "Pa")
+    se = positive("endurance_limit_pa", endurance_limit_pa, "Pa")
+    tau = positive("allowable_shear_pa", allowable_shear_pa, "Pa")
+    k = positive("bending_factor", bending_factor, "(dimensionless)")
     return _sizing("soderberg", "d = [16/(pi tau) sqrt(((Sy/Se) K M)^2 + T^2)]^(1/3)",
                    moment, torque, k, 1.0, sy / se, tau, standard_diameters_m)
 
@@ -217,10 +218,10 @@ def shaft_diameter_asme(moment_n_m: float, torque_n_m: float, allowable_shear_pa
     ShaftSizing
         Diameter and next standard size (method ``"asme"``).
     """
-    moment = _non_negative("moment_n_m", moment_n_m, "N m")
-    torque = _non_negative("torque_n_m", torque_n_m, "N m")
-    tau = _positive("allowable_shear_pa", allowable_shear_pa, "Pa")
-    km = _positive("bending_factor", bending_factor, "(dimensionless)")
-    kt = _positive("torsion_factor", torsion_factor, "(dimensionless)")
+    moment = non_negative("moment_n_m", moment_n_m, "N m")
+    torque = non_negative("torque_n_m", torque_n_m, "N m")
+    tau = positive("allowable_shear_pa", allowable_shear_pa, "Pa")
+    km = positive("bending_factor", bending_factor, "(dimensionless)")
+    kt = positive("torsion_factor", torsion_factor, "(dimensionless)")
     return _sizing("asme", "d = [16/(pi tau) sqrt((Km M)^2 + (Kt T)^2)]^(1/3)",
                    moment, torque, km, kt, 1.0, tau, standard_diameters_m)

@@ -11,7 +11,7 @@ import numpy as np
 from modal.errors import ParameterError
 from modal.units import rpm_to_rad_s
 
-from ..drive import _finite, _non_negative, _positive
+from .._checks import finite, non_negative, positive
 
 __all__ = [
     "STANDARD_SHAFT_DIAMETERS_M",
@@ -63,9 +63,9 @@ class PointLoad:
     def from_direction(cls, position_m: float, magnitude_n: float, angle_from_vertical_deg: float, name: str = "") -> "PointLoad":
         """Load of ``magnitude_n`` N at ``angle_from_vertical_deg`` degrees from the vertical
         (``vertical = F cos``, ``horizontal = F sin``), at ``position_m`` m."""
-        magnitude = _finite("magnitude_n", magnitude_n, "N")
-        angle_rad = math.radians(_finite("angle_from_vertical_deg", angle_from_vertical_deg, "deg"))
-        position = _finite("position_m", position_m, "m")
+        magnitude = finite("magnitude_n", magnitude_n, "N")
+        angle_rad = math.radians(finite("angle_from_vertical_deg", angle_from_vertical_deg, "deg"))
+        position = finite("position_m", position_m, "m")
         return cls(position, magnitude * math.cos(angle_rad), magnitude * math.sin(angle_rad), name)
 
 
@@ -86,9 +86,9 @@ class ShaftGeometry:
     bearing_b_m: float
 
     def __post_init__(self) -> None:
-        length = _positive("length_m", self.length_m, "m")
-        a = _finite("bearing_a_m", self.bearing_a_m, "m")
-        b = _finite("bearing_b_m", self.bearing_b_m, "m")
+        length = positive("length_m", self.length_m, "m")
+        a = finite("bearing_a_m", self.bearing_a_m, "m")
+        b = finite("bearing_b_m", self.bearing_b_m, "m")
         if not 0.0 <= a < b <= length:
             raise ParameterError(
                 f"bearing_a_m = {a:.6g} m, bearing_b_m = {b:.6g} m; expected "
@@ -102,7 +102,7 @@ class ShaftGeometry:
 
 
 def _check_position(geometry: ShaftGeometry, name: str, position_m: float) -> float:
-    x = _finite(name, position_m, "m")
+    x = finite(name, position_m, "m")
     if not 0.0 <= x <= geometry.length_m:
         raise ParameterError(
             f"{name} = {x:.6g} m is outside the shaft; expected 0 <= {name} <= length_m = {geometry.length_m:.6g} m"
@@ -196,9 +196,9 @@ def analyse_shaft(geometry: ShaftGeometry, loads: Sequence[PointLoad], torque_n_
         if not isinstance(load, PointLoad):
             raise ParameterError(f"loads[{index}] is a {type(load).__name__}; expected a PointLoad")
         positions.append(_check_position(geometry, f"loads[{index}].position_m", load.position_m))
-        vertical.append(_finite(f"loads[{index}].vertical_n", load.vertical_n, "N"))
-        horizontal.append(_finite(f"loads[{index}].horizontal_n", load.horizontal_n, "N"))
-    torque = _finite("torque_n_m", torque_n_m, "N m")
+        vertical.append(finite(f"loads[{index}].vertical_n", load.vertical_n, "N"))
+        horizontal.append(finite(f"loads[{index}].horizontal_n", load.horizontal_n, "N"))
+    torque = finite("torque_n_m", torque_n_m, "N m")
     x = np.asarray(positions)
     xa, xb, span = geometry.bearing_a_m, geometry.bearing_b_m, geometry.span_m
 
@@ -347,6 +347,6 @@ def shaft_torque_n_m(power_w: float, shaft_speed_rpm: float) -> float:
     float
         Torque, N m.
     """
-    power = _non_negative("power_w", power_w, "W")
-    speed = _positive("shaft_speed_rpm", shaft_speed_rpm, "rpm")
+    power = non_negative("power_w", power_w, "W")
+    speed = positive("shaft_speed_rpm", shaft_speed_rpm, "rpm")
     return power / float(rpm_to_rad_s(speed))

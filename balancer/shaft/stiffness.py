@@ -11,7 +11,7 @@ import numpy as np
 from modal.errors import ParameterError
 from modal.units import rad_s_to_rpm
 
-from ..drive import _non_negative, _positive
+from .._checks import non_negative, positive
 from .statics import STEEL_DENSITY_KG_M3, STEEL_YOUNGS_MODULUS_PA, ShaftGeometry, _check_position
 
 __all__ = [
@@ -29,7 +29,7 @@ __all__ = [
 # --------------------------------------------------------------------------- stiffness
 def second_moment_of_area_m4(diameter_m: float) -> float:
     """``I = pi d**4 / 64`` of a solid round shaft, m^4 (``diameter_m`` in m)."""
-    d = _positive("diameter_m", diameter_m, "m")
+    d = positive("diameter_m", diameter_m, "m")
     return math.pi * d**4 / 64.0
 
 
@@ -87,7 +87,7 @@ def bending_stiffness_n_per_m(geometry: ShaftGeometry, position_m: float, diamet
         Stiffness, N/m.
     """
     layout = rotor_layout(geometry, position_m)
-    ei = _positive("youngs_modulus_pa", youngs_modulus_pa, "Pa") * second_moment_of_area_m4(diameter_m)
+    ei = positive("youngs_modulus_pa", youngs_modulus_pa, "Pa") * second_moment_of_area_m4(diameter_m)
     x, span = float(position_m), geometry.span_m
     if layout == "between bearings":
         a, b = x - geometry.bearing_a_m, geometry.bearing_b_m - x
@@ -123,10 +123,10 @@ def span_critical_speed_rad_s(span_m: float, diameter_m: float, youngs_modulus_p
     float
         Critical speed, rad/s.
     """
-    span = _positive("span_m", span_m, "m")
-    e = _positive("youngs_modulus_pa", youngs_modulus_pa, "Pa")
-    rho = _positive("density_kg_m3", density_kg_m3, "kg/m^3")
-    d = _positive("diameter_m", diameter_m, "m")
+    span = positive("span_m", span_m, "m")
+    e = positive("youngs_modulus_pa", youngs_modulus_pa, "Pa")
+    rho = positive("density_kg_m3", density_kg_m3, "kg/m^3")
+    d = positive("diameter_m", diameter_m, "m")
     area = math.pi * d * d / 4.0
     return (math.pi / span) ** 2 * math.sqrt(e * second_moment_of_area_m4(d) / (rho * area))
 
@@ -190,7 +190,7 @@ def critical_speed(geometry: ShaftGeometry, diameter_m: float, masses_kg: Sequen
     labels: list[str] = []
     speeds: list[float] = []
     for index, (mass, position) in enumerate(zip(masses_kg, positions_m)):
-        m = _positive(f"masses_kg[{index}]", mass, "kg")
+        m = positive(f"masses_kg[{index}]", mass, "kg")
         x = _check_position(geometry, f"positions_m[{index}]", position)
         k = bending_stiffness_n_per_m(geometry, x, diameter_m, youngs_modulus_pa)
         labels.append(f"mass {index + 1} ({m:g} kg at {x:g} m, {rotor_layout(geometry, x)})")
@@ -260,9 +260,9 @@ def speed_margin(running_speed_rad_s: float, critical_speed_rad_s: float, requir
     SpeedMargin
         Ratios and pass/fail flags at 1x and 2x.
     """
-    w = _positive("running_speed_rad_s", running_speed_rad_s, "rad/s")
-    wc = _positive("critical_speed_rad_s", critical_speed_rad_s, "rad/s")
-    required = _non_negative("required_separation", required_separation, "(dimensionless)")
+    w = positive("running_speed_rad_s", running_speed_rad_s, "rad/s")
+    wc = positive("critical_speed_rad_s", critical_speed_rad_s, "rad/s")
+    required = non_negative("required_separation", required_separation, "(dimensionless)")
     s1 = abs(wc / w - 1.0)
     s2 = abs(wc / (2.0 * w) - 1.0)
     return SpeedMargin(
