@@ -100,6 +100,15 @@ def _smoothed(values: np.ndarray, region: np.ndarray, width: int) -> np.ndarray:
     return out
 
 
+def _level(energy: np.ndarray, n_channels: int) -> float:
+    """Noise level of a residual energy (|r|²/σ² averaged over channels) from its median.
+
+    The mean of ``n_channels`` Exp(1) variables is Gamma(n, 1/n), with median
+    ``gammaincinv(n, 0.5)/n``: ln 2 for one channel, 0.96 for eight.
+    """
+    return float(np.median(energy)) / (float(special.gammaincinv(n_channels, 0.5)) / n_channels)
+
+
 def _seen_through(res, omega, response, noise_std):
     floor = ARITHMETIC_FLOOR * np.max(np.abs(response), axis=1)
     return np.maximum(np.minimum(noise_std, neighbour_noise_std(omega, res)), floor)
@@ -179,11 +188,11 @@ def find_missing_mode(omega: np.ndarray, response: np.ndarray, power: int, regio
     smooth = _smoothed(energy, region, width)
     # screen (cheap): the smoothed residual must rise above its noise level by 4 of its
     # standard deviations (1/sqrt(lines × channels) of an Exp(1) mean); the level is the
-    # noise above or, when the residual's own median says more (noise the
-    # estimate misses), that median (|r|²/σ² ~ Exp(1) has median ln 2). A misfit spread over
-    # the whole band (few lines) passes when the mean residual is above the noise by 4 of
-    # its standard deviations
-    level = max(1.0, float(np.median(energy)) / np.log(2))
+    # noise above or, when the residual's own median says more (noise the estimate misses),
+    # that median: the mean of |r|²/σ² ~ Exp(1) over n channels is Gamma(n, 1/n), whose median
+    # is ln 2 for one channel and 0.96 for eight. A misfit spread over the whole band (few
+    # lines) passes when the mean residual is above the noise by 4 of its standard deviations
+    level = max(1.0, _level(energy, n_ch))
     peaked = smooth.max() > level * (1 + 4 / np.sqrt(width * n_ch))
     if not (peaked or np.mean(energy) > 1 + 4 / np.sqrt(energy.size * n_ch)):
         return None

@@ -39,3 +39,16 @@ def test_residual_noise_of_exact_data_is_the_arithmetic_floor():
     seen = residual_noise_std(frf.omega_rad_s, frf.channels, 0, region, fit.omega_n, fit.damping_ratio,
                               estimate_noise_std(frf))
     assert seen[0] == np.sqrt(np.finfo(float).eps) * np.abs(frf.channels).max()
+
+
+def test_noise_level_of_a_residual_energy_is_one_for_noise():
+    # the screen of the missing-mode check compares the residual with its noise level; for
+    # white noise averaged over n channels the level must be 1 whatever n (it took ln 2 as the
+    # median for every n, so eight channels read 1.39 and the screen went deaf by that much).
+    # 4000 lines: the median's relative scatter is ≈ 1.25/sqrt(4000·n) ≤ 0.02, so 0.08 is four
+    from modal.checks import _level
+
+    rng = np.random.default_rng(4)
+    for n_channels in (1, 2, 8):
+        energy = rng.exponential(size=(n_channels, 4000)).mean(axis=0)
+        assert abs(_level(energy, n_channels) - 1) < 0.08
