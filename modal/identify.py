@@ -251,10 +251,18 @@ def _refinement_check(frf, bands, power, poles, consts, noise, estimated_noise):
     def no_reference(chi2):
         return (0.0, 0.0, np.zeros(frf.n_channels, complex), chi2, 0.0, 0.0)
 
-    wn0 = np.array([p[0] for p in poles])
-    z0 = np.array([p[1] for p in poles])
-    if not (np.all(np.isfinite(wn0)) and np.all(np.isfinite(z0)) and np.all(wn0 > 0)
-            and np.all((z0 > 0) & (z0 < 1))):
+    # the refinement starts from the method's poles; a pole the method could not give (ζ ≤ 0
+    # or non-finite: half-power under heavy noise) starts from its band instead, so that it
+    # does not take the check away from the other modes (stress finding 25)
+    peak = np.array([TWO_PI * b.peak_hz for b in bands])
+    width = np.array([b.half_power_width_hz / (2 * b.peak_hz) if b.peak_hz > 0 else np.nan for b in bands])
+    span = np.array([(b.high_hz - b.low_hz) / (12 * b.peak_hz) if b.peak_hz > 0 else np.nan for b in bands])
+    wn0 = np.array([p[0] for p in poles], float)
+    z0 = np.array([p[1] for p in poles], float)
+    wn0 = np.where(np.isfinite(wn0) & (wn0 > 0), wn0, peak)
+    fallback = np.where(np.isfinite(width) & (width > 0), width, span)
+    z0 = np.where(np.isfinite(z0) & (z0 > 0) & (z0 < 1), z0, np.clip(fallback, 1e-9, 0.99))
+    if not (np.all(np.isfinite(wn0)) and np.all(wn0 > 0) and np.all(np.isfinite(z0))):
         return [no_reference(np.nan)] * n_modes, None
     keep, region = _regions(bands, frf.frequency_hz)
     strongest = np.argsort(np.max(np.abs(frf.channels[:, keep]) / np.where(noise > 0, noise, 1.0)[:, None],
