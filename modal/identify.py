@@ -291,7 +291,10 @@ def _refinement_check(frf, bands, power, poles, consts, noise, estimated_noise):
             out.append(no_reference(chi2))
             continue
         d_const = np.where(np.isfinite(consts[r]) & np.isfinite(const_ref[r]), consts[r] - const_ref[r], 0)
-        out.append((wn - omega_n[r], zeta - damping_ratio[r], d_const, chi2, *std_ref[r]))
+        # a method value that is not a number gives no difference (it carries its own flags)
+        d_wn = wn - omega_n[r] if np.isfinite(wn) else 0.0
+        d_z = zeta - damping_ratio[r] if np.isfinite(zeta) else 0.0
+        out.append((d_wn, d_z, d_const, chi2, *std_ref[r]))
     return out, missing
 
 
