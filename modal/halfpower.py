@@ -121,7 +121,13 @@ def _fitted_crossing(omega, db, level_db, guess, window_db=1.0, min_lines=7):
     best = roots[np.argmin(np.abs(roots))]
     if abs(best) > 0.5:  # outside the fitted lines: not a crossing of this side
         return guess
-    return guess + best * np.ptp(w)
+    crossing = guess + best * np.ptp(w)
+    # under heavy noise the lines near the level scatter over the whole side, and a root
+    # half their span from the guess can fall past the peak or below zero (a negative ω2 at
+    # 18 % noise, stress finding 27): a crossing of this side lies within its lines
+    if not omega[0] <= crossing <= omega[-1]:
+        return guess
+    return crossing
 
 
 def half_power_curve(omega: np.ndarray, h: np.ndarray, power: int, noise_std: float) -> HalfPowerEstimate:

@@ -544,3 +544,21 @@ def test_one_invalid_pole_leaves_the_refinement_check_to_the_others():
     # so the differences are the offsets put in, to far better than these margins
     assert abs(d_wn / two_pi - 0.3) < 0.05 and abs(d_z - 0.002) < 5e-4
     assert abs(check[1][1] - (-0.02)) < 5e-3  # and the invalid one differs by its whole error
+
+
+def test_half_power_crossing_stays_on_its_side_of_the_peak():
+    # stress finding 27: mobility, ζ = 0.28 and 0.5, 18 % noise. The least-squares crossing
+    # of the upper side (a quadratic through the lines within 1 dB of the level, which the
+    # noise scatters over the whole side) fell below zero, and sqrt(ω1·ω2) warned and gave NaN.
+    # A refined crossing outside its side's lines now keeps the line-interpolated one.
+    f = 0.1593487327504735 + 0.21869746550094699 * np.arange(1864)
+    clean = modal_frf(f, [1.0, 67.96612506431045], [0.2761579208653549, 0.5], [39.4784176, 70.2036572],
+                      kind="mobility")
+    frf = add_noise(clean, 0.1796875, seed=139715)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", modal.ModalWarning)
+        warnings.simplefilter("error", RuntimeWarning)
+        result = identify(frf, "halfpower", bands_hz=[(0.16, 2.66), (34.48, 271.86)])
+    for mode, band in zip(result, [(0.16, 2.66), (34.48, 271.86)]):
+        assert np.isfinite(mode.natural_frequency_hz) and np.isfinite(mode.damping_ratio)
+        assert band[0] <= mode.natural_frequency_hz <= band[1]
