@@ -498,7 +498,7 @@ def identify(frf: FRF, method: str = "nls", bands_hz=None, *, noise_std=None, dr
     for index, (band, (wn, zeta, const, cov, s_wn, s_z, flags, quality, chi2)) in enumerate(zip(bands, per_mode)):
         flags = set(flags)
         detail = {}
-        if missing_mode is not None and missing_mode.band == index:
+        if missing_mode is not None and (missing_mode.band == index or index in missing_mode.moved_bands):
             flags.add("missing_mode")
             detail["missing_mode"] = f" (near {missing_mode.frequency_hz:.6g} Hz, zeta {missing_mode.damping_ratio:.3g})"
         const = np.asarray(const, complex)

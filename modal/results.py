@@ -31,9 +31,10 @@ FLAG_TEXT = {
     "non_positive_constant": "driving-point modal constant has a negative real part: k, c, m not defined",
     "close_modes": ("another mode lies within this mode's fitting band, or overlaps it (2*zeta*wn/delta_wn > 1.5): "
                     "the standard errors understate the scatter"),
-    "missing_mode": ("the residual holds another mode inside this band that peak detection missed (one more mode "
-                     "reduces it significantly, F-test at 1e-6); the estimates are biased by it: give bands_hz for "
-                     "both modes or lower min_prominence_db"),
+    "missing_mode": ("the residual holds another mode in or next to this band that peak detection missed (one more "
+                     "mode reduces it significantly, F-test at 1e-6), or this mode moves by more than 3 of its errors "
+                     "once that mode is in the model; the estimates are biased by it: give bands_hz for both modes "
+                     "or lower min_prominence_db"),
     "method_bias": ("half-power or circle estimate lies more than 3 of its standard errors from the least-squares "
                     "refinement of the same modes (the method's own bias: line spacing, noise at the peak, "
                     "a neighbouring mode); its standard errors include the difference, method 'nls' gives the refined values"),
