@@ -434,8 +434,9 @@ def identify(frf: FRF, method: str = "nls", bands_hz=None, *, noise_std=None, dr
             filled = _constants_all_poles(frf, bands, power, [p[0] for p in poles], [p[1] for p in poles])
             consts[missing] = filled[missing]
         check, missing_mode = _refinement_check(frf, bands, power, poles, consts, noise, estimated_noise)
-        for band, (wn, zeta, s_wn, s_z, _, flags, q), const, geometric, (d_wn, d_z, d_const, chi2, bound_wn, bound_z) in zip(
+        for band, (wn, zeta, s_wn, s_z, _, flags, q), const, geometric, reference in zip(
                 bands, poles, consts, ~missing, check):
+            d_wn, d_z, d_const, chi2, bound_wn, bound_z = reference
             if np.isfinite(chi2) and chi2 > CHI2_LIMIT:
                 flags.add("model_inadequate")
             # no estimator beats the Cramér–Rao bound of the refinement: a smaller own
@@ -460,9 +461,9 @@ def identify(frf: FRF, method: str = "nls", bands_hz=None, *, noise_std=None, dr
             # variance along the difference is raised to at least its square, since the
             # efficient refinement's error is part of the method's (its own errors were 1.5x
             # optimistic for the mass at any noise: sd of z 1.4-1.8, now 0.8-0.9)
-            square = np.einsum("ci,ci->c", diff, diff)
-            along = np.einsum("ci,cij,cj->c", diff, cov[:, 2:, 2:], diff) / np.maximum(square, np.finfo(float).tiny)
-            raise_to = np.clip(1.0 - along / np.maximum(square, np.finfo(float).tiny), 0.0, 1.0)
+            square = np.maximum(np.einsum("ci,ci->c", diff, diff), np.finfo(float).tiny)
+            along = np.einsum("ci,cij,cj->c", diff, cov[:, 2:, 2:], diff) / square  # variance along it
+            raise_to = np.clip(1.0 - along / square, 0.0, 1.0)
             extra = np.where(const_biased, 1.0, np.where(geometric, raise_to, 0.0))
             cov[:, 2:, 2:] += extra[:, None, None] * diff[:, :, None] * diff[:, None, :]
             finite = z_const[np.isfinite(z_const)]

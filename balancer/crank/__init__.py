@@ -43,63 +43,11 @@ Everything public is importable from ``balancer.crank``.
 """
 from __future__ import annotations
 
-from .model import (
-    OBJECTIVES,
-    Objective as Objective,  # the objective names, for type hints
-    PAPER_RULES,
-    RodSplit,
-    SliderCrank,
-    balance_fraction,
-    counterweight_mass,
-    counterweight_moment,
-    slider_crank_from_components,
-    two_mass_split,
-)
-from .forces import (
-    ShakingForce,
-    ShakingHarmonics,
-    max_shaking_force,
-    shaking_force,
-    shaking_harmonics,
-    shaking_objective,
-)
-from .counterweight import (
-    Counterweight,
-    CounterweightEvaluation,
-    GridSearchResult,
-    OptimalCounterweight,
-    OptimalCurve,
-    counterweight_on_curve,
-    evaluate_balance_fraction,
-    evaluate_counterweight,
-    grid_search_counterweight,
-    optimal_counterweight,
-)
+from .model import *  # noqa: F401,F403 (each module's __all__)
+from .forces import *  # noqa: F401,F403 (each module's __all__)
+from .counterweight import *  # noqa: F401,F403 (each module's __all__)
+from .model import Objective  # noqa: F401 (the objective names, for type hints)
+from . import counterweight, forces, model
 
-__all__ = [
-    "SliderCrank",
-    "RodSplit",
-    "ShakingForce",
-    "ShakingHarmonics",
-    "CounterweightEvaluation",
-    "OptimalCurve",
-    "OptimalCounterweight",
-    "Counterweight",
-    "GridSearchResult",
-    "PAPER_RULES",
-    "OBJECTIVES",
-    "two_mass_split",
-    "slider_crank_from_components",
-    "balance_fraction",
-    "counterweight_mass",
-    "counterweight_moment",
-    "shaking_force",
-    "shaking_harmonics",
-    "max_shaking_force",
-    "shaking_objective",
-    "evaluate_counterweight",
-    "evaluate_balance_fraction",
-    "optimal_counterweight",
-    "counterweight_on_curve",
-    "grid_search_counterweight",
-]
+#: every public name, from the modules' own lists (one place to add a name)
+__all__ = [*model.__all__, *forces.__all__, *counterweight.__all__]

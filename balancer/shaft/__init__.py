@@ -25,68 +25,11 @@ Everything public is importable from ``balancer.shaft``.
 """
 from __future__ import annotations
 
-from .statics import (
-    PointLoad,
-    STANDARD_SHAFT_DIAMETERS_M,
-    STEEL_DENSITY_KG_M3,
-    STEEL_YOUNGS_MODULUS_PA,
-    ShaftAnalysis,
-    ShaftDiagram,
-    ShaftGeometry,
-    analyse_shaft,
-    bending_moment_at,
-    shaft_diagram,
-    shaft_torque_n_m,
-)
-from .sizing import (
-    ShaftSizing,
-    allowable_shear_stress_pa,
-    asme_allowable_shear_stress_pa,
-    endurance_limit_pa,
-    shaft_diameter_asme,
-    shaft_diameter_soderberg,
-)
-from .stiffness import (
-    CriticalSpeed,
-    SpeedMargin,
-    bending_stiffness_n_per_m,
-    critical_speed,
-    rotor_layout,
-    second_moment_of_area_m4,
-    span_critical_speed_rad_s,
-    speed_margin,
-)
-from .handover import (
-    RotorHandover,
-    rotor_handover,
-)
+from .statics import *  # noqa: F401,F403 (each module's __all__)
+from .sizing import *  # noqa: F401,F403 (each module's __all__)
+from .stiffness import *  # noqa: F401,F403 (each module's __all__)
+from .handover import *  # noqa: F401,F403 (each module's __all__)
+from . import handover, sizing, statics, stiffness
 
-__all__ = [
-    "STANDARD_SHAFT_DIAMETERS_M",
-    "STEEL_YOUNGS_MODULUS_PA",
-    "STEEL_DENSITY_KG_M3",
-    "PointLoad",
-    "ShaftGeometry",
-    "ShaftAnalysis",
-    "ShaftDiagram",
-    "ShaftSizing",
-    "CriticalSpeed",
-    "SpeedMargin",
-    "RotorHandover",
-    "analyse_shaft",
-    "bending_moment_at",
-    "shaft_diagram",
-    "shaft_torque_n_m",
-    "endurance_limit_pa",
-    "allowable_shear_stress_pa",
-    "asme_allowable_shear_stress_pa",
-    "shaft_diameter_soderberg",
-    "shaft_diameter_asme",
-    "second_moment_of_area_m4",
-    "rotor_layout",
-    "bending_stiffness_n_per_m",
-    "span_critical_speed_rad_s",
-    "critical_speed",
-    "speed_margin",
-    "rotor_handover",
-]
+#: every public name, from the modules' own lists (one place to add a name)
+__all__ = [*statics.__all__, *sizing.__all__, *stiffness.__all__, *handover.__all__]
