@@ -38,7 +38,7 @@ from .nls import fit_modes
 from .peaks import neighbour_noise_std
 from .units import TWO_PI
 
-__all__ = ["MissingMode", "find_missing_mode", "residual_noise_std", "SIGNIFICANCE"]
+__all__ = ["MissingMode", "find_missing_mode", "residual_noise_std", "residual_structure", "SIGNIFICANCE"]
 
 #: false-alarm probability of each test for one added mode
 SIGNIFICANCE = 1e-6
@@ -146,6 +146,40 @@ def residual_noise_std(omega: np.ndarray, response: np.ndarray, power: int, regi
     zeta = np.atleast_1d(np.asarray(damping_ratio, float))
     res = _residual(omega, response, omega_n, zeta, power, region)
     return _seen_through(res, omega, response, np.asarray(noise_std, float))
+
+
+def residual_structure(omega: np.ndarray, response: np.ndarray, power: int, region: np.ndarray,
+                       omega_n, damping_ratio) -> float:
+    """How far the fit's residual is from white: its variance over its line-to-line noise.
+
+    The residual variance (sum of squares over the degrees of freedom) is
+    divided by the square of :func:`modal.peaks.neighbour_noise_std` of the
+    same residual, which sees only what changes from line to line. For white
+    noise the ratio is 1 (within a few 1/sqrt(lines)); a misfit that is smooth
+    across the lines (the model's truncation on near-exact data, a lost mode)
+    raises it. The median over the ``CHECK_CHANNELS`` strongest channels.
+
+    Parameters
+    ----------
+    omega, response, power, region, omega_n, damping_ratio
+        As for :func:`find_missing_mode`.
+
+    Returns
+    -------
+    float
+        The ratio; NaN when the residual leaves no degree of freedom or is zero.
+    """
+    omega_n = np.atleast_1d(np.asarray(omega_n, float))
+    zeta = np.atleast_1d(np.asarray(damping_ratio, float))
+    strongest = np.argsort(np.max(np.abs(response), axis=1))[::-1][:CHECK_CHANNELS]
+    res = _residual(omega, response[strongest], omega_n, zeta, power, region)
+    dof = omega.size - omega_n.size - (int(region.max()) + 1) - omega_n.size / res.shape[0]
+    if dof <= 0:
+        return np.nan
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.sum(np.abs(res) ** 2, axis=1) / dof / neighbour_noise_std(omega, res) ** 2
+    ratio = ratio[np.isfinite(ratio)]
+    return float(np.median(ratio)) if ratio.size else np.nan
 
 
 def find_missing_mode(omega: np.ndarray, response: np.ndarray, power: int, region: np.ndarray,

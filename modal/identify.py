@@ -5,13 +5,13 @@ import warnings
 
 import numpy as np
 
-from .checks import find_missing_mode, residual_noise_std
+from .checks import find_missing_mode, residual_noise_std, residual_structure
 from .circlefit import circle_fit_curve
 from .errors import IdentificationError, QualityWarning, ResolutionWarning, warn
 from .frf import FRF, KIND_POWER
 from .halfpower import half_power_curve
 from .model import mode_basis, solve_linear
-from .nls import fit_modes
+from .nls import fit_modes, truncation_shift
 from .peaks import ModeBand, bands_from_hz, estimate_noise_std, find_modes
 from .results import FLAG_TEXT, IdentificationResult, ModeResult, ModeStd, physical_parameters
 from .units import TWO_PI
@@ -35,6 +35,9 @@ BIAS_LIMIT = 3.0
 #: half-power and circle fits: the pole comes from at most this many strongest channels;
 #: the other channels' modal constants are solved linearly with that pole
 POLE_CHANNELS = 32
+#: a fit whose residual variance is more than this many times its line-to-line noise
+#: (checks.residual_structure) has a smooth misfit: its truncation shift is measured
+STRUCTURED_RATIO = 4.0
 _RESOLUTION_FLAGS = {"resolution_limited", "missing_crossing", "too_few_points"}
 
 
@@ -277,6 +280,9 @@ def _refinement_check(frf, bands, power, poles, consts, noise, estimated_noise):
     order = np.argsort(fit.omega_n)
     omega_n, damping_ratio = fit.omega_n[order], fit.damping_ratio[order]
     std_ref = np.sqrt(np.abs(fit.mode_cov[order][:, 0, [0, 1], [0, 1]]))  # (n_modes, 2)
+    shift = _truncation(frf, bands, power, fit, strongest)
+    if shift is not None:  # the refinement's own truncation bias (finding 26) widens its errors
+        std_ref = np.hypot(std_ref, shift[0][order])
     # an unconverged refinement still serves: a mode below the noise crawling along a flat
     # valley keeps LM from stopping while the other poles are long settled; the check only
     # adds flags and widens errors
@@ -312,6 +318,34 @@ def _fit_noise(frf, bands, power, omega_n, damping_ratio, estimated_noise, chann
     with np.errstate(all="ignore"):
         return residual_noise_std(frf.omega_rad_s[keep], frf.channels[rows][:, keep], power, region,
                                   omega_n, damping_ratio, estimated_noise[rows])
+
+
+def _truncation(frf, bands, power, fit, channels=None):
+    """Shift of the fit when the band backgrounds gain a slope and a curvature, or None.
+
+    Measured only where the residual is smooth across the lines (ratio of
+    :func:`modal.checks.residual_structure` above ``STRUCTURED_RATIO``): there
+    the noise is below the misfit of the plain offset, and the shift is the
+    truncation bias of the modes outside the bands (:func:`modal.nls.truncation_shift`).
+    With white residuals the shift would be noise only and is not measured.
+    Returns (pole shift (n_modes, 2), constant shift (n_modes, n_channels)) in
+    the fit's order of modes.
+    """
+    keep, region = _regions(bands, frf.frequency_hz)
+    rows = slice(None) if channels is None else channels
+    omega, response = frf.omega_rad_s[keep], frf.channels[rows][:, keep]
+    with np.errstate(all="ignore"):
+        structure = residual_structure(omega, response, power, region, fit.omega_n, fit.damping_ratio)
+    if not structure > STRUCTURED_RATIO:
+        return None
+    return truncation_shift(omega, response, power, region, fit)
+
+
+def _with_shift(cov, pole_shift, constant_shift):
+    """Covariance (n_ch, 4, 4) of one mode plus the outer product of its shift per channel."""
+    d = np.column_stack([np.broadcast_to(pole_shift, (constant_shift.size, 2)),
+                         constant_shift.real, constant_shift.imag])
+    return cov + d[:, :, None] * d[:, None, :]
 
 
 def _missing_mode(frf, bands, power, omega_n, damping_ratio, estimated_noise):
@@ -478,6 +512,9 @@ def identify(frf: FRF, method: str = "nls", bands_hz=None, *, noise_std=None, dr
         chi2 = _chi2(fit.noise_var, _fit_noise(frf, bands, power, fit.omega_n, fit.damping_ratio,
                                                estimated_noise))
         missing_mode = _missing_mode(frf, bands, power, fit.omega_n, fit.damping_ratio, estimated_noise)
+        # near-exact data: the offset's truncation (modes outside the bands) biases the poles
+        # beyond their white-noise errors; its measured shift is added to them (finding 26)
+        shift = _truncation(frf, bands, power, fit)
         order = np.argsort(fit.omega_n)  # two close poles may cross during the fit
         for band, r in zip(bands, order):
             flags: set[str] = set()
@@ -487,7 +524,7 @@ def identify(frf: FRF, method: str = "nls", bands_hz=None, *, noise_std=None, dr
                 flags.add("too_few_points")  # no lines left over for a residual: no errors
             if np.isfinite(chi2) and chi2 > CHI2_LIMIT:
                 flags.add("model_inadequate")
-            cov = fit.mode_cov[r]
+            cov = fit.mode_cov[r] if shift is None else _with_shift(fit.mode_cov[r], shift[0][r], shift[1][r])
             s_wn = float(np.sqrt(max(cov[0, 0, 0], 0))) if np.isfinite(cov[0, 0, 0]) else np.nan
             s_z = float(np.sqrt(max(cov[0, 1, 1], 0))) if np.isfinite(cov[0, 1, 1]) else np.nan
             wn, zeta = float(fit.omega_n[r]), float(fit.damping_ratio[r])

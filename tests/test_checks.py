@@ -1,8 +1,8 @@
-"""The noise as a fit's residual shows it (modal.checks.residual_noise_std)."""
+"""The fit's residual: its noise (residual_noise_std), whiteness (residual_structure), truncation."""
 import numpy as np
 
-from modal.checks import residual_noise_std
-from modal.nls import fit_modes
+from modal.checks import residual_noise_std, residual_structure
+from modal.nls import fit_modes, truncation_shift
 from modal.peaks import estimate_noise_std
 from modal.synthetic import add_noise, modal_frf
 
@@ -52,3 +52,42 @@ def test_noise_level_of_a_residual_energy_is_one_for_noise():
     for n_channels in (1, 2, 8):
         energy = rng.exponential(size=(n_channels, 4000)).mean(axis=0)
         assert abs(_level(energy, n_channels) - 1) < 0.08
+
+
+def _out_of_band_case():
+    # one mode at 9 Hz fitted on 6–15 Hz, a mode at 189 Hz outside the band, exact data
+    f = np.linspace(6.0, 15.0, 91)
+    frf = modal_frf(f, [9.0, 189.0], [0.1, 0.1], [394.8, 39.48])
+    region = np.zeros(f.size, int)
+    fit = fit_modes(frf.omega_rad_s, frf.channels, 0, [2 * np.pi * 9], [0.1], region=region)
+    return frf, region, fit
+
+
+def test_truncation_shift_measures_the_offsets_bias_from_a_mode_outside_the_band():
+    # the 189 Hz mode varies across the band by -2iζω/ωs (first order) and (ω/ωs)² (second);
+    # a plain offset leaves both, and the pole is biased. The slope and curvature take them
+    # out: what remains is third order, (15/189) ≈ 0.08 of the second-order part, so the
+    # shift must account for the bias to within 10 %
+    frf, region, fit = _out_of_band_case()
+    bias = np.array([fit.omega_n[0] - 2 * np.pi * 9.0, fit.damping_ratio[0] - 0.1])
+    assert abs(bias[1]) > 1e-9  # the bias is real: far above the 1e-13 LM step
+    pole_shift, constant_shift = truncation_shift(frf.omega_rad_s, frf.channels, 0, region, fit)
+    assert np.all(np.abs(bias + pole_shift[0]) < 0.1 * np.abs(bias))
+    assert constant_shift.shape == (1, 1)
+    # and the residual is smooth across the lines: far from white
+    assert residual_structure(frf.omega_rad_s, frf.channels, 0, region, fit.omega_n, fit.damping_ratio) > 100
+
+
+def test_residual_of_a_right_model_under_noise_is_white():
+    # one mode, 1 % noise, 2001 lines: residual variance over its line-to-line noise is 1.
+    # The neighbour estimate is a median of ~2000 |e|²: relative scatter ≈ 1/(sqrt(N) ln 2)
+    # ≈ 3 %; the ratio's scatter is about that, so 0.85–1.15 is five of them
+    f = np.linspace(80.0, 120.0, 2001)
+    ratios = []
+    for seed in range(5):
+        frf = add_noise(modal_frf(f, [100.0], [0.02], [1.0]), 0.01, seed=seed)
+        region = np.zeros(f.size, int)
+        fit = fit_modes(frf.omega_rad_s, frf.channels, 0, [2 * np.pi * 100], [0.02], region=region)
+        ratios.append(residual_structure(frf.omega_rad_s, frf.channels, 0, region, fit.omega_n,
+                                         fit.damping_ratio))
+    assert np.all(np.abs(np.array(ratios) - 1) < 0.15), ratios
