@@ -38,7 +38,7 @@ from .nls import fit_modes
 from .peaks import neighbour_noise_std
 from .units import TWO_PI
 
-__all__ = ["MissingMode", "find_missing_mode", "residual_noise_std", "residual_structure", "SIGNIFICANCE"]
+__all__ = ["MissingMode", "find_missing_mode", "residual_noise_std", "residual_structure", "restart_pole", "SIGNIFICANCE"]
 
 #: false-alarm probability of each test for one added mode
 SIGNIFICANCE = 1e-6
@@ -180,6 +180,44 @@ def residual_structure(omega: np.ndarray, response: np.ndarray, power: int, regi
         ratio = np.sum(np.abs(res) ** 2, axis=1) / dof / neighbour_noise_std(omega, res) ** 2
     ratio = ratio[np.isfinite(ratio)]
     return float(np.median(ratio)) if ratio.size else np.nan
+
+
+def restart_pole(omega: np.ndarray, response: np.ndarray, power: int, region: np.ndarray,
+                 omega_n, damping_ratio, in_band: np.ndarray) -> tuple[float, float] | None:
+    """Where a mode that the joint fit lost should start again.
+
+    The residual of the other modes, as energy relative to each channel's
+    max|H|² averaged over the ``CHECK_CHANNELS`` strongest channels and
+    smoothed over their median half-power width, is largest where the lost
+    mode's energy is. The start ζ is the other modes' median.
+
+    Parameters
+    ----------
+    omega, response, power, region
+        As for :func:`find_missing_mode`.
+    omega_n, damping_ratio : array_like
+        The other modes' poles (rad/s, dimensionless), at least one.
+    in_band : ndarray of bool, shape (n_freq,)
+        The lost mode's band.
+
+    Returns
+    -------
+    (ωn [rad/s], ζ) or None
+        None when the band holds fewer than 3 lines.
+    """
+    omega_n = np.atleast_1d(np.asarray(omega_n, float))
+    zeta = np.atleast_1d(np.asarray(damping_ratio, float))
+    if np.count_nonzero(in_band) < 3 or omega_n.size == 0:
+        return None
+    scale = np.max(np.abs(response), axis=1)
+    strongest = np.argsort(scale)[::-1][:CHECK_CHANNELS]
+    scale = np.where(scale[strongest] > 0, scale[strongest], 1.0)
+    res = _residual(omega, response[strongest], omega_n, zeta, power, region)
+    energy = np.mean(np.abs(res) ** 2 / scale[:, None] ** 2, axis=0)
+    spacing = float(np.median(np.diff(omega)))
+    width = int(np.clip(np.round(np.median(2 * zeta * omega_n) / spacing), 1, max(1, omega.size // 4)))
+    smooth = np.where(in_band, _smoothed(energy, region, width), -np.inf)
+    return float(omega[int(np.argmax(smooth))]), float(np.median(zeta))
 
 
 def find_missing_mode(omega: np.ndarray, response: np.ndarray, power: int, region: np.ndarray,
