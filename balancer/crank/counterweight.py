@@ -11,6 +11,7 @@ from scipy import optimize
 from modal.errors import ParameterError
 
 from .forces import _check_objective, _objective_value, _refined_max
+from .._checks import bounded
 from .model import (
     PAPER_RULES,
     Objective,
@@ -18,7 +19,6 @@ from .model import (
     _angles,
     _counterweight_moment,
     _factors,
-    _finite_float,
     _force_xy,
     _require_reciprocating,
     _speed_rad_s,
@@ -262,7 +262,7 @@ def optimal_counterweight(mech: SliderCrank, speed_rpm: float, objective: Object
     _check_objective(objective)
     _require_reciprocating(mech)
     omega = _speed_rad_s(speed_rpm)
-    n_points = int(_finite_float("n_curve_points", n_curve_points, minimum=2.0))
+    n_points = int(bounded("n_curve_points", n_curve_points, minimum=2.0))
     m_rot, m_rec, r = mech.rotating_mass_kg, mech.reciprocating_mass_kg, mech.crank_radius_m
     lower, upper = -m_rot / m_rec, 1.0
 
@@ -377,7 +377,7 @@ def counterweight_on_curve(mech: SliderCrank, optimum: OptimalCounterweight, *,
     moment = optimum.counterweight_moment_kg_m
     m_rot, m_rec, r = mech.rotating_mass_kg, mech.reciprocating_mass_kg, mech.crank_radius_m
     if radius_m is not None:
-        radius = _finite_float("radius_m", radius_m, minimum=0.0, strict=True, maximum=r)
+        radius = bounded("radius_m", radius_m, minimum=0.0, strict=True, maximum=r)
         mass, rule = moment / radius, "given radius"
         kk = (mass - m_rot) / m_rec
         if kk > 1.0 + 1e-12:
@@ -389,7 +389,7 @@ def counterweight_on_curve(mech: SliderCrank, optimum: OptimalCounterweight, *,
     if k is None:
         kk, rule = k_low, "lightest (r_c = r)"
     else:
-        kk = _finite_float("k", k, minimum=k_low - 1e-12, maximum=1.0)
+        kk = bounded("k", k, minimum=k_low - 1e-12, maximum=1.0)
         rule = "given k"
     mass = m_rot + kk * m_rec
     radius = min(moment / mass, r) if mass > 0 else 0.0

@@ -8,6 +8,7 @@ import numpy as np
 
 from modal.errors import ParameterError
 
+from .._checks import bounded
 from .model import (
     _MAX_SERIES_ORDER,
     _N_FFT,
@@ -18,7 +19,6 @@ from .model import (
     _angles,
     _counterweight_moment,
     _factors,
-    _finite_float,
     _force_xy,
     _require_reciprocating,
     _speed_rad_s,
@@ -139,7 +139,7 @@ def shaking_harmonics(mech: SliderCrank, speed_rpm: float, counterweight_mass_kg
     ShakingHarmonics
     """
     if mech.is_exact:
-        top = int(_finite_float("max_order", max_order, minimum=1.0, maximum=_MAX_SERIES_ORDER))
+        top = int(bounded("max_order", max_order, minimum=1.0, maximum=_MAX_SERIES_ORDER))
         orders = np.arange(1, top + 1)
     else:
         orders = np.asarray(mech.harmonics, dtype=int)

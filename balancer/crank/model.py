@@ -13,6 +13,8 @@ import numpy as np
 from modal.errors import ParameterError
 from modal.units import rpm_to_rad_s
 
+from .._checks import bounded
+
 __all__ = [
     "SliderCrank",
     "RodSplit",
@@ -43,27 +45,8 @@ _N_FFT = 512
 # |F| for lam < 1 are tens of degrees apart, far wider than this step.
 _N_GRID_HALF_TURN = 721
 
-# --------------------------------------------------------------------------- input checks
-def _finite_float(name: str, value, *, minimum: float | None = None,
-                  strict: bool = False, maximum: float | None = None) -> float:
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        raise ParameterError(f"{name} = {value!r}: expected a real number") from None
-    if not math.isfinite(number):
-        raise ParameterError(f"{name} = {value!r}: expected a finite number")
-    if minimum is not None:
-        if strict and not number > minimum:
-            raise ParameterError(f"{name} = {number!r}: expected a value > {minimum}")
-        if not strict and not number >= minimum:
-            raise ParameterError(f"{name} = {number!r}: expected a value >= {minimum}")
-    if maximum is not None and number > maximum:
-        raise ParameterError(f"{name} = {number!r}: expected a value <= {maximum}")
-    return number
-
-
 def _speed_rad_s(speed_rpm) -> float:
-    speed = _finite_float("speed_rpm", speed_rpm, minimum=0.0, strict=True)
+    speed = bounded("speed_rpm", speed_rpm, minimum=0.0, strict=True)
     return float(rpm_to_rad_s(speed))
 
 
@@ -116,15 +99,15 @@ class SliderCrank:
     series: str = "leading"
 
     def __post_init__(self) -> None:
-        radius = _finite_float("crank_radius_m", self.crank_radius_m, minimum=0.0, strict=True)
-        length = _finite_float("rod_length_m", self.rod_length_m, minimum=0.0, strict=True)
+        radius = bounded("crank_radius_m", self.crank_radius_m, minimum=0.0, strict=True)
+        length = bounded("rod_length_m", self.rod_length_m, minimum=0.0, strict=True)
         if not length > radius:
             raise ParameterError(
                 f"rod_length_m = {length!r} with crank_radius_m = {radius!r}: the rod must be "
                 "longer than the crank (rod_length_m > crank_radius_m)")
-        m_rot = _finite_float("rotating_mass_kg", self.rotating_mass_kg, minimum=0.0)
-        m_rec = _finite_float("reciprocating_mass_kg", self.reciprocating_mass_kg, minimum=0.0)
-        j_ab = _finite_float("rod_inertia_correction_kg_m2", self.rod_inertia_correction_kg_m2)
+        m_rot = bounded("rotating_mass_kg", self.rotating_mass_kg, minimum=0.0)
+        m_rec = bounded("reciprocating_mass_kg", self.reciprocating_mass_kg, minimum=0.0)
+        j_ab = bounded("rod_inertia_correction_kg_m2", self.rod_inertia_correction_kg_m2)
         if self.series not in ("leading", "fourier"):
             raise ParameterError(
                 f"series = {self.series!r}: expected 'leading' or 'fourier'")
@@ -205,13 +188,13 @@ def two_mass_split(rod_length_m: float, rod_mass_kg: float, rod_cg_to_crank_pin_
     -------
     RodSplit
     """
-    length = _finite_float("rod_length_m", rod_length_m, minimum=0.0, strict=True)
-    m_g = _finite_float("rod_mass_kg", rod_mass_kg, minimum=0.0)
-    a = _finite_float("rod_cg_to_crank_pin_m", rod_cg_to_crank_pin_m, minimum=0.0,
+    length = bounded("rod_length_m", rod_length_m, minimum=0.0, strict=True)
+    m_g = bounded("rod_mass_kg", rod_mass_kg, minimum=0.0)
+    a = bounded("rod_cg_to_crank_pin_m", rod_cg_to_crank_pin_m, minimum=0.0,
                       maximum=length)
-    m_a = _finite_float("crank_pin_mass_kg", crank_pin_mass_kg, minimum=0.0)
-    m_b = _finite_float("piston_mass_kg", piston_mass_kg, minimum=0.0)
-    j_g = _finite_float("rod_inertia_about_cg_kg_m2", rod_inertia_about_cg_kg_m2, minimum=0.0)
+    m_a = bounded("crank_pin_mass_kg", crank_pin_mass_kg, minimum=0.0)
+    m_b = bounded("piston_mass_kg", piston_mass_kg, minimum=0.0)
+    j_g = bounded("rod_inertia_about_cg_kg_m2", rod_inertia_about_cg_kg_m2, minimum=0.0)
     b = length - a
     return RodSplit(rotating_mass_kg=m_a + m_g * b / length,
                     reciprocating_mass_kg=m_b + m_g * a / length,
@@ -313,8 +296,8 @@ def _force_xy(mech: SliderCrank, omega: float, moment_kg_m: float,
 
 
 def _counterweight_moment(mech: SliderCrank, counterweight_mass_kg, counterweight_radius_m) -> float:
-    mass = _finite_float("counterweight_mass_kg", counterweight_mass_kg, minimum=0.0)
-    radius = _finite_float("counterweight_radius_m", counterweight_radius_m, minimum=0.0)
+    mass = bounded("counterweight_mass_kg", counterweight_mass_kg, minimum=0.0)
+    radius = bounded("counterweight_radius_m", counterweight_radius_m, minimum=0.0)
     if radius > mech.crank_radius_m * (1.0 + 1e-12):
         raise ParameterError(
             f"counterweight_radius_m = {radius!r}: expected 0 <= r_c <= crank_radius_m = "
@@ -335,7 +318,7 @@ def counterweight_mass(mech: SliderCrank, k: float) -> float:
     -------
     float
     """
-    fraction = _finite_float("k", k, minimum=0.0, maximum=1.0)
+    fraction = bounded("k", k, minimum=0.0, maximum=1.0)
     return mech.rotating_mass_kg + fraction * mech.reciprocating_mass_kg
 
 
@@ -352,7 +335,7 @@ def counterweight_moment(mech: SliderCrank, balance_fraction_value: float) -> fl
     -------
     float
     """
-    alpha = _finite_float("balance_fraction", balance_fraction_value)
+    alpha = bounded("balance_fraction", balance_fraction_value)
     return (mech.rotating_mass_kg + alpha * mech.reciprocating_mass_kg) * mech.crank_radius_m
 
 
