@@ -38,7 +38,9 @@ from .nls import fit_modes
 from .peaks import neighbour_noise_std
 from .units import TWO_PI
 
-__all__ = ["MissingMode", "find_missing_mode", "residual_noise_std", "residual_structure", "restart_pole", "SIGNIFICANCE"]
+__all__ = [
+    "MissingMode", "find_missing_mode", "residual_noise_std", "residual_structure", "restart_pole", "SIGNIFICANCE",
+]
 
 #: false-alarm probability of each test for one added mode
 SIGNIFICANCE = 1e-6

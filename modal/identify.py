@@ -90,13 +90,12 @@ def _linear_constants(omega, h, power, wn, zeta):
 def _constants_all_poles(frf, bands, power, omega_n, damping_ratio):
     """Modal constants of every channel for known poles: one linear least-squares solve
     (all modes together, one complex offset per band region) over the lines of the bands."""
-    keep, region = _regions(bands, frf.frequency_hz)
-    omega = frf.omega_rad_s[keep]
+    omega, response, region = _band_data(frf, bands)
     ok = np.isfinite(omega_n) & np.isfinite(damping_ratio)
     phi = mode_basis(omega, np.asarray(omega_n)[ok], np.asarray(damping_ratio)[ok], power).T
     offsets = np.zeros((omega.size, region.max() + 1), dtype=complex)
     offsets[np.arange(omega.size), region] = 1.0
-    coef = solve_linear(np.hstack([phi, offsets]), frf.channels[:, keep].T)
+    coef = solve_linear(np.hstack([phi, offsets]), response.T)
     out = np.full((len(bands), frf.n_channels), np.nan, dtype=complex)
     out[ok] = coef[:ok.sum()]
     return out
@@ -179,6 +178,13 @@ def _regions(bands: list[ModeBand], freq):
     for br in breaks:
         region[br + 1:] += 1
     return keep, region
+
+
+def _band_data(frf, bands, channels=None):
+    """Lines of the bands (rad/s), the FRF there (all or some channels) and each line's region."""
+    keep, region = _regions(bands, frf.frequency_hz)
+    rows = slice(None) if channels is None else channels
+    return frf.omega_rad_s[keep], frf.channels[rows][:, keep], region
 
 
 def _start_pole(frf, band, power, noise):
@@ -270,7 +276,7 @@ def _refinement_check(frf, bands, power, poles, consts, noise, estimated_noise):
     keep, _ = _regions(bands, frf.frequency_hz)
     strongest = np.argsort(np.max(np.abs(frf.channels[:, keep]) / np.where(noise > 0, noise, 1.0)[:, None],
                                   axis=1))[::-1][:POLE_CHANNELS]
-    fit = _fit_bands(frf, bands, power, wn0, z0, estimated_noise, strongest)
+    fit = _fit_bands(frf, bands, power, wn0, z0, strongest)
     # the noise as the fit's residual shows it (the raw estimate takes in curvature on coarse axes)
     chi2 = _chi2(fit.noise_var, _fit_noise(frf, bands, power, fit.omega_n, fit.damping_ratio,
                                            estimated_noise, strongest))
@@ -311,14 +317,13 @@ def _chi2(residual_var, noise_std) -> float:
 
 def _fit_noise(frf, bands, power, omega_n, damping_ratio, estimated_noise, channels=None):
     """:func:`modal.checks.residual_noise_std` on the lines of the bands (all or some channels)."""
-    keep, region = _regions(bands, frf.frequency_hz)
+    omega, response, region = _band_data(frf, bands, channels)
     rows = slice(None) if channels is None else channels
     with np.errstate(all="ignore"):
-        return residual_noise_std(frf.omega_rad_s[keep], frf.channels[rows][:, keep], power, region,
-                                  omega_n, damping_ratio, estimated_noise[rows])
+        return residual_noise_std(omega, response, power, region, omega_n, damping_ratio, estimated_noise[rows])
 
 
-def _fit_bands(frf, bands, power, omega_n0, damping_ratio0, estimated_noise, channels=None):
+def _fit_bands(frf, bands, power, omega_n0, damping_ratio0, channels=None):
     """:func:`modal.nls.fit_modes` of every band's mode together, with collapsed modes reseated.
 
     A weak mode whose start lies on a noise spike can collapse there inside the
@@ -331,9 +336,7 @@ def _fit_bands(frf, bands, power, omega_n0, damping_ratio0, estimated_noise, cha
     fit runs again. The restart is kept only when its residual is lower: the
     reported fit is the better least-squares optimum of the same model.
     """
-    keep, region = _regions(bands, frf.frequency_hz)
-    rows = slice(None) if channels is None else channels
-    omega, response = frf.omega_rad_s[keep], frf.channels[rows][:, keep]
+    omega, response, region = _band_data(frf, bands, channels)
     with np.errstate(all="ignore"):
         fit = fit_modes(omega, response, power, omega_n0, damping_ratio0, region=region)
     if len(bands) < 2:
@@ -376,9 +379,7 @@ def _truncation(frf, bands, power, fit, channels=None):
     Returns (pole shift (n_modes, 2), constant shift (n_modes, n_channels)) in
     the fit's order of modes.
     """
-    keep, region = _regions(bands, frf.frequency_hz)
-    rows = slice(None) if channels is None else channels
-    omega, response = frf.omega_rad_s[keep], frf.channels[rows][:, keep]
+    omega, response, region = _band_data(frf, bands, channels)
     with np.errstate(all="ignore"):
         structure = residual_structure(omega, response, power, region, fit.omega_n, fit.damping_ratio)
     if not structure > STRUCTURED_RATIO:
@@ -395,11 +396,11 @@ def _with_shift(cov, pole_shift, constant_shift):
 
 def _missing_mode(frf, bands, power, omega_n, damping_ratio, estimated_noise):
     """:func:`modal.checks.find_missing_mode` on the lines of the bands."""
-    keep, region = _regions(bands, frf.frequency_hz)
+    omega, response, region = _band_data(frf, bands)
     bands_rad = [(TWO_PI * b.low_hz, TWO_PI * b.high_hz) for b in bands]
     with np.errstate(all="ignore"):
-        return find_missing_mode(frf.omega_rad_s[keep], frf.channels[:, keep], power, region,
-                                 omega_n, damping_ratio, estimated_noise, bands_rad)
+        return find_missing_mode(omega, response, power, region, omega_n, damping_ratio, estimated_noise,
+                                 bands_rad)
 
 
 def _overlap(per_mode, index) -> float:
@@ -551,7 +552,7 @@ def identify(frf: FRF, method: str = "nls", bands_hz=None, *, noise_std=None, dr
             per_mode.append((wn, zeta, const, cov, s_wn, s_z, flags, q, chi2))
     else:
         starts = [_start_pole(frf, band, power, noise) for band in bands]
-        fit = _fit_bands(frf, bands, power, [s[0] for s in starts], [s[1] for s in starts], estimated_noise)
+        fit = _fit_bands(frf, bands, power, [s[0] for s in starts], [s[1] for s in starts])
         chi2 = _chi2(fit.noise_var, _fit_noise(frf, bands, power, fit.omega_n, fit.damping_ratio,
                                                estimated_noise))
         missing_mode = _missing_mode(frf, bands, power, fit.omega_n, fit.damping_ratio, estimated_noise)
