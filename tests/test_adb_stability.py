@@ -247,3 +247,31 @@ def test_no_stable_speed_without_drag_or_without_support_damping():
         assert len(stable_speed_intervals(p, 10 * WN)) == 0
     classes = balanced_stability(S1.replace(c=0.0, D=0.0), np.linspace(0.1, 10, 200) * WN).stability_class
     assert set(np.unique(classes)) == {UNSTABLE, MARGINAL}
+
+
+def test_rounding_bound_of_a_nearly_defective_eigenvalue_is_its_real_sensitivity():
+    # a 2x2 Jordan block at -1e-3: the eigenvalue condition number is infinite (the first-order
+    # bound kappa eps ||J|| says nothing), yet rounding-size perturbations move the eigenvalues
+    # by about sqrt(eps) ~ 1.5e-8, far below 1e-3: the verdict is stable. At 0 it stays marginal
+    from balancer.adb.linear import eigen_analysis_nondimensional
+
+    jordan = np.array([[[-1e-3, 1.0], [0.0, -1e-3]], [[0.0, 1.0], [0.0, 0.0]]])
+    analysis = eigen_analysis_nondimensional(jordan, 1.0)
+    assert list(analysis.stability_class) == [STABLE, MARGINAL]
+    assert analysis.rounding_bound_per_s[0] < 1e-6  # ten times a sqrt(eps)-size change
+
+
+def test_a_huge_condition_number_at_one_grid_speed_does_not_split_a_stable_interval():
+    # stress finding 30 (tests/test_stress_adb.py with tests/test_stress_identify.py): five
+    # balls, stable from 1.373 wn on with a growth rate of -0.029/s throughout, but at 4.3 wn
+    # the critical condition number was 4e16 and the first-order rounding bound 2.9e4/s, so
+    # that one grid speed came out marginal and the interval was cut there (4.2875–4.3125 wn
+    # missing). Perturbing the Jacobian at the rounding level moves the growth rate by 1e-12
+    params = ADBParameters(M=1.0, m=0.001, n=5, R=0.23713737056616552, e=0.0006153698904364681,
+                           k=100.0, c=0.059167988436520935, D=0.0005609407219565116)
+    wn = params.natural_frequency_rad_s
+    intervals = stable_speed_intervals(params, 5.0 * wn, grid_points=400)
+    assert len(intervals) == 1 and intervals.intervals_ratio[0, 1] == 5.0
+    at = balanced_stability(params, [4.3 * wn])
+    assert at.stability_class[0] == STABLE
+    assert at.rounding_bound_per_s[0] < 1e-6 * abs(at.max_real_part_per_s[0])
