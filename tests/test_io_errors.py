@@ -400,6 +400,21 @@ def test_mat_truncated(tmp_path):
     _check_fails(path, "not a readable MATLAB")
 
 
+def test_mat_size_beyond_what_the_file_can_hold(tmp_path):
+    # stress finding 31: a bit flip in a cell's dimensions (1x1 → 1x268435457) in a 1.8 kB file
+    # kept loadmat allocating for 9 s before it failed. The sizes listed by whosmat are checked
+    # against the file's size first (zlib compresses at most about 1032:1)
+    path = tmp_path / "m.mat"
+    write_frf(_frf(), path)
+    data = bytearray(path.read_bytes())
+    name = data.index(b"response_points")
+    dims = name - 8 - 8  # the dimensions subelement: its tag, then two int32, then the name's tag
+    assert data[dims - 8] == 5 and int.from_bytes(data[dims:dims + 4], "little") == 1  # miINT32, 1 x …
+    data[dims + 4:dims + 8] = (268435457).to_bytes(4, "little")
+    path.write_bytes(bytes(data))
+    _check_fails(path, "variable 'response_points' claims shape (1, 268435457)", f"{len(data)}-byte file")
+
+
 def test_mat73_missing_variable(tmp_path):
     path = tmp_path / "m.mat"
     write_frf(_frf(), path, format="mat73")
