@@ -18,7 +18,8 @@ if getattr(modal, "__toolkit_id__", None) != "modalbal":  # pragma: no cover
 
 ROOT = Path(__file__).resolve().parent.parent
 SYNTHETIC = ROOT / "data" / "synthetic"
-SHARED = ROOT.parent / "shared"
+#: real measured files shipped with the project (MIT, from ladisk/pyuff; see data/real/README.md)
+REAL = ROOT / "data" / "real"
 
 
 @pytest.fixture
@@ -27,7 +28,5 @@ def synthetic_dir() -> Path:
 
 
 @pytest.fixture
-def shared_dir() -> Path:
-    if not SHARED.is_dir():
-        pytest.skip("../shared/ (reference data) is not beside the checkout")
-    return SHARED
+def real_dir() -> Path:
+    return REAL

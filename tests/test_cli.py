@@ -96,12 +96,11 @@ def test_no_half_written_plot_on_failure(tmp_path):
 
 
 def test_real_beam_files_and_time_data_refused():
-    from conftest import SHARED
+    from conftest import REAL
 
-    real = SHARED / "data" / "real"
+    real = REAL
     beams = sorted(real.glob("pyuff_meas_point_*.txt"))
-    if len(beams) != 3:
-        pytest.skip("../shared/data/real is not beside the checkout")
+    assert len(beams) == 3, "data/real must ship the three beam files"
     out = run("fit", *beams, "--frequency-step", "1", "--kind", "accelerance", "--band", "40", "60", "--json")
     assert out.returncode == 0, out.stderr
     rows = json.loads(out.stdout)["modes"]

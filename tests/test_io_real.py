@@ -1,4 +1,4 @@
-"""Real measured data from ../shared/data/real (pyuff's measured beam FRFs and a 58b time file)."""
+"""Real measured data from data/real (pyuff's measured beam FRFs and a 58b time file)."""
 from __future__ import annotations
 
 import numpy as np
@@ -12,8 +12,8 @@ TIME = "pyuff_MPSTD_Set001_2024_10_08_10_27_07.uff"
 
 
 @pytest.fixture
-def real(shared_dir):
-    return shared_dir / "data" / "real"
+def real(real_dir):
+    return real_dir
 
 
 def _beam(real):

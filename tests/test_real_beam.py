@@ -1,4 +1,4 @@
-"""Fitting the measured free-free beam (../shared/data/real, from ladisk/pyuff, MIT)."""
+"""Fitting the measured free-free beam (data/real, from ladisk/pyuff, MIT)."""
 import warnings
 
 import numpy as np
@@ -7,17 +7,16 @@ import pytest
 import modal
 from modal import ModalWarning
 
-#: an independent LSCF + LSFD fit (sdypy-EMA, 10–1000 Hz, order 50), see ../shared/data/real/README.md
+#: an independent LSCF + LSFD fit (sdypy-EMA, 10–1000 Hz, order 50), see data/real/README.md
 LSCF_HZ = [51.5, 142.2, 278.7, 460.4, 687.2]
 
 
 @pytest.fixture(scope="module")
 def beam():
-    from conftest import SHARED
+    from conftest import REAL
 
-    paths = sorted((SHARED / "data" / "real").glob("pyuff_meas_point_*.txt"))
-    if len(paths) != 3:
-        pytest.skip("../shared/data/real is not beside the checkout")
+    paths = sorted(REAL.glob("pyuff_meas_point_*.txt"))
+    assert len(paths) == 3, "data/real must ship the three beam files"
     # the files hold 1001 complex lines without a frequency axis: 0..1000 Hz, 1 Hz steps
     channels = [modal.read_frf(p, frequency_step=1.0, kind="accelerance") for p in paths]
     frf = modal.FRF(channels[0].frequency_hz, np.array([c.response for c in channels]), kind="accelerance",
