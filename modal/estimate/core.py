@@ -1,0 +1,353 @@
+"""Time records → FRF with coherence and a calibrated noise level per line.
+
+:func:`estimate_frf` is the one entry point; it returns an
+:class:`EstimatedFRF`, an :class:`~modal.frf.FRF` that also carries the
+coherence, the number of averages, what was rejected, and ``noise_std``: the
+standard deviation of the complex random error of each line, so that
+:func:`modal.identify` can weight by it.
+
+Noise model (Bendat & Piersol, *Random Data*, ch. 9): with n records and
+q inputs, the least-squares FRF's error is complex Gaussian with
+E|Ĥ − H|² = σ²_N [S_xx⁻¹]_ii, σ²_N estimated from the residual
+Σ|Y − ĤX|² / (n − q); for one input this is |H|²(1 − γ²)/(γ²(n − 1)).
+Overlapping records share noise; :func:`~modal.estimate.spectra.overlap_variance_factor`
+inflates the variance by Welch's 1 + 2Σρ².
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from ..errors import FRFValidationError, ParameterError
+from ..frf import FRF, FRF_KINDS, KIND_POWER
+from . import spectra
+from .hits import find_hits
+from .windows import WINDOWS, exponential_window, force_window, segment_window
+
+__all__ = ["EstimatedFRF", "estimate_frf", "RESPONSE_QUANTITIES"]
+
+#: what a response channel measured, and its power of iω relative to displacement
+RESPONSE_QUANTITIES = {"displacement": 0, "velocity": 1, "acceleration": 2}
+
+
+@dataclass(frozen=True, eq=False)
+class EstimatedFRF(FRF):
+    """An FRF estimated from time records, with its coherence and noise.
+
+    Channels are ordered output by output and, within one output, input by
+    input (channel ``o * n_inputs + i``).
+
+    Attributes
+    ----------
+    coherence : ndarray, shape like ``response``
+        Ordinary coherence of each input–output pair (0–1).
+    multiple_coherence : ndarray, shape (n_outputs, n_freq)
+        Multiple coherence of each output on all inputs (equal to the ordinary
+        coherence for one input).
+    noise_std : ndarray, shape like ``response``, or None
+        Standard deviation of the complex random error of each line,
+        E|Ĥ − H|² = noise_std², in the FRF's unit. None with one average (undefined).
+    averages : int
+        Records (segments or accepted hits) averaged.
+    rejected : list of dict
+        Rejected hits: ``hit`` (from 1), ``time_s``, ``reason``.
+    estimator : {"H1", "H2", "Hv"}
+    window : str
+    exponential_decay_s : float or None
+        τ of the exponential window, s: every pole's real part is more negative
+        by 1/τ; :func:`modal.identify` takes it back out.
+    sample_rate_hz : float
+    segment_length : int
+        Samples per record.
+    overlap : float
+        Fraction of a segment shared with the next (continuous records).
+    n_inputs : int
+        Excitation channels.
+    """
+
+    coherence: np.ndarray | None = None
+    multiple_coherence: np.ndarray | None = None
+    noise_std: np.ndarray | None = None
+    averages: int = 1
+    rejected: list = field(default_factory=list)
+    estimator: str = "H1"
+    window: str = "rect"
+    exponential_decay_s: float | None = None
+    sample_rate_hz: float | None = None
+    segment_length: int | None = None
+    overlap: float = 0.0
+    n_inputs: int = 1
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        shape = np.shape(self.response)
+        for name in ("coherence", "noise_std"):
+            value = getattr(self, name)
+            if value is None:
+                continue
+            arr = np.array(value, dtype=float)
+            if arr.shape != shape or not np.all(np.isfinite(arr)) or np.any(arr < 0):
+                raise FRFValidationError(
+                    f"{self.source}: field {name!r} must be finite, >= 0 and shaped like 'response' {shape}"
+                )
+            arr.setflags(write=False)
+            object.__setattr__(self, name, arr)
+        if self.multiple_coherence is not None:
+            arr = np.atleast_2d(np.array(self.multiple_coherence, dtype=float))
+            arr.setflags(write=False)
+            object.__setattr__(self, "multiple_coherence", arr)
+
+    def _per_line(self, keep) -> dict:
+        out = {}
+        for name in ("coherence", "noise_std", "multiple_coherence"):
+            value = getattr(self, name)
+            out[name] = None if value is None else value[..., keep]
+        return out
+
+    def cropped(self, f_low_hz: float, f_high_hz: float) -> "EstimatedFRF":
+        """The lines with ``f_low_hz <= f <= f_high_hz`` (coherence and noise with them)."""
+        keep = (self.frequency_hz >= f_low_hz) & (self.frequency_hz <= f_high_hz)
+        if keep.sum() < 2:
+            raise FRFValidationError(
+                f"{self.source}: band {f_low_hz}–{f_high_hz} Hz holds {int(keep.sum())} lines, expected at least 2"
+            )
+        return replace(self, frequency_hz=self.frequency_hz[keep], response=self.response[..., keep],
+                       **self._per_line(keep))
+
+    def channel(self, index: int) -> "EstimatedFRF":
+        """A single-channel estimate of channel ``index``."""
+        pts = lambda ids: None if ids is None else (ids[index],)  # noqa: E731
+        pick = lambda a: None if a is None else np.atleast_2d(a)[index]  # noqa: E731
+        output = index // self.n_inputs
+        return replace(self, response=self.channels[index], response_points=pts(self.response_points),
+                       reference_points=pts(self.reference_points), coherence=pick(self.coherence),
+                       noise_std=pick(self.noise_std), multiple_coherence=np.atleast_2d(
+                           self.multiple_coherence)[output] if self.multiple_coherence is not None else None,
+                       n_inputs=1)
+
+    def as_kind(self, kind) -> "EstimatedFRF":
+        """Exact conversion to another kind; ``noise_std`` scales with |iω|^Δp."""
+        converted = super().as_kind(kind)
+        if converted is self or self.noise_std is None:
+            return converted
+        delta = KIND_POWER[kind] - KIND_POWER[self.kind]
+        return replace(converted, noise_std=self.noise_std * np.abs(self.omega_rad_s) ** delta)
+
+
+def _as_signals(value, name: str, source: str):
+    """(channels, samples) view of an array-like; ndarray/memmap/h5py slices stream."""
+    if not hasattr(value, "shape") or not hasattr(value, "__getitem__"):
+        try:
+            value = np.asarray(value, dtype=float)
+        except (TypeError, ValueError) as exc:
+            raise ParameterError(f"{source}: field {name!r} is not numeric ({exc})") from None
+    if len(value.shape) == 1:
+        value = np.asarray(value, dtype=float)[np.newaxis, :]
+    if len(value.shape) != 2:
+        raise ParameterError(
+            f"{source}: field {name!r} has shape {tuple(value.shape)}; expected (samples,) or (channels, samples)"
+        )
+    return value
+
+
+def _check_finite(signal, name: str, source: str, block: int = 2**22) -> None:
+    n = signal.shape[1]
+    for first in range(0, n, block):
+        part = np.asarray(signal[:, first:first + block], dtype=float)
+        bad = ~np.isfinite(part)
+        if bad.any():
+            ch, i = (int(v) for v in np.argwhere(bad)[0])
+            raise ParameterError(
+                f"{source}: field {name!r} has a non-finite sample at channel {ch + 1}, sample {first + i}; "
+                "expected finite numbers"
+            )
+
+
+def _default_segment_length(n_samples: int) -> int:
+    """Largest power of two giving at least 16 half-overlapping segments (at least 16 samples)."""
+    return 1 << max(4, int(np.floor(np.log2(max(n_samples / 8.5, 16)))))
+
+
+def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str = "H1",
+                 kind: str = "receptance", segment_length: int | None = None, overlap: float = 0.5,
+                 window: str = "hann", exponential_decay_s: float | None = None, impact: bool = False,
+                 response_quantity: str | None = None, excitation_points=None, response_points=None,
+                 threshold: float | None = None, pretrigger_s: float | None = None,
+                 double_hit_window_s: float = 0.05, decay_fraction: float = 0.05,
+                 full_scale: float | None = None, source: str = "<array>") -> EstimatedFRF:
+    """Estimate FRFs, coherence and per-line noise from excitation and response records.
+
+    Parameters
+    ----------
+    excitation : array_like, shape (n_samples,) or (n_inputs, n_samples)
+        Force channel(s), N (or the force unit of the file).
+    response : array_like, shape (n_samples,) or (n_outputs, n_samples)
+        Response channels. Any array-like that slices (``np.memmap``, an h5py
+        dataset) is streamed record by record.
+    sample_rate_hz : float
+        Samples per second, Hz.
+    estimator : {"H1", "H2", "Hv"}
+        ``"H1"`` (noise on the response; MIMO with several inputs), ``"H2"``
+        (noise on the force), ``"Hv"`` (total least squares). H2 and Hv take one input.
+    kind : {"receptance", "mobility", "accelerance"}
+        Kind of the returned FRF.
+    response_quantity : {"displacement", "velocity", "acceleration"}, optional
+        What the response channels measured; default: what ``kind`` implies (no
+        conversion). Converting to a lower kind drops the 0 Hz line.
+    segment_length : int, optional
+        Samples per record. Continuous records: default the largest power of two
+        giving ≥ 16 half-overlapping segments. Impact: default from the hit spacing.
+    overlap : float
+        Fraction in [0, 1) of a segment shared with the next (continuous records only).
+    window : {"rect", "hann", "force", "exponential"}
+        Continuous records: ``"rect"`` or ``"hann"`` on every channel. Impact
+        records: ``"rect"``; ``"force"`` (force window on the excitation);
+        ``"exponential"`` (force window on the excitation and exp(−t/τ) on all
+        channels; needs ``exponential_decay_s``).
+    exponential_decay_s : float, optional
+        τ of the exponential window, s (also allowed with ``"force"``). The FRF
+        carries it and :func:`modal.identify` corrects the damping.
+    impact : bool
+        Find the hits in a continuous record and average one record per accepted hit.
+    excitation_points, response_points : sequence of str, optional
+        Point ids of the inputs and outputs (a pair with equal ids is a driving point).
+    threshold, pretrigger_s, double_hit_window_s, decay_fraction, full_scale
+        Hit detection settings, see :func:`modal.estimate.hits.find_hits`.
+    source : str
+        Name used in messages (the file).
+
+    Returns
+    -------
+    EstimatedFRF
+    """
+    estimator = {"h1": "H1", "h2": "H2", "hv": "Hv"}.get(str(estimator).lower(), estimator)
+    if estimator not in spectra.ESTIMATORS:
+        raise ParameterError(f"field 'estimator' is {estimator!r}; expected one of {', '.join(spectra.ESTIMATORS)}")
+    if kind not in FRF_KINDS:
+        raise ParameterError(f"field 'kind' is {kind!r}; expected one of {', '.join(FRF_KINDS)}")
+    if response_quantity is not None and response_quantity not in RESPONSE_QUANTITIES:
+        raise ParameterError(
+            f"field 'response_quantity' is {response_quantity!r}; expected one of {', '.join(RESPONSE_QUANTITIES)}"
+        )
+    if window not in WINDOWS:
+        raise ParameterError(f"field 'window' is {window!r}; expected one of {', '.join(WINDOWS)}")
+    fs = float(sample_rate_hz)
+    if not (np.isfinite(fs) and fs > 0):
+        raise ParameterError(f"field 'sample_rate_hz' is {sample_rate_hz!r}; expected a positive rate in Hz")
+    if not (0.0 <= overlap < 1.0):
+        raise ParameterError(f"field 'overlap' is {overlap!r}; expected a fraction in [0, 1)")
+    x = _as_signals(excitation, "excitation", source)
+    y = _as_signals(response, "response", source)
+    if x.shape[1] != y.shape[1]:
+        raise ParameterError(
+            f"{source}: 'excitation' has {x.shape[1]} samples and 'response' {y.shape[1]}; expected equal lengths"
+        )
+    n = x.shape[1]
+    _check_finite(x, "excitation", source)
+    _check_finite(y, "response", source)
+
+    rejected: list[dict] = []
+    if impact:
+        if window == "hann":
+            raise ParameterError("field 'window': 'hann' would suppress the hit; impact records take "
+                                 "'rect', 'force' or 'exponential'")
+        if window == "exponential" and exponential_decay_s is None:
+            raise ParameterError("field 'exponential_decay_s' is required with window='exponential' (τ in s)")
+        if x.shape[0] != 1:
+            raise ParameterError(f"{source}: impact=True takes one force channel, got {x.shape[0]}")
+        force = np.asarray(x[0], dtype=float)
+        pre = None if pretrigger_s is None else pretrigger_s
+        probe = find_hits(force, np.asarray(y, dtype=float), fs, threshold=threshold, pretrigger_s=pre,
+                          record_length=segment_length, double_hit_window_s=double_hit_window_s,
+                          decay_fraction=decay_fraction, full_scale=full_scale)
+        length = probe.record_length
+        pre_samples = int(probe.trigger_index[0] - probe.record_start[0])
+        decay = (None if exponential_decay_s is None
+                 else exponential_window(length, fs, exponential_decay_s, pre_samples))
+        hits = probe if decay is None else find_hits(
+            force, np.asarray(y, dtype=float), fs, threshold=threshold, pretrigger_s=pre, record_length=length,
+            double_hit_window_s=double_hit_window_s, decay_fraction=decay_fraction, decay_window=decay,
+            full_scale=full_scale)
+        rejected = hits.rejected
+        starts = hits.record_start[hits.accepted]
+        if starts.size == 0:
+            reasons = "; ".join(f"hit {r['hit']} at {r['time_s']:.3f} s: {r['reason']}" for r in rejected)
+            raise ParameterError(f"{source}: every hit was rejected ({reasons})")
+        in_w = np.ones(length)
+        if window in ("force", "exponential"):
+            in_w = force_window(length, pre_samples, width=max(8, 3 * hits.pulse_samples))
+        out_w = np.ones(length)
+        if decay is not None:
+            in_w = in_w * decay
+            out_w = decay
+        step = length
+    else:
+        if window not in ("rect", "hann"):
+            raise ParameterError(f"field 'window': {window!r} is for impact records (impact=True); "
+                                 "a continuous record takes 'rect' or 'hann'")
+        if exponential_decay_s is not None:
+            raise ParameterError("field 'exponential_decay_s' applies to impact records (impact=True)")
+        length = _default_segment_length(n) if segment_length is None else int(segment_length)
+        if not (2 <= length <= n):
+            raise ParameterError(f"field 'segment_length' is {segment_length!r}; expected 2 to {n} samples")
+        step = max(1, int(round(length * (1.0 - overlap))))
+        starts = np.arange(0, n - length + 1, step)
+        in_w = out_w = segment_window(window, length)
+        decay = None
+
+    sums = spectra.accumulate(x, y, starts, length, in_w, out_w)
+    estimate = {"H1": spectra.h1, "H2": spectra.h2, "Hv": spectra.hv}[estimator]
+    frf3, coherence3, multiple, variance3 = estimate(sums, source)
+    n_out, n_in, n_lines = frf3.shape
+    frequency = np.fft.rfftfreq(length, 1.0 / fs)
+    response_lines = frf3.reshape(n_out * n_in, n_lines)
+    coherence = coherence3.reshape(n_out * n_in, n_lines)
+    noise = None
+    if variance3 is not None:
+        factor = spectra.overlap_variance_factor(out_w, step) if not impact else 1.0
+        noise = np.sqrt(variance3.reshape(n_out * n_in, n_lines) * factor)
+
+    if response_quantity is not None:
+        delta = KIND_POWER[kind] - RESPONSE_QUANTITIES[response_quantity]
+        if delta:
+            keep = frequency > 0 if delta < 0 else np.ones(frequency.size, bool)
+            frequency = frequency[keep]
+            scale = (2j * np.pi * frequency) ** delta
+            response_lines = response_lines[:, keep] * scale
+            coherence = coherence[:, keep]
+            multiple = multiple[:, keep]
+            if noise is not None:
+                noise = noise[:, keep] * np.abs(scale)
+
+    def ids(points, count, name):
+        if points is None:
+            return None
+        points = [points] if isinstance(points, (str, int)) else list(points)
+        if len(points) != count:
+            raise ParameterError(f"{source}: field {name!r} has {len(points)} ids, expected {count}")
+        return [str(p) for p in points]
+
+    ins = ids(excitation_points, n_in, "excitation_points")
+    outs = ids(response_points, n_out, "response_points")
+    single = n_out * n_in == 1
+    return EstimatedFRF(
+        frequency_hz=frequency,
+        response=response_lines[0] if single else response_lines,
+        kind=kind,
+        response_points=None if outs is None else [o for o in outs for _ in range(n_in)],
+        reference_points=None if ins is None else [i for _ in range(n_out) for i in ins],
+        source=source,
+        coherence=coherence[0] if single else coherence,
+        multiple_coherence=multiple,
+        noise_std=None if noise is None else (noise[0] if single else noise),
+        averages=sums.n_records,
+        rejected=list(rejected),
+        estimator=estimator,
+        window=window,
+        exponential_decay_s=None if exponential_decay_s is None else float(exponential_decay_s),
+        sample_rate_hz=fs,
+        segment_length=length,
+        overlap=0.0 if impact else float(overlap),
+        n_inputs=n_in,
+    )
