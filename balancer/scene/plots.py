@@ -49,7 +49,7 @@ def _response(results):
 
 
 def _compressor(results):
-    from ..crank_plots import plot_force_locus, plot_objective
+    from ..compressor.crank_plots import plot_force_locus, plot_objective
 
     c = results["compressor"]
     return [("force_locus", plot_force_locus(c.mechanism, c.speed_rpm, c.counterweight_mass_kg, c.counterweight_radius_m)),

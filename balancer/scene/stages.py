@@ -150,8 +150,8 @@ def stage_identify(scene: Scene, frf: modal.FRF) -> modal.IdentificationResult:
 
 def stage_drive(scene: Scene) -> DriveStage:
     """Belt stages in series and the shaft's hand-over (speed, stiffness, critical-speed margin)."""
-    from ..drive import BeltStageSpec, belt_drive
-    from ..shaft import ShaftGeometry, rotor_handover
+    from ..drive.belt import BeltStageSpec, belt_drive
+    from ..drive.shaft import ShaftGeometry, rotor_handover
 
     cfg = scene.section("drive")
     specs = [BeltStageSpec(**{k: v for k, v in s.items()}) for s in cfg["stages"]]
@@ -229,7 +229,7 @@ def stage_adb_response(scene: Scene, rotor: RotorStage, drive=None) -> Simulatio
 
 def stage_compressor(scene: Scene) -> CompressorStage:
     """Exact optimum counterweight of the slider-crank (lightest: r_c = r, or a given k)."""
-    from ..crank import SliderCrank, counterweight_on_curve, optimal_counterweight
+    from ..compressor.crank import SliderCrank, counterweight_on_curve, optimal_counterweight
 
     cfg = scene.section("compressor")
     mech = SliderCrank(cfg["crank_radius_m"], cfg["rod_length_m"], cfg["rotating_mass_kg"],
@@ -242,7 +242,7 @@ def stage_compressor(scene: Scene) -> CompressorStage:
 
 def stage_mounts(scene: Scene, compressor: CompressorStage, identify=None) -> MountsStage:
     """Body on mounts: natural frequencies and the base force before and after balancing."""
-    from ..mounts import Mount, MountedBody, RigidBody, balancing_comparison, natural_modes
+    from ..compressor.mounts import Mount, MountedBody, RigidBody, balancing_comparison, natural_modes
 
     body_cfg = scene.section("compressor.body")
     mounts = []

@@ -13,7 +13,7 @@ import numpy as np
 from modal.errors import ParameterError
 from modal.units import rpm_to_rad_s
 
-from .._checks import bounded
+from ..._checks import bounded
 
 __all__ = [
     "SliderCrank",

@@ -18,7 +18,7 @@ from matplotlib.figure import Figure
 
 from modal.errors import ParameterError
 
-from .drive import BeltDrive, BeltStage
+from .belt import BeltDrive, BeltStage
 from .shaft import RotorHandover, ShaftAnalysis, ShaftSizing, shaft_diagram
 
 __all__ = [

@@ -11,7 +11,7 @@ from scipy import optimize
 from modal.errors import ParameterError
 
 from .forces import _check_objective, _objective_value, _refined_max
-from .._checks import bounded
+from ..._checks import bounded
 from .model import (
     PAPER_RULES,
     Objective,

@@ -11,7 +11,7 @@ import numpy as np
 from modal.errors import ParameterError
 from modal.units import rad_s_to_rpm
 
-from .._checks import non_negative, positive
+from ..._checks import non_negative, positive
 from .statics import STEEL_DENSITY_KG_M3, STEEL_YOUNGS_MODULUS_PA, ShaftGeometry, _check_position
 
 __all__ = [

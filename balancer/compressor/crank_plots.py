@@ -11,7 +11,7 @@ import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
-from balancer.crank import (
+from .crank import (
     PAPER_RULES,
     OptimalCounterweight,
     SliderCrank,

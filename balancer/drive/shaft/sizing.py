@@ -8,8 +8,8 @@ from typing import Sequence
 
 from modal.errors import ParameterError
 
-from .._checks import non_negative, positive
-from ..drive import next_standard_size
+from ..._checks import non_negative, positive
+from ..belt import next_standard_size
 from .statics import STANDARD_SHAFT_DIAMETERS_M
 
 __all__ = [

@@ -8,7 +8,7 @@ import numpy as np
 
 from modal.errors import ParameterError
 
-from .._checks import bounded
+from ..._checks import bounded
 from .model import (
     _MAX_SERIES_ORDER,
     _N_FFT,

@@ -7,7 +7,7 @@ from typing import Sequence
 
 from modal.units import rad_s_to_rpm
 
-from .._checks import positive
+from ..._checks import positive
 from .statics import STEEL_DENSITY_KG_M3, STEEL_YOUNGS_MODULUS_PA, ShaftGeometry, _check_position
 from .stiffness import (
     CriticalSpeed,

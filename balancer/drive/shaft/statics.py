@@ -11,7 +11,7 @@ import numpy as np
 from modal.errors import ParameterError
 from modal.units import rpm_to_rad_s
 
-from .._checks import finite, non_negative, positive
+from ..._checks import finite, non_negative, positive
 
 __all__ = [
     "STANDARD_SHAFT_DIAMETERS_M",

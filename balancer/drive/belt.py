@@ -30,7 +30,7 @@ import numpy as np
 from modal.errors import ParameterError
 from modal.units import rpm_to_rad_s
 
-from ._checks import finite, non_negative, positive
+from .._checks import finite, non_negative, positive
 
 __all__ = [
     "BELT_LENGTH_ARC_COEFFICIENT",

@@ -35,8 +35,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import linalg
 
-from balancer.crank import SliderCrank, shaking_harmonics
 from modal.errors import ParameterError
+
+from .crank import SliderCrank, shaking_harmonics
 
 __all__ = [
     "RigidBody",
