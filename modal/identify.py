@@ -8,6 +8,7 @@ import numpy as np
 from .checks import find_missing_mode, residual_noise_std, residual_structure, restart_pole
 from .circlefit import circle_fit_curve
 from .errors import IdentificationError, QualityWarning, ResolutionWarning, warn
+from .estimate.correction import remove_window_damping
 from .frf import FRF, KIND_POWER
 from .halfpower import half_power_curve
 from .model import mode_basis, solve_linear
@@ -243,7 +244,7 @@ def _sdof_covariance(frf, band, power, wn, zeta, s_wn, s_z):
     return cov
 
 
-def _refinement_check(frf, bands, power, poles, consts, noise, estimated_noise):
+def _refinement_check(frf, bands, power, poles, consts, noise, estimated_noise, known_noise=False):
     """Compare single-mode estimates with the least-squares refinement of the same modes.
 
     All modes are refined together by :func:`fit_modes`, started from the
@@ -279,7 +280,7 @@ def _refinement_check(frf, bands, power, poles, consts, noise, estimated_noise):
     fit = _fit_bands(frf, bands, power, wn0, z0, strongest)
     # the noise as the fit's residual shows it (the raw estimate takes in curvature on coarse axes)
     chi2 = _chi2(fit.noise_var, _fit_noise(frf, bands, power, fit.omega_n, fit.damping_ratio,
-                                           estimated_noise, strongest))
+                                           estimated_noise, strongest, known_noise))
     # the refinement may return the modes in another order (two close poles crossing)
     order = np.argsort(fit.omega_n)
     omega_n, damping_ratio = fit.omega_n[order], fit.damping_ratio[order]
@@ -315,10 +316,25 @@ def _chi2(residual_var, noise_std) -> float:
     return float(np.nanmedian(ratio)) if np.isfinite(ratio).any() else np.nan
 
 
-def _fit_noise(frf, bands, power, omega_n, damping_ratio, estimated_noise, channels=None):
-    """:func:`modal.checks.residual_noise_std` on the lines of the bands (all or some channels)."""
-    omega, response, region = _band_data(frf, bands, channels)
+def _band_noise(frf, bands, line_noise):
+    """Per channel, the RMS over the bands' lines of a known noise per line."""
+    line_noise = np.atleast_2d(np.asarray(line_noise, float))
+    freq = frf.frequency_hz
+    lines = np.zeros(freq.size, bool)
+    for band in bands:
+        lines |= (freq >= band.low_hz) & (freq <= band.high_hz)
+    return np.sqrt(np.mean(line_noise[:, lines] ** 2, axis=1))
+
+
+def _fit_noise(frf, bands, power, omega_n, damping_ratio, estimated_noise, channels=None, known=False):
+    """:func:`modal.checks.residual_noise_std` on the lines of the bands (all or some channels).
+
+    ``known``: the noise came with the FRF (an estimate from time data) and is taken as it is.
+    """
     rows = slice(None) if channels is None else channels
+    if known:
+        return np.asarray(estimated_noise, float)[rows]
+    omega, response, region = _band_data(frf, bands, channels)
     with np.errstate(all="ignore"):
         return residual_noise_std(omega, response, power, region, omega_n, damping_ratio, estimated_noise[rows])
 
@@ -482,8 +498,14 @@ def identify(frf: FRF, method: str = "nls", bands_hz=None, *, noise_std=None, dr
     power = KIND_POWER[frf.kind]
     n_ch = frf.n_channels
     estimated_noise = estimate_noise_std(frf)
+    # an FRF estimated from time data carries its own calibrated noise per line (modal.estimate_frf)
+    line_noise = getattr(frf, "noise_std", None)
     bands = bands_from_hz(frf, bands_hz) if bands_hz is not None else find_modes(
-        frf, min_prominence_db=min_prominence_db, max_modes=max_modes, noise_std=estimated_noise)
+        frf, min_prominence_db=min_prominence_db, max_modes=max_modes, noise_std=estimated_noise,
+        line_noise_std=line_noise)
+    known_noise = noise_std is None and line_noise is not None
+    if known_noise:
+        estimated_noise = _band_noise(frf, bands, line_noise)
     if noise_std is None:
         noise = estimated_noise
     else:
@@ -513,7 +535,8 @@ def identify(frf: FRF, method: str = "nls", bands_hz=None, *, noise_std=None, dr
         if missing.any():
             filled = _constants_all_poles(frf, bands, power, [p[0] for p in poles], [p[1] for p in poles])
             consts[missing] = filled[missing]
-        check, missing_mode = _refinement_check(frf, bands, power, poles, consts, noise, estimated_noise)
+        check, missing_mode = _refinement_check(frf, bands, power, poles, consts, noise, estimated_noise,
+                                                known_noise)
         for band, (wn, zeta, s_wn, s_z, _, flags, q), const, geometric, reference in zip(
                 bands, poles, consts, ~missing, check):
             d_wn, d_z, d_const, chi2, bound_wn, bound_z = reference
@@ -554,7 +577,7 @@ def identify(frf: FRF, method: str = "nls", bands_hz=None, *, noise_std=None, dr
         starts = [_start_pole(frf, band, power, noise) for band in bands]
         fit = _fit_bands(frf, bands, power, [s[0] for s in starts], [s[1] for s in starts])
         chi2 = _chi2(fit.noise_var, _fit_noise(frf, bands, power, fit.omega_n, fit.damping_ratio,
-                                               estimated_noise))
+                                               estimated_noise, known=known_noise))
         missing_mode = _missing_mode(frf, bands, power, fit.omega_n, fit.damping_ratio, estimated_noise)
         # near-exact data: the offset's truncation (modes outside the bands) biases the poles
         # beyond their white-noise errors; its measured shift is added to them (finding 26)
@@ -576,6 +599,7 @@ def identify(frf: FRF, method: str = "nls", bands_hz=None, *, noise_std=None, dr
                 flags.add("band_edge_peak")
             per_mode.append((wn, zeta, fit.modal_constant[r], cov, s_wn, s_z, flags, chi2, chi2))
 
+    decay_s = getattr(frf, "exponential_decay_s", None)
     modes = []
     for index, (band, (wn, zeta, const, cov, s_wn, s_z, flags, quality, chi2)) in enumerate(zip(bands, per_mode)):
         flags = set(flags)
@@ -596,6 +620,12 @@ def identify(frf: FRF, method: str = "nls", bands_hz=None, *, noise_std=None, dr
             others.append(index)
         if others:
             flags.add("close_modes")
+        window_zeta = 0.0
+        if decay_s is not None:
+            # the exponential window's damping out again (exact pole shift by 1/τ)
+            wn, zeta, cov, s_wn, s_z, window_zeta, valid = remove_window_damping(wn, zeta, cov, s_wn, s_z, decay_s)
+            if not valid:
+                flags.add("window_damping_dominates")
         (k, c, m), (sk, sc, sm) = _physical(frf, wn, zeta, const, cov, driving, flags)
         s_const = np.sqrt(np.maximum(cov[:, 2, 2] + cov[:, 3, 3], 0))
         single = frf.response.ndim == 1
@@ -607,6 +637,7 @@ def identify(frf: FRF, method: str = "nls", bands_hz=None, *, noise_std=None, dr
             stiffness_n_per_m=sq(k), damping_n_s_per_m=sq(c), mass_kg=sq(m), std=std, flags=flags_t,
             method=method, band_hz=(band.low_hz, band.high_hz), n_lines=int(omega_b.size),
             lines_per_bandwidth=lines_per_bw, chi2=chi2, driving_point=sq(driving), quality=quality,
+            window_damping_ratio=window_zeta,
         )
         modes.append(mode)
         serious = set(flags_t) - {"driving_point_assumed", "not_driving_point"}

@@ -35,6 +35,8 @@ FLAG_TEXT = {
                      "mode reduces it significantly, F-test at 1e-6), or this mode moves by more than 3 of its errors "
                      "once that mode is in the model; the estimates are biased by it: give bands_hz for both modes "
                      "or lower min_prominence_db"),
+    "window_damping_dominates": ("the exponential window's decay 1/tau is not below the mode's measured decay rate: "
+                                 "all its damping may be the window's, so it was not removed; use a longer tau"),
     "method_bias": ("half-power or circle estimate lies more than 3 of its standard errors from the least-squares "
                     "refinement of the same modes (the method's own bias: line spacing, noise at the peak, "
                     "a neighbouring mode); its standard errors include the difference, method 'nls' gives the refined values"),
@@ -97,6 +99,9 @@ class ModeResult:
     quality : float
         Method-specific quality measure (circle: relative spread of the
         damping-pair estimates; NLS: chi2; half-power: lines above −3 dB).
+    window_damping_ratio : float
+        Damping ratio an exponential window had added to the measured FRF and
+        that was removed from ``damping_ratio`` (0 without such a window).
     """
 
     natural_frequency_hz: float
@@ -114,6 +119,7 @@ class ModeResult:
     chi2: float = float("nan")
     driving_point: np.ndarray | bool = True
     quality: float = float("nan")
+    window_damping_ratio: float = 0.0
 
     @property
     def omega_n_rad_s(self) -> float:
@@ -173,6 +179,7 @@ class IdentificationResult:
                 row["band_hz"] = [float(b) for b in mode.band_hz]
                 row["driving_point"] = bool(pick(mode.driving_point))
                 row["chi2"] = float(mode.chi2)
+                row["window_damping_ratio"] = float(mode.window_damping_ratio)
                 out.append(row)
         return out
 
