@@ -14,6 +14,7 @@ import warnings
 from pathlib import Path
 
 
+from .cli_time import add_time_options, frf_from_time, wants_time
 from .errors import ModalError
 from .frf import FRF_KINDS
 from .report import jsonable
@@ -46,6 +47,16 @@ def build_parser() -> argparse.ArgumentParser:
     fit.add_argument("--json", action="store_true", help="print one JSON document on stdout")
     fit.add_argument("--plot", metavar="OUT.png", help="write a figure of the fit")
     fit.add_argument("--archive", metavar="OUT.h5", help="write the FRF and results to an HDF5 archive")
+    add_time_options(fit)
+    frf = sub.add_parser("frf", help="estimate FRFs from a time record (force and responses)",
+                         description="Estimate FRFs with coherence and noise per line from a time file "
+                                     "(UFF 58/58b function type 1, CSV with a time column, MAT, HDF5).")
+    frf.add_argument("path", help="time file")
+    frf.add_argument("--out", required=True, metavar="FRF.h5",
+                     help="output: .h5 keeps coherence, noise and settings; .uff/.csv/.mat the FRF only")
+    frf.add_argument("--kind", choices=FRF_KINDS, help="FRF kind (default: from what the responses measured)")
+    frf.add_argument("--json", action="store_true", help="print one JSON document on stdout")
+    add_time_options(frf)
     return parser
 
 
@@ -59,7 +70,11 @@ def _fit(args) -> int:
 
     names = ("kind", "frequency_axis", "frequency_step", "frequency_start", "layout", "delimiter", "decimal", "dataset")
     hints = {k: getattr(args, k) for k in names if getattr(args, k) is not None}
-    frf = read_frf(args.path[0] if len(args.path) == 1 else args.path, **hints)
+    if len(args.path) == 1 and wants_time(args, args.path[0]):
+        frf = frf_from_time(args.path[0], args)
+        _report_estimate(frf)
+    else:
+        frf = read_frf(args.path[0] if len(args.path) == 1 else args.path, **hints)
     label = args.path[0] if len(args.path) == 1 else f"{args.path[0]} (+{len(args.path) - 1} files)"
     methods = ["nls", "circle", "halfpower"] if args.method == "all" else [args.method]
     results = [identify(frf, method, bands_hz=args.band) for method in methods]
@@ -97,6 +112,34 @@ def _fit(args) -> int:
     return 0
 
 
+def _report_estimate(frf) -> None:
+    """One line on stderr: what the estimate averaged and what it rejected."""
+    print(f"{frf.source}: {frf.estimator} estimate, {frf.averages} average(s), window {frf.window}"
+          + (f", exponential decay {frf.exponential_decay_s:g} s (its damping is removed)"
+             if frf.exponential_decay_s else ""), file=sys.stderr)
+    for item in frf.rejected:
+        print(f"{frf.source}: hit {item['hit']} at {item['time_s']:.4g} s rejected: {item['reason']}", file=sys.stderr)
+
+
+def _frf(args) -> int:
+    from .io import write_frf
+
+    frf = frf_from_time(args.path, args)
+    _report_estimate(frf)
+    write_frf(frf, args.out)
+    if args.json:
+        doc = {"file": args.path, "out": args.out, "kind": frf.kind, "n_channels": frf.n_channels,
+               "n_lines": frf.n_freq, "averages": frf.averages, "estimator": frf.estimator, "window": frf.window,
+               "exponential_decay_s": frf.exponential_decay_s, "rejected": frf.rejected,
+               "response_points": list(frf.response_points or []),
+               "reference_points": list(frf.reference_points or [])}
+        json.dump(jsonable(doc), sys.stdout, indent=1, allow_nan=False)
+        sys.stdout.write("\n")
+    else:
+        print(f"{args.out}: {frf.n_channels} FRF(s), {frf.n_freq} lines, {frf.kind}")
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit code."""
     parser = build_parser()
@@ -105,11 +148,14 @@ def main(argv: list[str] | None = None) -> int:
     try:
         if args.command == "fit":
             return _fit(args)
+        if args.command == "frf":
+            return _frf(args)
     except ModalError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 1
     except OSError as exc:
-        print(f"error: {exc.filename or args.path[0]}: {exc.strerror or exc}", file=sys.stderr)
+        path = args.path if isinstance(args.path, str) else args.path[0]
+        print(f"error: {exc.filename or path}: {exc.strerror or exc}", file=sys.stderr)
         return 1
     return 2
 

@@ -87,6 +87,63 @@ def write_frf_group(group, frf: FRF) -> None:
         ids = getattr(frf, name)
         if ids is not None:
             group.attrs[name] = np.array(list(ids), dtype=h5py.string_dtype())
+    if getattr(frf, "averages", None) is not None:  # an estimate from time data (modal.estimate_frf)
+        _write_estimate(group, frf)
+
+
+#: per-line arrays of an estimate from time data, and their units (None: the FRF's own unit)
+_ESTIMATE_ARRAYS = {"coherence": "1", "multiple_coherence": "1", "noise_std": None}
+#: numbers of an estimate, and their units
+_ESTIMATE_NUMBERS = {"averages": "1", "sample_rate_hz": "Hz", "segment_length": "1", "overlap": "1",
+                     "n_inputs": "1", "exponential_decay_s": "s"}
+
+
+def _write_estimate(group, frf) -> None:
+    """Coherence, noise per line and the estimate's settings beside an estimated FRF's response."""
+    import json
+
+    for name, unit in _ESTIMATE_ARRAYS.items():
+        value = getattr(frf, name)
+        if value is not None:
+            ds = group.create_dataset(name, data=np.asarray(value, dtype=np.float64))
+            ds.attrs["units"] = frf.units if unit is None else unit
+    for name, unit in _ESTIMATE_NUMBERS.items():
+        value = getattr(frf, name)
+        if value is not None:
+            ds = group.create_dataset(name, data=value)
+            ds.attrs["units"] = unit
+    group.attrs["estimator"] = frf.estimator
+    group.attrs["window"] = frf.window
+    group.attrs["rejected"] = json.dumps(frf.rejected)
+
+
+def _read_estimate(group, frf: FRF, source: str) -> FRF:
+    """An :class:`~modal.estimate.EstimatedFRF` when the group holds an estimate's extras, else ``frf``."""
+    if "averages" not in group:
+        return frf
+    import json
+
+    from ..estimate import EstimatedFRF
+
+    extras: dict[str, Any] = {}
+    try:
+        for name in _ESTIMATE_ARRAYS:
+            if name in group:
+                arr = np.asarray(group[name][()], float)
+                extras[name] = arr if name == "multiple_coherence" else arr.reshape(np.shape(frf.response))
+        for name in _ESTIMATE_NUMBERS:
+            if name in group:
+                value = group[name][()]
+                extras[name] = int(value) if name in ("averages", "segment_length", "n_inputs") else float(value)
+        extras["estimator"] = _str_attr(group.attrs.get("estimator", "H1"))
+        extras["window"] = _str_attr(group.attrs.get("window", "rect"))
+        extras["rejected"] = json.loads(_str_attr(group.attrs.get("rejected", "[]")))
+    except (ValueError, TypeError) as exc:
+        raise FormatError(f"{source}: group {group.name}: the estimate's coherence or noise cannot be read ({exc}); "
+                          "expected arrays shaped like 'response'") from None
+    return EstimatedFRF(frequency_hz=frf.frequency_hz, response=frf.response, kind=frf.kind,
+                        response_points=frf.response_points, reference_points=frf.reference_points,
+                        units=frf.units, source=frf.source, **extras)
 
 
 def read_frf_group(group, source: str, hints: dict[str, Any] | None = None) -> FRF:
@@ -136,8 +193,9 @@ def read_frf_group(group, source: str, hints: dict[str, Any] | None = None) -> F
     points = [(_str_list(group.attrs[n]) if n in group.attrs else None)
               for n in ("response_points", "reference_points")]
     units = _str_attr(rds.attrs["units"]) if "units" in rds.attrs else None
-    return build_frf(freq, resp, kind, source, response_points=points[0], reference_points=points[1],
-                     units=units, hints=hints, squeeze=False)
+    frf = build_frf(freq, resp, kind, source, response_points=points[0], reference_points=points[1],
+                    units=units, hints=hints, squeeze=False)
+    return _read_estimate(group, frf, source)
 
 
 # ------------------------------------------------------------------ files

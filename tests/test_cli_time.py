@@ -1,0 +1,137 @@
+"""Time files on the command line: `modal fit TIME_FILE`, `modal frf TIME_FILE --out`, and read_time."""
+from __future__ import annotations
+
+import gc
+import json
+import os
+import subprocess
+import sys
+import warnings
+
+import numpy as np
+import pytest
+
+import modal
+from conftest import REAL, ROOT
+from modal.errors import FormatError
+from modal.io.timedata import read_time
+from timedata import DigitalModes
+
+FS = 1024.0
+PLANT = DigitalModes(np.array([40.0, 95.0]), np.array([0.03, 0.02]), np.array([[1.0, 0.5], [0.6, -0.8]]), FS)
+
+
+def run(*args):
+    env = {**os.environ, "MPLBACKEND": "Agg"}
+    return subprocess.run([sys.executable, "-m", "modal", *map(str, args)], capture_output=True, text=True,
+                          cwd=ROOT, env=env, timeout=120)
+
+
+def _records(seed=0, n=2**16):
+    rng = np.random.default_rng(seed)
+    force = rng.standard_normal(n)
+    accel = PLANT.respond(force)  # displacement, m: written as such below
+    return force, accel + 1e-3 * accel.std(axis=1, keepdims=True) * rng.standard_normal(accel.shape)
+
+
+def write_uff_time(path, force, responses, binary=True):
+    """A UFF file of 58b (or 58) time-response datasets: force (data type 13) first, then displacements (8)."""
+    import pyuff
+
+    open(path, "wb").close()  # pyuff's mode "overwrite" truncates again when it switches to binary: "add" instead
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # pyuff leaves its file handles to the garbage collector
+        _write_sets(pyuff.UFF(os.fspath(path)), force, responses, binary)
+        gc.collect()
+
+
+def _write_sets(uff, force, responses, binary):
+    for k, (values, data_type, unit) in enumerate([(force, 13, "N")] + [(r, 8, "m") for r in responses]):
+        uff.write_sets({
+            "type": 58, "binary": int(binary), "id1": f"channel {k + 1}", "id2": "NONE", "id3": "NONE",
+            "id4": "NONE", "id5": "NONE", "func_type": 1, "func_id": k + 1, "ver_num": 0, "load_case_id": 0,
+            "rsp_ent_name": "NONE", "rsp_node": k + 1, "rsp_dir": 3, "ref_ent_name": "NONE", "ref_node": 0,
+            "ref_dir": 0, "abscissa_spacing": 1, "abscissa_min": 0.0, "abscissa_inc": 1.0 / FS, "z_axis_value": 0.0,
+            "abscissa_spec_data_type": 17, "abscissa_axis_lab": "Time", "abscissa_axis_units_lab": "s",
+            "ordinate_spec_data_type": data_type, "ordinate_axis_lab": "NONE", "ordinate_axis_units_lab": unit,
+            "orddenom_spec_data_type": 0, "orddenom_axis_lab": "NONE", "orddenom_axis_units_lab": "NONE",
+            "z_axis_spec_data_type": 0, "x": np.arange(values.size) / FS, "data": np.asarray(values, float),
+        }, mode="add", force_double=True)
+
+
+def test_read_time_from_uff_58b(tmp_path):
+    force, resp = _records()
+    path = tmp_path / "hammer.uff"
+    write_uff_time(path, force, resp)
+    record = read_time(path)
+    assert record.sample_rate_hz == pytest.approx(FS, rel=1e-12)
+    assert record.quantities == ("force", "displacement", "displacement")
+    assert record.names == ("1+Z", "2+Z", "3+Z")
+    np.testing.assert_allclose(record.signals[0], force, rtol=1e-12)
+    assert record.force_channels() == [0] and record.channel_index("2+Z") == 1 and record.channel_index(3) == 2
+
+
+def test_real_58b_time_file_reads_and_fit_without_force_says_why():
+    path = REAL / "pyuff_MPSTD_Set001_2024_10_08_10_27_07.uff"
+    record = read_time(path)
+    assert record.signals.shape == (4, 222400) and record.sample_rate_hz == pytest.approx(3200.0)
+    assert set(record.quantities) == {"acceleration"}
+    out = run("fit", path)
+    assert out.returncode == 1
+    assert "no channel marked as force" in out.stderr and "--excitation" in out.stderr
+    assert out.stderr.count("\n") == 1  # one line, no traceback
+
+
+def test_fit_time_file_finds_the_modes(tmp_path):
+    force, resp = _records()
+    path = tmp_path / "random.uff"
+    write_uff_time(path, force, resp)
+    out = run("fit", path, "--segment-length", 4096, "--json")
+    assert out.returncode == 0, out.stderr
+    doc = json.loads(out.stdout)
+    assert doc["kind"] == "receptance" and doc["n_channels"] == 2
+    found = sorted({round(row["natural_frequency_hz"], 6) for row in doc["modes"]})
+    np.testing.assert_allclose(found, PLANT.natural_frequency_hz, rtol=1e-3)
+    # the excitation (point 1) is not a response point: no driving point, k c m undefined
+    assert all("not_driving_point" in row["flags"] for row in doc["modes"])
+    assert "H1 estimate" in out.stderr
+
+
+def test_frf_command_writes_an_estimate_that_fit_reads_back(tmp_path):
+    force, resp = _records(seed=1)
+    path = tmp_path / "random.csv"
+    table = np.column_stack([np.arange(force.size) / FS, force, resp.T])
+    np.savetxt(path, table, delimiter=",", header="time,force [N],a [m],b [m]", comments="")
+    out_h5 = tmp_path / "frf.h5"
+    made = run("frf", path, "--excitation", "force", "--out", out_h5, "--segment-length", 2048, "--json")
+    assert made.returncode == 0, made.stderr
+    doc = json.loads(made.stdout)
+    assert doc["averages"] == 63 and doc["reference_points"] == ["force", "force"]
+    back = modal.read_frf(out_h5)
+    assert isinstance(back, modal.EstimatedFRF) and back.averages == 63
+    direct = modal.estimate_frf(force, resp, FS, segment_length=2048)
+    np.testing.assert_allclose(back.response, direct.response, rtol=1e-9)
+    np.testing.assert_allclose(back.noise_std, direct.noise_std, rtol=1e-9)
+    fitted = run("fit", out_h5, "--json")
+    assert fitted.returncode == 0, fitted.stderr
+    found = sorted({round(row["natural_frequency_hz"], 6) for row in json.loads(fitted.stdout)["modes"]})
+    np.testing.assert_allclose(found, PLANT.natural_frequency_hz, rtol=1e-3)
+
+
+def test_csv_time_axis_must_be_uniform(tmp_path):
+    path = tmp_path / "bad.csv"
+    t = np.arange(100) / FS
+    t[50] += 0.3 / FS
+    np.savetxt(path, np.column_stack([t, np.ones(100), np.ones(100)]), delimiter=",", header="time,f,a",
+               comments="")
+    with pytest.raises(FormatError, match="'time' is not uniformly increasing"):
+        read_time(path)
+
+
+def test_unknown_channel_names_the_choices(tmp_path):
+    force, resp = _records(n=4096)
+    path = tmp_path / "hammer.uff"
+    write_uff_time(path, force, resp, binary=False)
+    out = run("frf", path, "--excitation", "7+Z", "--out", tmp_path / "x.h5")
+    assert out.returncode == 1 and "no channel '7+Z'" in out.stderr and "1=1+Z" in out.stderr
+    assert not (tmp_path / "x.h5").exists()
