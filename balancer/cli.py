@@ -1,4 +1,5 @@
-"""Command line: ``python -m balancer run SCENE.toml [--out A.h5] [--plots DIR] [--archive EARLIER.h5] [--json]``.
+"""Command line: ``python -m balancer run SCENE.toml [--out A.h5] [--plots DIR] [--archive EARLIER.h5] [--json]``
+and ``python -m balancer influence READINGS.toml ...`` (see :mod:`balancer.influence.cli`).
 
 Exit codes: 0 success, 1 bad scene or input (one line on stderr naming the
 file, the key and what was expected), 2 usage error. The summary (or JSON with
@@ -26,6 +27,9 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--plots", metavar="DIR", help="folder for the plots")
     run.add_argument("--archive", metavar="EARLIER.h5", help="earlier archive of the scene: reuse unchanged stages")
     run.add_argument("--json", action="store_true", help="print one JSON document on stdout")
+    from .influence.cli import add_parser as add_influence
+
+    add_influence(sub)
     return parser
 
 
@@ -33,6 +37,10 @@ def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit code."""
     args = build_parser().parse_args(argv)
     warnings.showwarning = lambda message, *a, **k: print(f"warning: {message}", file=sys.stderr)
+    if args.command == "influence":
+        from .influence.cli import run as run_influence
+
+        return run_influence(args)
     from .scene import run_scene
     from .scene.summary import digest
 

@@ -88,8 +88,11 @@ def write_node(parent: h5py.Group, name: str, obj: Any) -> None:
         cls = type(obj)
         group.attrs["__type__"] = "dataclass"
         group.attrs["__class__"] = f"{cls.__module__}:{cls.__qualname__}"
+        explicit = obj.archive_units() if callable(getattr(obj, "archive_units", None)) else {}
         for f in dataclasses.fields(obj):
             write_node(group, f.name, getattr(obj, f.name))
+            if f.name in explicit and isinstance(group[f.name], h5py.Dataset):
+                group[f.name].attrs["units"] = explicit[f.name]  # units the field name cannot say
         return
     if obj is None:
         parent.create_group(name).attrs["__type__"] = "none"

@@ -106,6 +106,10 @@ class IsoCheck:
     passes: np.ndarray
     verdict: str
 
+    def archive_units(self) -> dict[str, str]:
+        """Units the field names cannot say (for the archive)."""
+        return {"grade_mm_s": "mm/s", "ratio": "1", "passes": "1"}
+
 
 def iso_check(residual_unbalance_kg_m, grade_mm_s: float, rotor_mass_kg: float, speed_rpm: float,
               distances_m: tuple[float, float] | None = None) -> IsoCheck:

@@ -111,7 +111,7 @@ def vibration(amplitude, phase_lag_deg, units: str, field: str = "reading") -> n
     a = _finite_array(amplitude, f"{field}.amplitude")
     p = _finite_array(phase_lag_deg, f"{field}.phase_deg")
     if a.shape != p.shape:
-        raise ParameterError(f"{field}: {a.size} amplitudes but {p.size} phases; expected one phase per amplitude")
+        raise ParameterError(f"{field}.amplitude: {a.size} amplitudes but {p.size} phases; expected one phase per amplitude")
     if np.any(a < 0):
         raise ParameterError(f"{field}.amplitude: entry {int(np.flatnonzero(a < 0)[0])} is negative; expected >= 0")
     return a * unit.to_si * np.exp(1j * np.deg2rad(p))

@@ -83,8 +83,31 @@ def _drive(results):
     return [("speeds", fig)]
 
 
+def _balance(results):
+    from ..influence.plots import plot_balance
+
+    b = results["balance"]
+    figures = [("polar", plot_balance(b.report))]
+    if b.study is not None:
+        st = b.study
+        fig = Figure(figsize=(7, 4), layout="constrained")
+        ax = fig.add_subplot()
+        w = st.speeds_rad_s
+        ax.semilogy(w, st.amplitude_before_m * 1e6, "o-", label="before")
+        ax.semilogy(w, st.amplitude_least_squares_m * 1e6, "s--", label="least squares")
+        ax.semilogy(w, st.amplitude_minmax_m * 1e6, "^--", label="min-max")
+        ax.semilogy(w, st.amplitude_model_only_m * 1e6, "x:", label="model alpha only (no trial)")
+        if np.isfinite(st.adb_residual_amplitude_m):
+            ax.semilogy([st.adb_speed_rad_s], [st.adb_residual_amplitude_m * 1e6], "*", ms=12, label="ball balancer")
+        ax.set_xlabel("speed [rad/s]")
+        ax.set_ylabel("1x amplitude [µm]")
+        ax.legend(fontsize="small")
+        figures.append(("comparison", fig))
+    return figures
+
+
 _FIGURES = {"identify": _identify, "adb_stability": _stability, "adb_response": _response,
-            "compressor": _compressor, "mounts": _mounts, "drive": _drive}
+            "compressor": _compressor, "mounts": _mounts, "drive": _drive, "balance": _balance}
 
 
 def stage_figures(stage: str, results) -> list[tuple[str, Figure]]:

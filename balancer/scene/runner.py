@@ -28,6 +28,7 @@ _STAGE_CONFIG = {
                    "compressor.reciprocating_mass_kg", "compressor.speed_rpm", "compressor.harmonics",
                    "compressor.counterweight_k"),
     "mounts": ("compressor.body", "compressor.mounts"),
+    "balance": ("balance",),
 }
 
 
@@ -87,6 +88,13 @@ def stage_hashes(scene: Scene, stages) -> dict[str, str]:
             except OSError as exc:
                 raise SceneError(f"{scene.source}: key 'frf.file' = {scene.section('frf.file')!r}: cannot read {path} "
                                  f"({exc.strerror})") from None
+        if stage == "balance" and scene.section("balance.readings"):
+            path = scene.folder / scene.section("balance.readings")
+            try:
+                config["readings_sha256"] = hashlib.sha256(path.read_bytes()).hexdigest()
+            except OSError as exc:
+                raise SceneError(f"{scene.source}: key 'balance.readings' = {scene.section('balance.readings')!r}: "
+                                 f"cannot read {path} ({exc.strerror})") from None
         payload = {"stage": stage, "config": config, "software": modal.__version__,
                    "deps": {d: hashes[d] for d in dependencies(scene, stage)}}
         hashes[stage] = hashlib.sha256(json.dumps(payload, sort_keys=True).encode()).hexdigest()

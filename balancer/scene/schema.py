@@ -26,11 +26,12 @@ from modal.errors import SceneError
 __all__ = ["Scene", "load_scene", "parse_scene", "STAGES", "DEPENDS", "Reference", "parse_reference"]
 
 #: every stage and the sections its configuration comes from
-STAGES = ("frf", "identify", "drive", "rotor", "adb_stability", "adb_response", "compressor", "mounts")
+STAGES = ("frf", "identify", "drive", "rotor", "adb_stability", "adb_response", "compressor", "mounts", "balance")
 #: fixed dependencies (references add ``identify`` / ``drive`` where used)
 DEPENDS = {
     "frf": (), "identify": ("frf",), "drive": (), "rotor": (), "adb_stability": ("rotor",),
     "adb_response": ("rotor",), "compressor": (), "mounts": ("compressor",),
+    "balance": (),  # [balance.simulate] adds rotor (and adb_response when configured): see dependencies
 }
 IDENTIFIED_FIELDS = {
     "stiffness": "stiffness_n_per_m", "damping": "damping_n_s_per_m", "mass": "mass_kg",
@@ -198,6 +199,18 @@ SCHEMA: dict[str, Any] = {
                     "stiffness_n_per_m": lambda v: v if isinstance(v, str) and ref_or(POS, ("identified",))(v) else list_of(NONNEG, length=3)(v),
                     "damping_n_s_per_m": lambda v: v if isinstance(v, str) and ref_or(POS, ("identified",))(v) else list_of(NONNEG, length=3)(v)}],
     },
+    "balance": {
+        "readings": STR, "units": STR, "mass_units": choice("g", "kg"),
+        "radius_m": lambda v: list_of(POS)(v) if isinstance(v, list) else POS(v), "sensors": list_of(STR),
+        "initial": {"amplitude": list_of(NONNEG), "phase_deg": list_of(NUM)},
+        "trial": [{"mass": POS, "angle_deg": NUM, "amplitude": list_of(NONNEG), "phase_deg": list_of(NUM)}],
+        "after": {"amplitude": list_of(NONNEG), "phase_deg": list_of(NUM)},
+        "method": choice("least_squares", "minmax"), "weights": list_of(POS), "max_unbalance_kg_m": POS,
+        "holes": INT, "positions_deg": list_of(NUM),
+        "iso": {"grade_mm_s": POS, "rotor_mass_kg": POS, "speed_rpm": POS, "distances_m": list_of(NONNEG, length=2)},
+        "simulate": {"speeds_rad_s": list_of(POS), "trial_mass": POS, "trial_angle_deg": NUM, "noise": NONNEG, "seed": INT,
+                     "rotor_mass_kg": POS, "stiffness_n_per_m": POS, "damping_n_s_per_m": NONNEG},
+    },
     "outputs": {"tables": list_of(choice(*STAGES), min_length=0), "plots": list_of(choice(*STAGES), min_length=0),
                 "archive": lambda v: v if isinstance(v, bool) else list_of(choice(*STAGES), min_length=0)(v)},
 }
@@ -213,6 +226,9 @@ REQUIRED = {
     "compressor": ("crank_radius_m", "rod_length_m", "rotating_mass_kg", "reciprocating_mass_kg", "speed_rpm"),
     "compressor.body": ("mass_kg", "inertia_kg_m2", "crank_centre_m"),
     "compressor.mounts": ("position_m", "stiffness_n_per_m"),
+    "balance": ("units", "radius_m"),
+    "balance.iso": ("grade_mm_s", "rotor_mass_kg", "speed_rpm"),
+    "balance.simulate": ("speeds_rad_s", "trial_mass"),
 }
 
 
@@ -274,7 +290,7 @@ def parse_scene(config: dict, text: str = "", source: str = "<scene>", folder: P
     if not isinstance(config, dict):
         raise SceneError(f"{source}: a scene is a table of sections, got {type(config).__name__}")
     clean = _validate(config, SCHEMA, "", source)
-    for section in ("rotor", "adb", "drive", "compressor"):
+    for section in ("rotor", "adb", "drive", "compressor", "balance"):
         if section in clean:
             _require(clean[section], section, section, source)
     outputs = clean.get("outputs")
@@ -284,6 +300,8 @@ def parse_scene(config: dict, text: str = "", source: str = "<scene>", folder: P
         raise SceneError(f"{source}: key 'frf' has both 'file' and 'synthetic'; expected one of them")
     if "frf" in clean and "file" not in clean["frf"] and "synthetic" not in clean["frf"]:
         raise SceneError(f"{source}: key 'frf' needs 'file' or a [frf.synthetic] table")
+    if "balance" in clean and "simulate" not in clean["balance"]:
+        _check_balance(clean["balance"], source, Path(folder))
     scene = Scene(clean, text, source, Path(folder))
     # every stage an output names must have its sections, and every reference its source
     for stage in set(outputs.get("tables", [])) | set(outputs.get("plots", [])) | (
@@ -292,12 +310,24 @@ def parse_scene(config: dict, text: str = "", source: str = "<scene>", folder: P
     return scene
 
 
+def _check_balance(config: dict, source: str, folder: Path) -> None:
+    """The [balance] readings are consistent (shapes, units, files) before any work."""
+    from balancer.influence.job import parse_job
+    from modal.errors import ModalError
+
+    try:
+        parse_job(config, source, folder, key_prefix="balance.")
+    except ModalError as exc:
+        raise SceneError(str(exc)) from None
+
+
 def stage_sections(stage: str) -> tuple[str, ...]:
     """Sections a stage needs in the scene."""
     return {
         "frf": ("frf",), "identify": ("frf",), "drive": ("drive",), "rotor": ("rotor", "adb"),
         "adb_stability": ("rotor", "adb"), "adb_response": ("rotor", "adb", "adb.response"),
         "compressor": ("compressor",), "mounts": ("compressor", "compressor.body", "compressor.mounts"),
+        "balance": ("balance",),
     }[stage]
 
 
@@ -340,6 +370,10 @@ def dependencies(scene: Scene, stage: str) -> tuple[str, ...]:
                              f"but the scene has no [{needed[0]}] section")
         if source not in deps:
             deps.append(source)
+    if stage == "balance" and scene.section("balance.simulate") is not None:
+        deps.append("rotor")  # the simulated rotor is the [rotor] stage's
+        if scene.section("adb.response.speed_rad_s") is not None:
+            deps.append("adb_response")  # the ball balancer at constant speed, for comparison
     return tuple(deps)
 
 

@@ -23,7 +23,7 @@ from .schema import DRIVE_FIELDS, IDENTIFIED_FIELDS, Reference, Scene, parse_ref
 __all__ = [
     "RotorStage", "StabilityStage", "DriveStage", "CompressorStage", "MountsStage",
     "stage_frf", "stage_identify", "stage_drive", "stage_rotor", "stage_adb_stability", "stage_adb_response",
-    "stage_compressor", "stage_mounts", "resolve", "STAGE_FUNCTIONS",
+    "stage_compressor", "stage_mounts", "resolve", "STAGE_FUNCTIONS", "BalanceStage", "stage_balance",
 ]
 
 
@@ -263,10 +263,54 @@ def stage_mounts(scene: Scene, compressor: CompressorStage, identify=None) -> Mo
     return MountsStage(system, np.asarray(modes.natural_frequency_hz), comparison)
 
 
+@dataclass(frozen=True)
+class BalanceStage:
+    """Field balancing: the report of the scene's method and, for [balance.simulate], the study."""
+
+    report: object  # balancer.influence.BalanceReport
+    study: object | None  # balancer.influence.study.FieldBalancingStudy
+
+
+def stage_balance(scene: Scene, rotor: RotorStage | None = None, adb_response=None) -> BalanceStage:
+    """Correction, split, predicted residual and ISO verdict; or the simulated study on the [rotor]."""
+    from ..influence.job import balance, parse_job
+    from ..influence.study import field_balancing_study
+
+    cfg = scene.section("balance")
+    iso = cfg.get("iso", {})
+    options = {"weights": cfg.get("weights"), "max_unbalance_kg_m": cfg.get("max_unbalance_kg_m"),
+               "holes": cfg.get("holes"), "positions_deg": cfg.get("positions_deg"),
+               "grade_mm_s": iso.get("grade_mm_s"), "rotor_mass_kg": iso.get("rotor_mass_kg"),
+               "speed_rpm": iso.get("speed_rpm"), "distances_m": tuple(iso["distances_m"]) if "distances_m" in iso else None}
+    method = cfg.get("method", "least_squares")
+    sim = cfg.get("simulate")
+    if sim is None:
+        job = parse_job({k: v for k, v in cfg.items() if k not in ("simulate",)}, scene.source, scene.folder, "balance.")
+        return BalanceStage(balance(job, method, **options), None)
+    p = rotor.params
+    # the simulated rotor's truth (default: the identified [rotor] itself); alpha_model uses the identified k, c, M
+    true_M, true_k, true_c = (sim.get("rotor_mass_kg", p.M), sim.get("stiffness_n_per_m", p.k),
+                              sim.get("damping_n_s_per_m", p.c))
+    radius = cfg["radius_m"][0] if isinstance(cfg["radius_m"], list) else cfg["radius_m"]
+    study = field_balancing_study(true_M, true_k, true_c, p.e, sim["speeds_rad_s"], model_k_c_M=(p.k, p.c, p.M),
+                                  trial_mass=sim["trial_mass"],
+                                  trial_angle_deg=sim.get("trial_angle_deg", 0.0), radius_m=radius,
+                                  noise=sim.get("noise", 0.05), seed=sim.get("seed", 0), units=cfg["units"],
+                                  mass_units=cfg.get("mass_units", "g"), adb=adb_response)
+    report = study.minmax if method == "minmax" else study.least_squares
+    if any(options[k] is not None for k in ("holes", "positions_deg", "grade_mm_s")):
+        from ..influence.study import simulated_job
+
+        job = simulated_job(true_M, true_k, true_c, p.e, sim["speeds_rad_s"], sim["trial_mass"], sim.get("trial_angle_deg", 0.0),
+                            radius, sim.get("noise", 0.05), sim.get("seed", 0), cfg["units"], cfg.get("mass_units", "g"))
+        report = balance(job, method, **options)
+    return BalanceStage(report, study)
+
+
 STAGE_FUNCTIONS = {
     "frf": stage_frf, "identify": stage_identify, "drive": stage_drive, "rotor": stage_rotor,
     "adb_stability": stage_adb_stability, "adb_response": stage_adb_response, "compressor": stage_compressor,
-    "mounts": stage_mounts,
+    "mounts": stage_mounts, "balance": stage_balance,
 }
 
 

@@ -57,7 +57,40 @@ def digest(stage: str, result) -> dict:
             d.update(speed_rad_s=float(h.speed_rad_s), stiffness_n_per_m=float(h.stiffness_n_per_m),
                      speed_ratio_to_critical=float(h.speed_ratio))
         return d
+    if stage == "balance":
+        return _balance_digest(result)
     return {}
+
+
+def _balance_digest(result) -> dict:
+    r = result.report
+    amplitude, _ = r.in_user_units(r.initial)
+    left, _ = r.in_user_units(r.residual)
+    d = {"method": r.method, "reading_units": r.reading_units, "mass_units": r.mass_units,
+         "correction_mass": [float(m) * (1e3 if r.mass_units == "g" else 1.0) for m in r.correction_mass_kg],
+         "correction_angle_deg": [float(a) for a in r.correction_angle_deg],
+         "correction_kg_m": [[float(u.real), float(u.imag)] for u in r.correction_kg_m],
+         "worst_initial": float(np.max(amplitude)), "worst_residual": float(np.max(left)),
+         "condition_number": r.condition_number, "flags": list(r.flags)}
+    if r.positions_deg.size:
+        d["split"] = [{f"{p:g}": float(m) * (1e3 if r.mass_units == "g" else 1.0) for p, m in zip(r.positions_deg, row) if m > 0}
+                      for row in r.split_mass_kg]
+    if r.iso is not None:
+        d["iso"] = {"grade_mm_s": r.iso.grade_mm_s, "verdict": r.iso.verdict,
+                    "permissible_per_plane_kg_m": [float(v) for v in r.iso.permissible_per_plane_kg_m],
+                    "residual_unbalance_kg_m": [float(v) for v in r.iso.residual_unbalance_kg_m]}
+    st = result.study
+    if st is not None:
+        d["study"] = {"speeds_rad_s": [float(w) for w in st.speeds_rad_s],
+                      "alpha_model_error": [float(v) for v in st.alpha_model_error],
+                      "alpha_measured_error": [float(v) for v in st.alpha_measured_error],
+                      "amplitude_before_m": [float(v) for v in st.amplitude_before_m],
+                      "amplitude_least_squares_m": [float(v) for v in st.amplitude_least_squares_m],
+                      "amplitude_minmax_m": [float(v) for v in st.amplitude_minmax_m],
+                      "amplitude_model_only_m": [float(v) for v in st.amplitude_model_only_m],
+                      "adb_speed_rad_s": st.adb_speed_rad_s, "adb_residual_amplitude_m": st.adb_residual_amplitude_m,
+                      "adb_amplitude_without_balls_m": st.adb_amplitude_without_balls_m}
+    return d
 
 
 def _table(stage: str, result) -> list[str]:
@@ -92,6 +125,31 @@ def _table(stage: str, result) -> list[str]:
             line += (f"; hand-over: Ω = {d['speed_rad_s']:.5g} rad/s, k = {d['stiffness_n_per_m']:.5g} N/m, "
                      f"Ω/ω_crit = {d['speed_ratio_to_critical']:.3g}")
         return [line]
+    if stage == "balance":
+        unit = d["mass_units"]
+        lines = [f"  {d['method']}: " + "; ".join(f"plane {j + 1}: {m:.4g} {unit} at {a:.1f} deg"
+                                                 for j, (m, a) in enumerate(zip(d["correction_mass"], d["correction_angle_deg"]))),
+                 f"  worst reading {d['worst_initial']:.4g} -> {d['worst_residual']:.3g} {d['reading_units']} predicted; "
+                 f"condition number {d['condition_number']:.3g}{'; flags: ' + ', '.join(d['flags']) if d['flags'] else ''}"]
+        for j, row in enumerate(d.get("split", [])):
+            lines.append(f"  plane {j + 1} on holes: " + ", ".join(f"{m:.4g} {unit} at {p} deg" for p, m in row.items()))
+        if "iso" in d:
+            iso = d["iso"]
+            lines.append(f"  ISO 21940-11 G {iso['grade_mm_s']:g}: {iso['verdict']} (residual "
+                         + ", ".join(f"{r * 1e6:.4g}" for r in iso["residual_unbalance_kg_m"]) + " g mm, permissible "
+                         + ", ".join(f"{p * 1e6:.4g}" for p in iso["permissible_per_plane_kg_m"]) + " g mm)")
+        if "study" in d:
+            st = d["study"]
+            for i, w in enumerate(st["speeds_rad_s"]):
+                lines.append(f"  {w:.4g} rad/s: alpha error {100 * st['alpha_model_error'][i]:.2g} % (model), "
+                             f"{100 * st['alpha_measured_error'][i]:.2g} % (trial run); 1x amplitude "
+                             f"{st['amplitude_before_m'][i] * 1e6:.4g} µm before, {st['amplitude_least_squares_m'][i] * 1e6:.3g} "
+                             f"(least squares), {st['amplitude_minmax_m'][i] * 1e6:.3g} (min-max), "
+                             f"{st['amplitude_model_only_m'][i] * 1e6:.3g} (model alpha, no trial) µm")
+            if math.isfinite(st["adb_residual_amplitude_m"]):
+                lines.append(f"  ball balancer at {st['adb_speed_rad_s']:.4g} rad/s: {st['adb_residual_amplitude_m'] * 1e6:.3g} µm "
+                             f"(without balls {st['adb_amplitude_without_balls_m'] * 1e6:.4g} µm)")
+        return lines
     if stage == "frf":
         return [f"  {d['n_channels']} channel(s), {d['n_lines']} lines, {d['kind']}"]
     return []

@@ -1,0 +1,118 @@
+"""``python -m balancer influence READINGS.toml``: the weekly balancing job without a scene.
+
+Prints the correction per plane (mass at the file's radius and angle), its split onto
+holes, the predicted vibration per reading and, with ``--grade``, the ISO 21940-11
+verdict; ``--json`` prints the same as one JSON document.  Exit codes as ``run``.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+
+from modal.errors import ModalError
+from modal.report import jsonable
+
+__all__ = ["add_parser", "run", "report_document"]
+
+
+def add_parser(sub) -> argparse.ArgumentParser:
+    """Add the ``influence`` sub-command to an argparse sub-parser set."""
+    p = sub.add_parser("influence", help="influence-coefficient balancing from a readings file",
+                       description="Correction masses from initial and trial-run readings (influence coefficients).")
+    p.add_argument("readings", help="readings TOML file (see data/synthetic/balance_readings.toml)")
+    p.add_argument("--method", choices=("least_squares", "minmax"), default=None,
+                   help="least squares (default) or min-max (smallest worst reading)")
+    p.add_argument("--grade", type=float, metavar="G", help="ISO 21940-11 balance quality grade G (mm/s), e.g. 2.5")
+    p.add_argument("--rotor-mass", type=float, metavar="KG", help="rotor mass (kg) for the ISO check")
+    p.add_argument("--speed-rpm", type=float, metavar="RPM", help="maximum service speed (rpm) for the ISO check")
+    p.add_argument("--holes", type=int, metavar="N", help="split the correction onto N equally spaced holes (first at the mark)")
+    p.add_argument("--max-correction", type=float, metavar="KG_M", help="largest correction per plane (kg m)")
+    p.add_argument("--json", action="store_true", help="print one JSON document on stdout")
+    return p
+
+
+def report_document(report) -> dict:
+    """The report as a JSON-ready dict (user units for readings and masses; SI where named)."""
+    scale = 1e3 if report.mass_units == "g" else 1.0
+    amp0, ph0 = report.in_user_units(report.initial)
+    amp1, ph1 = report.in_user_units(report.residual)
+    doc = {
+        "method": report.method, "reading_units": report.reading_units, "mass_units": report.mass_units,
+        "correction": [{"plane": j + 1, "mass": float(report.correction_mass_kg[j] * scale),
+                        "angle_deg": float(report.correction_angle_deg[j]), "radius_m": float(report.radius_m[j]),
+                        "unbalance_kg_m": float(abs(report.correction_kg_m[j]))}
+                       for j in range(report.correction_kg_m.size)],
+        "readings": [{"sensor": s, "initial_amplitude": float(amp0[i]), "initial_phase_deg": float(ph0[i]),
+                      "predicted_amplitude": float(amp1[i]), "predicted_phase_deg": float(ph1[i])}
+                     for i, s in enumerate(report.sensors)],
+        "worst_initial": float(amp0.max()), "worst_residual": float(amp1.max()),
+        "rms_initial": float((amp0**2).mean() ** 0.5), "rms_residual": float((amp1**2).mean() ** 0.5),
+        "condition_number": report.condition_number, "flags": list(report.flags),
+    }
+    if report.positions_deg.size:
+        doc["split"] = [[{"hole_deg": float(p), "mass": float(m * scale)} for p, m in zip(report.positions_deg, row) if m > 0]
+                        for row in report.split_mass_kg]
+    if report.iso is not None:
+        iso = report.iso
+        doc["iso"] = {"grade_mm_s": iso.grade_mm_s, "verdict": iso.verdict,
+                      "permissible_unbalance_kg_m": iso.permissible_unbalance_kg_m,
+                      "permissible_per_plane_kg_m": [float(v) for v in iso.permissible_per_plane_kg_m],
+                      "residual_unbalance_kg_m": [float(v) for v in iso.residual_unbalance_kg_m],
+                      "passes": [bool(v) for v in iso.passes]}
+    return doc
+
+
+def _text(doc: dict) -> str:
+    unit, mu = doc["reading_units"], doc["mass_units"]
+    lines = [f"method: {doc['method']}", "", "correction (add):"]
+    for c in doc["correction"]:
+        lines.append(f"  plane {c['plane']}: {c['mass']:.4g} {mu} at {c['angle_deg']:.1f} deg (radius {c['radius_m']:g} m)")
+    for j, row in enumerate(doc.get("split", [])):
+        lines.append(f"  plane {j + 1} on holes: " + ", ".join(f"{h['mass']:.4g} {mu} at {h['hole_deg']:g} deg" for h in row))
+    lines += ["", f"{'reading':<28} {'initial':>18} {'predicted after':>20}"]
+    for r in doc["readings"]:
+        lines.append(f"{r['sensor']:<28} {r['initial_amplitude']:>9.4g} {unit} {r['initial_phase_deg']:>5.0f}° "
+                     f"{r['predicted_amplitude']:>10.3g} {unit} {r['predicted_phase_deg']:>5.0f}°")
+    lines += ["", f"worst {doc['worst_initial']:.4g} -> {doc['worst_residual']:.3g} {unit}; "
+              f"RMS {doc['rms_initial']:.4g} -> {doc['rms_residual']:.3g} {unit}; condition number {doc['condition_number']:.3g}"
+              + (f"; flags: {', '.join(doc['flags'])}" if doc["flags"] else "")]
+    if "iso" in doc:
+        iso = doc["iso"]
+        lines.append(f"ISO 21940-11 G {iso['grade_mm_s']:g}: {iso['verdict']} (residual "
+                     + ", ".join(f"{v * 1e6:.4g}" for v in iso["residual_unbalance_kg_m"]) + " g mm; permissible "
+                     + ", ".join(f"{v * 1e6:.4g}" for v in iso["permissible_per_plane_kg_m"]) + " g mm)")
+    return "\n".join(lines)
+
+
+def run(args) -> int:
+    """Run the sub-command; returns the exit code."""
+    import tomllib
+    from pathlib import Path
+
+    from .job import balance, load_job
+
+    try:
+        job = load_job(args.readings)
+        options = tomllib.loads(Path(args.readings).read_text(encoding="utf-8"))
+        iso = options.get("iso", {})
+        grade = args.grade if args.grade is not None else iso.get("grade_mm_s")
+        mass = args.rotor_mass if args.rotor_mass is not None else iso.get("rotor_mass_kg")
+        speed = args.speed_rpm if args.speed_rpm is not None else iso.get("speed_rpm")
+        report = balance(job, args.method or options.get("method", "least_squares"),
+                         weights=options.get("weights"),
+                         max_unbalance_kg_m=args.max_correction if args.max_correction is not None else options.get("max_unbalance_kg_m"),
+                         holes=args.holes if args.holes is not None else options.get("holes"),
+                         positions_deg=None if args.holes is not None else options.get("positions_deg"),
+                         grade_mm_s=grade, rotor_mass_kg=mass, speed_rpm=speed,
+                         distances_m=tuple(iso["distances_m"]) if "distances_m" in iso else None)
+    except ModalError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 1
+    doc = report_document(report)
+    if args.json:
+        json.dump(jsonable(doc), sys.stdout, indent=1, allow_nan=False)
+        sys.stdout.write("\n")
+    else:
+        print(_text(doc))
+    return 0

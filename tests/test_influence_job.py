@@ -1,0 +1,160 @@
+"""Balancing jobs as users write them: readings files, the `influence` command, the scene's [balance]."""
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+from balancer.influence.job import balance, load_job, parse_job
+from modal.errors import FormatError, ParameterError, SceneError
+
+ROOT = Path(__file__).resolve().parents[1]
+READINGS = ROOT / "data" / "synthetic" / "balance_readings.toml"
+STUDY_SCENE = ROOT / "data" / "synthetic" / "balance_scene.toml"
+
+
+def test_bundled_readings_give_the_rotor_unbalance_back():
+    """The file was made from a rotor with 3.6 g m at 60 deg and 2.4 g m at 250 deg (radius 0.15 m),
+    readings rounded to 0.1 um and 1 deg: the correction is 24 g at 240 deg and 16 g at 70 deg
+    to the rounding (0.5 deg of phase ~ 1 % on these vectors)."""
+    report = balance(load_job(READINGS), "least_squares", holes=12)
+    np.testing.assert_allclose(report.correction_mass_kg * 1e3, [24.0, 16.0], rtol=0.02)
+    np.testing.assert_allclose(report.correction_angle_deg, [240.0, 70.0], atol=1.0)
+    assert report.worst_residual < 0.02 * report.worst_initial
+    rebuilt = report.split_mass_kg @ np.exp(1j * np.deg2rad(report.positions_deg)) * report.radius_m
+    np.testing.assert_allclose(rebuilt, report.correction_kg_m, rtol=1e-12)
+
+
+def test_csv_readings_equal_inline_readings(tmp_path):
+    job = load_job(READINGS)
+    rows = ["run,amplitude,phase_deg"]
+    for name, values in [("initial", job.initial), ("trial1", job.trial_runs[0]), ("trial2", job.trial_runs[1])]:
+        amplitude = np.abs(values) * 1e6
+        phase = np.rad2deg(np.angle(values))
+        rows += [f"{name},{float(a)!r},{float(p)!r}" for a, p in zip(amplitude, phase)]
+    (tmp_path / "runs.csv").write_text("\n".join(rows) + "\n")
+    config = {"units": "um", "mass_units": "g", "radius_m": 0.15, "readings": "runs.csv",
+              "trial": [{"mass": 20.0, "angle_deg": 0.0}, {"mass": 20.0, "angle_deg": 0.0}]}
+    from_csv = parse_job(config, "job.toml", tmp_path)
+    np.testing.assert_allclose(from_csv.initial, job.initial, rtol=1e-13)
+    np.testing.assert_allclose(from_csv.trial_runs, job.trial_runs, rtol=1e-13)
+
+
+@pytest.mark.parametrize("edit, key", [
+    (lambda c: c.pop("units"), "units"),
+    (lambda c: c["trial"][0].pop("mass"), "trial[0].mass"),
+    (lambda c: c.pop("trial"), "trial"),
+    (lambda c: c["trial"][1].__setitem__("amplitude", [1.0, 2.0]), "trial[1].amplitude"),
+    (lambda c: c["initial"].__setitem__("phase_deg", [1.0, 2.0, float("nan"), 4.0]), "initial.phase_deg"),
+    (lambda c: c.__setitem__("radius_m", [0.1, 0.2, 0.3]), "radius_m"),
+    (lambda c: c.__setitem__("colour", "red"), "colour"),
+    (lambda c: c["trial"][0].__setitem__("amplitude", list(c["initial"]["amplitude"])) or
+     c["trial"][0].__setitem__("phase_deg", list(c["initial"]["phase_deg"])), "trial_runs[0]"),
+])
+def test_bad_readings_files_name_the_key(edit, key):
+    import tomllib
+
+    config = tomllib.loads(READINGS.read_text())
+    edit(config)
+    with pytest.raises(ParameterError) as info:
+        balance(parse_job(config, "job.toml"))
+    message = str(info.value)
+    assert "\n" not in message and key in message, message
+
+
+def test_unreadable_readings_file(tmp_path):
+    with pytest.raises(FormatError, match="no such readings file"):
+        load_job(tmp_path / "missing.toml")
+    (tmp_path / "bad.toml").write_text("units = ")
+    with pytest.raises(FormatError, match="bad.toml: not valid TOML"):
+        load_job(tmp_path / "bad.toml")
+
+
+def run_cli(*args, cwd=ROOT):
+    env = dict(os.environ, PYTHONPATH=str(ROOT), MPLBACKEND="Agg")
+    return subprocess.run([sys.executable, "-m", "balancer", *args], capture_output=True, text=True, cwd=cwd, env=env,
+                          timeout=120)
+
+
+def test_influence_command_line(tmp_path):
+    out = run_cli("influence", str(READINGS), "--method", "minmax", "--grade", "2.5", "--rotor-mass", "100",
+                  "--speed-rpm", "3000", "--holes", "8", "--json")
+    assert out.returncode == 0, out.stderr
+    doc = json.loads(out.stdout)
+    assert doc["method"] == "minmax" and doc["mass_units"] == "g" and len(doc["correction"]) == 2
+    assert doc["iso"]["verdict"] in ("pass", "fail") and len(doc["iso"]["permissible_per_plane_kg_m"]) == 2
+    assert doc["iso"]["permissible_unbalance_kg_m"] == pytest.approx(2.5e-3 * 100 / (3000 * np.pi / 30), rel=1e-12)
+    assert all(len(row) <= 2 for row in doc["split"])
+    ls = json.loads(run_cli("influence", str(READINGS), "--json").stdout)
+    assert doc["worst_residual"] <= ls["worst_residual"] * (1 + 1e-9)
+    text = run_cli("influence", str(READINGS))
+    assert text.returncode == 0 and "plane 1:" in text.stdout and "condition number" in text.stdout
+    (tmp_path / "bad.toml").write_text(READINGS.read_text().replace("units = \"um\"", "units = \"furlong\""))
+    bad = run_cli("influence", str(tmp_path / "bad.toml"))
+    assert bad.returncode == 1 and bad.stderr.count("\n") == 1 and "units" in bad.stderr and "bad.toml" in bad.stderr
+    assert run_cli("influence").returncode == 2
+
+
+def inline_scene(tmp_path, **extra):
+    import tomllib
+
+    job = tomllib.loads(READINGS.read_text())
+    section = {**job, "method": "minmax", "holes": 12,
+               "iso": {"grade_mm_s": 2.5, "rotor_mass_kg": 100.0, "speed_rpm": 3000.0, "distances_m": [0.4, 0.6]}, **extra}
+    return {"scene": {"name": "inline"}, "balance": section,
+            "outputs": {"tables": ["balance"], "plots": ["balance"], "archive": True}}
+
+
+def test_scene_balance_section_inline(tmp_path):
+    import balancer
+
+    run = balancer.run_scene(inline_scene(tmp_path), out=tmp_path / "b.h5", plots_dir=tmp_path / "plots")
+    assert run.stages["balance"] == "ran"
+    report = run.results["balance"].report
+    assert report.method == "minmax" and report.iso is not None
+    assert "[balance]" in run.summary and "ISO 21940-11 G 2.5" in run.summary
+    assert (tmp_path / "plots" / "balance_polar.png").stat().st_size > 10_000
+    back = balancer.read_archive(tmp_path / "b.h5")["balance"].report
+    np.testing.assert_array_equal(back.correction_kg_m, report.correction_kg_m)
+    with h5py.File(tmp_path / "b.h5") as f:
+        missing = []
+        f["balance"].visititems(lambda name, node: missing.append(name) if isinstance(node, h5py.Dataset)
+                                and node.dtype.kind not in "OSU" and "units" not in node.attrs else None)
+        assert missing == []  # every numeric dataset carries units
+        assert f["balance/report/residual"].attrs["units"] == "m"
+        assert f["balance/report/alpha"].attrs["units"] == "m/(kg m)"
+    again = balancer.run_scene(inline_scene(tmp_path), out=tmp_path / "b2.h5", archive=tmp_path / "b.h5")
+    assert again.stages["balance"] == "reused"
+
+
+def test_scene_balance_errors_before_any_work(tmp_path):
+    import balancer
+
+    scene = inline_scene(tmp_path)
+    scene["balance"]["trial"][1]["amplitude"] = [1.0, 2.0]
+    with pytest.raises(SceneError, match=r"balance\.trial\[1\]\.amplitude"):
+        balancer.run_scene(scene)
+    scene = inline_scene(tmp_path, method="median")
+    with pytest.raises(SceneError, match="balance.method"):
+        balancer.run_scene(scene)
+
+
+def test_bundled_study_scene(tmp_path):
+    """Identified k, c, M predict alpha within the identification error; both methods cut the vibration
+    by an order of magnitude at 5 % reading noise; the ideal ball balancer does better still."""
+    import balancer
+
+    run = balancer.run_scene(STUDY_SCENE, out=tmp_path / "s.h5", plots_dir=tmp_path / "p")
+    study = run.results["balance"].study
+    assert np.all(study.alpha_model_error < 0.02)  # k, c, M identified to < 1 % (their standard errors)
+    for left in (study.amplitude_least_squares_m, study.amplitude_minmax_m, study.amplitude_model_only_m):
+        assert np.all(left < 0.2 * study.amplitude_before_m)
+    assert study.minmax.worst_residual <= study.least_squares.worst_residual
+    assert study.adb_speed_rad_s == 250.0 and study.adb_residual_amplitude_m < study.amplitude_minmax_m[-1]
+    assert {p.name for p in (tmp_path / "p").iterdir()} == {"balance_polar.png", "balance_comparison.png"}
