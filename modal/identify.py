@@ -19,7 +19,9 @@ from .units import TWO_PI
 
 __all__ = ["identify", "METHODS"]
 
-METHODS = ("nls", "circle", "halfpower")
+#: the band-wise methods (one band per mode) and all methods
+BANDWISE_METHODS = ("nls", "circle", "halfpower")
+METHODS = BANDWISE_METHODS + ("global",)
 #: chi-square above which the model is flagged as not explaining the data
 CHI2_LIMIT = 3.0
 #: relative standard error of ζ above which an estimate is flagged
@@ -450,16 +452,21 @@ def _physical(frf, wn, zeta, const, cov, driving, flags):
 
 
 def identify(frf: FRF, method: str = "nls", bands_hz=None, *, noise_std=None, driving_point=None,
-             min_prominence_db: float = 6.0, max_modes: int | None = None) -> IdentificationResult:
+             min_prominence_db: float = 6.0, max_modes: int | None = None, **global_options) -> IdentificationResult:
     """Identify every mode of an FRF.
 
     Parameters
     ----------
     frf : FRF
         One or many channels (poles are shared by all channels).
-    method : {"nls", "circle", "halfpower"}
+    method : {"nls", "circle", "halfpower", "global"}
         ``"nls"`` (default): complex nonlinear least squares of all modes
         together, started from the better of half-power and circle fit.
+        ``"global"``: poly-reference LSCF (PolyMAX) poles with a stabilisation
+        diagram, then a joint refinement of all poles, modal constants and
+        residual terms over the whole band (:func:`modal.global_.identify_global`;
+        its options ``modes_hz``, ``order``, ``max_order`` pass through
+        ``**global_options``; ``bands_hz`` gives the band by its extremes).
         ``"circle"``: Kennedy–Pancu circle fit on the mobility.
         ``"halfpower"``: half-power bandwidth with exact inversion.
     bands_hz : list of (f_low, f_high), optional
@@ -493,8 +500,15 @@ def identify(frf: FRF, method: str = "nls", bands_hz=None, *, noise_std=None, dr
     """
     if not isinstance(frf, FRF):
         raise TypeError(f"identify() expects a modal.FRF, got {type(frf).__name__}")
+    if global_options and method != "global":
+        raise TypeError(f"identify() got options {', '.join(sorted(global_options))} that only method='global' takes")
     if method not in METHODS:
         raise IdentificationError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
+    if method == "global":
+        from .global_ import identify_global
+
+        band = None if bands_hz is None else (min(b[0] for b in bands_hz), max(b[1] for b in bands_hz))
+        return identify_global(frf, band_hz=band, noise_std=noise_std, driving_point=driving_point, **global_options)
     power = KIND_POWER[frf.kind]
     n_ch = frf.n_channels
     estimated_noise = estimate_noise_std(frf)

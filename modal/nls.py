@@ -118,7 +118,7 @@ def _project(Phi, Y):
 
 def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, damping_ratio0,
               region: np.ndarray | None = None, max_iter: int = 200, step_tol: float = 1e-13,
-              background_powers: tuple[int, ...] = (0,)) -> NLSFit:
+              background_powers: tuple[int, ...] = (0,), residual_terms: bool = False) -> NLSFit:
     """Fit poles and modal constants of several modes to many channels at once.
 
     Parameters
@@ -143,6 +143,11 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
         the line's position in the region (scaled to [−1, 1]); ``(0,)`` is the
         complex offset.
         :func:`truncation_shift` adds a slope and a curvature.
+    residual_terms : bool
+        Add the upper and lower residual terms of modes outside the lines,
+        (iω)^p (stiffness line) and (iω)^p/(−ω²) (mass line) in the FRF's kind, with
+        complex coefficients (after the region columns in ``offsets``; use
+        ``region=None`` with them). The lines must then exclude ω = 0.
     """
     omega = np.asarray(omega, float)
     Y_raw = np.atleast_2d(np.asarray(response, complex))
@@ -167,6 +172,9 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
     params[1::2] = np.clip(params[1::2], zeta_lo, ZETA_MAX)
     Y_full = Y
     background = _background(x, region, n_regions, background_powers)
+    if residual_terms:
+        kind = (1j * x) ** power
+        background = np.hstack([background, kind[:, None], (kind / -(x**2))[:, None]])
     n_b_guess = n_modes + background.shape[1]
     Y = _compress(Y, 2 * n_b_guess + 8)
 

@@ -7,7 +7,7 @@ float; the modal constant, k, c and m are arrays over channels.
 from __future__ import annotations
 
 from dataclasses import dataclass, field, fields
-from typing import Iterator
+from typing import Any, Iterator
 
 import numpy as np
 
@@ -37,6 +37,15 @@ FLAG_TEXT = {
                      "or lower min_prominence_db"),
     "window_damping_dominates": ("the exponential window's decay 1/tau is not below the mode's measured decay rate: "
                                  "all its damping may be the window's, so it was not removed; use a longer tau"),
+    "weak_evidence": ("global: the pole is stable in fewer than half of the model orders of the stabilisation "
+                      "diagram (or a modes_hz hint picked a pole stable in fewer than 3): a weakly excited mode or a "
+                      "noise pole; check the diagram and the shape before using it"),
+    "outside_band": ("global: the mode lies below the first resolvable lines or above the band: its parameters "
+                     "are extrapolated; widen the band or treat it as a residual"),
+    "rigid_body": ("global: the mode lies below a tenth of the next mode's frequency: a rigid-body or suspension "
+                   "mode of a free structure, not a flexible mode"),
+    "complex_shape": ("global: the modal constants are far from collinear in phase (MPC < 0.8): a complex mode, "
+                      "or noise/close modes; k, c, m and shape comparisons are approximate"),
     "method_bias": ("half-power or circle estimate lies more than 3 of its standard errors from the least-squares "
                     "refinement of the same modes (the method's own bias: line spacing, noise at the peak, "
                     "a neighbouring mode); its standard errors include the difference, method 'nls' gives the refined values"),
@@ -102,6 +111,17 @@ class ModeResult:
     window_damping_ratio : float
         Damping ratio an exponential window had added to the measured FRF and
         that was removed from ``damping_ratio`` (0 without such a window).
+    mode_shape : ndarray of complex or None
+        Method ``"global"``: the modal constants normalised per reference (each
+        channel divided by the largest-magnitude constant among the channels of
+        its reference), in the order of the FRF's channels.
+    participation : ndarray of complex or None
+        Method ``"global"``: the modal participation vector (one entry per
+        reference, unit norm) from the pLSCF denominator.
+    mpc : float
+        Modal phase collinearity (Pappa) of the modal constants, per reference
+        and averaged: 1 for a real (normal) mode, lower for a complex one. NaN
+        where not computed.
     """
 
     natural_frequency_hz: float
@@ -120,6 +140,9 @@ class ModeResult:
     driving_point: np.ndarray | bool = True
     quality: float = float("nan")
     window_damping_ratio: float = 0.0
+    mode_shape: np.ndarray | None = None
+    participation: np.ndarray | None = None
+    mpc: float = float("nan")
 
     @property
     def omega_n_rad_s(self) -> float:
@@ -145,6 +168,50 @@ class IdentificationResult:
     kind: str
     n_channels: int
     noise_std: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    residuals: np.ndarray | None = None
+    stabilisation: Any = None
+    settings: dict = field(default_factory=dict)
+
+    def synthesize(self, frequency_hz) -> "FRF":
+        """The identified model (modes, plus residual terms where fitted) as an FRF on any axis.
+
+        Parameters
+        ----------
+        frequency_hz : array_like
+            Lines, Hz (> 0 where the model has a lower residual term).
+
+        Returns
+        -------
+        FRF
+            Of this result's kind, one channel per channel of the fitted FRF.
+        """
+        from .frf import FRF, KIND_POWER
+        from .model import mode_basis
+
+        freq = np.asarray(frequency_hz, float)
+        omega = freq * TWO_PI
+        power = KIND_POWER[self.kind]
+        total = np.zeros((self.n_channels, freq.size), complex)
+        for mode in self.modes:
+            phi = mode_basis(omega, mode.omega_n_rad_s, mode.damping_ratio, power)[0]
+            const = np.nan_to_num(np.atleast_1d(np.asarray(mode.modal_constant, complex)))
+            total += const[:, None] * phi[None, :]
+        if self.residuals is not None:
+            upper, lower = np.asarray(self.residuals, complex).T
+            with np.errstate(divide="ignore", invalid="ignore"):
+                kind = (1j * omega) ** power
+                total += upper[:, None] * kind[None, :] - lower[:, None] * (kind / omega**2)[None, :]
+        return FRF(freq, total[0] if self.n_channels == 1 else total, kind=self.kind,
+                   source=f"synthesised ({self.method})")
+
+    def mac(self) -> np.ndarray:
+        """MAC matrix of the modes' modal constants over the channels, shape (n_modes, n_modes)."""
+        shapes = np.array([np.atleast_1d(np.asarray(m.modal_constant, complex)) for m in self.modes])
+        shapes = np.nan_to_num(shapes)
+        num = np.abs(shapes.conj() @ shapes.T) ** 2
+        norms = np.sum(np.abs(shapes) ** 2, axis=1)
+        den = np.outer(norms, norms)
+        return num / np.where(den > 0, den, np.inf)
 
     def __iter__(self) -> Iterator[ModeResult]:
         return iter(self.modes)

@@ -7,7 +7,7 @@ import pytest
 import modal
 from modal import QualityWarning, ResolutionWarning, identify
 from modal.checks import find_missing_mode
-from modal.identify import METHODS
+from modal.identify import BANDWISE_METHODS
 from modal.model import cramer_rao_sdof
 from modal.nls import fit_modes
 from modal.peaks import estimate_noise_std
@@ -316,7 +316,7 @@ def test_hidden_neighbour_is_flagged_missing_mode():
     assert [round(m.natural_frequency_hz) for m in both] == [115, 154]
 
 
-@pytest.mark.parametrize("method", METHODS)
+@pytest.mark.parametrize("method", BANDWISE_METHODS)
 def test_missing_mode_check_is_quiet_without_a_hidden_mode(method):
     # one mode, 1 % noise (false alarm < 1e-6 per test); and a strong mode just outside the
     # band, whose slope the band offset cannot absorb (structure that is not a mode here)
@@ -337,7 +337,7 @@ def test_missing_mode_check_is_quiet_without_a_hidden_mode(method):
         assert "missing_mode" not in mode.flags
 
 
-@pytest.mark.parametrize("method", METHODS)
+@pytest.mark.parametrize("method", BANDWISE_METHODS)
 def test_band_edges_do_not_depend_on_the_frequency_unit(method):
     # docs/stress.md finding 13: a band edge exactly on a line (halfway between two peaks on
     # the 0.002 Hz grid) let rounding of the kHz axis drop the line at 1.000 Hz, and NLS ζ
@@ -431,7 +431,7 @@ def test_two_modes_merged_into_one_peak_are_flagged_missing_mode():
     assert len(result) == 1 and "missing_mode" in result[0].flags
 
 
-@pytest.mark.parametrize("method", METHODS)
+@pytest.mark.parametrize("method", BANDWISE_METHODS)
 def test_linear_solves_do_not_depend_on_the_units(method):
     # receptance at 1e7 Hz (f × 1e3): mode columns ~1e-16 beside the offset column of ones
     # fell below lstsq's rank cut-off, half-power masses came out 1e29 off and missing_mode

@@ -1,0 +1,178 @@
+"""Global identification (identify(frf, method="global")): pLSCF, stabilisation, joint refinement."""
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+import modal
+from conftest import REAL
+from modal.global_ import channel_grid, mpc, plscf_poles
+
+#: the real beam's modes by an independent LSCF + LSFD fit (sdypy-EMA, data/real/README.md)
+BEAM_HZ = np.array([51.5, 142.2, 278.7, 460.4, 687.2])
+
+
+def _fit(frf, **kwargs):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", modal.ModalWarning)  # flags are checked explicitly
+        return modal.identify(frf, "global", **kwargs)
+
+
+def structure():
+    """14 modes in 20-600 Hz (a close pair at 200/202 Hz within their 4 Hz half-power bandwidths, with
+    orthogonal participation; a mode at 340 Hz driven at a fifth of the others), two modes above the band,
+    12 response points x 2 references (24 channels), real normal modes of unit modal mass."""
+    rng = np.random.default_rng(100)
+    fn = np.array([32., 55., 81., 110., 146., 200., 202., 251., 297., 340., 395., 452., 505., 560., 700., 850.])
+    zeta = np.array([0.02, 0.015, 0.012, 0.01, 0.01, 0.01, 0.01, 0.008, 0.008, 0.008, 0.006, 0.006, 0.005, 0.005,
+                     0.005, 0.005])
+    n_out, refs = 12, [0, 5]
+    phi = rng.normal(size=(n_out, fn.size))
+    phi[refs, :] = rng.choice([-1, 1], size=(2, fn.size)) * rng.uniform(0.6, 1.2, size=(2, fn.size))
+    phi[:, 6] = phi[:, 5][::-1] * np.sign(rng.normal(size=n_out))
+    phi[refs, 5], phi[refs, 6] = [1.0, 1.0], [1.0, -1.0]
+    phi[refs, 9] *= 0.2
+    const = np.array([[phi[o, r] * phi[q, r] for r in range(fn.size)] for o in range(n_out) for q in refs])
+    resp = [str(o) for o in range(n_out) for q in refs]
+    ref = [str(q) for o in range(n_out) for q in refs]
+    return fn, zeta, const, resp, ref
+
+
+@pytest.fixture(scope="module")
+def multi_reference():
+    fn, zeta, const, resp, ref = structure()
+    f = np.arange(20, 600.001, 0.25)
+    clean = modal.modal_frf(f, fn, zeta, const, kind="accelerance", response_points=resp, reference_points=ref)
+    noisy = modal.add_noise(clean, 0.002, seed=1)  # 0.2 % of each channel's peak
+    return fn, zeta, const, clean, noisy, _fit(noisy)
+
+
+def test_channel_grid_finds_outputs_and_references(multi_reference):
+    *_, noisy, _ = multi_reference
+    index, refs, transposed = channel_grid(noisy)
+    assert index.shape == (12, 2) and refs == ["0", "5"] and not transposed
+    assert sorted(index.ravel()) == list(range(24))
+
+
+def test_every_mode_in_band_found_with_calibrated_errors(multi_reference):
+    fn, zeta, const, clean, noisy, result = multi_reference
+    found = np.array([m.natural_frequency_hz for m in result])
+    in_band = np.flatnonzero(fn < 600)
+    matched = []
+    for k in in_band:
+        j = int(np.argmin(np.abs(found - fn[k])))
+        assert abs(found[j] / fn[k] - 1) < 3e-3, (fn[k], found)  # the issue's 0.3 %
+        matched.append(j)
+    assert len(set(matched)) == in_band.size  # the close pair at 200/202 Hz is two modes
+    modes = [result[j] for j in matched]
+    z_f = np.array([(m.natural_frequency_hz - fn[k]) / m.std.natural_frequency_hz for m, k in zip(modes, in_band)])
+    z_z = np.array([(m.damping_ratio - zeta[k]) / m.std.damping_ratio for m, k in zip(modes, in_band)])
+    # "inside 4 standard errors for nearly all modes": the two modes above the band are modelled by the
+    # residual terms only, which may bias the top mode beyond its white-noise error
+    assert np.sum(np.abs(z_f) < 4) >= in_band.size - 1 and np.sum(np.abs(z_z) < 4) >= in_band.size - 1
+    for m, k in zip(modes, in_band):
+        a = np.asarray(m.modal_constant)
+        mac = abs(np.vdot(a, const[:, k])) ** 2 / (np.vdot(a, a).real * np.vdot(const[:, k], const[:, k]).real)
+        assert mac >= 0.98, (fn[k], mac)
+        assert m.mpc > 0.9  # real normal modes
+    for j, m in enumerate(result):
+        if j not in matched:  # a pole that matches no mode of the structure must not pass as one
+            assert not m.ok, (m.natural_frequency_hz, m.flags)
+    assert "close_modes" in result[matched[5]].flags and "close_modes" in result[matched[6]].flags
+
+
+def test_synthesis_reproduces_the_noise_free_frf(multi_reference):
+    *_, clean, noisy, result = multi_reference
+    synth = result.synthesize(clean.frequency_hz)
+    assert synth.kind == "accelerance" and synth.channels.shape == clean.channels.shape
+    error = np.abs(synth.channels - clean.channels) / np.abs(clean.channels)
+    assert np.median(error) < 0.01  # the issue's 1 %
+    # the synthesis is the model identify fitted: its residual on the noisy data is the noise (0.2 % of peak)
+    residual = noisy.channels - synth.channels
+    noise = 0.002 * np.abs(clean.channels).max(axis=1)
+    assert np.mean(np.abs(residual) ** 2 / noise[:, None] ** 2) == pytest.approx(1.0, abs=0.1)
+
+
+def test_mac_matrix_is_diagonal_for_distinct_shapes(multi_reference):
+    *_, result = multi_reference
+    mac = result.mac()
+    assert mac.shape == (len(result), len(result))
+    np.testing.assert_allclose(np.diag(mac), 1.0, rtol=1e-12)
+    assert np.all(mac <= 1 + 1e-12)
+
+
+def test_stabilisation_diagram_and_settings_are_kept(multi_reference):
+    *_, result = multi_reference
+    diagram = result.stabilisation
+    assert diagram.order.size == diagram.frequency_hz.size == diagram.stable.size > 0
+    lo, hi = result.settings["orders"]
+    assert set(np.unique(diagram.order)) <= set(range(lo, hi + 1))
+    assert result.settings["references"] == ["0", "5"]
+
+
+def test_plscf_converges_on_noise_free_data():
+    # the z-domain basis only approximates a continuous-time FRF: on noise-free data the poles converge
+    # geometrically with the order (relative frequency error 4e-4 at order 4, 1e-6 at 8, 1e-9 at 12, 4e-11 at 20)
+    fn, zeta = np.array([50.0, 80.0]), np.array([0.02, 0.01])
+    f = np.linspace(10, 150, 701)
+    frf = modal.modal_frf(f, fn, zeta, np.array([[1.0, 0.5], [0.4, -0.8], [0.7, 0.2]]))
+    low, high = plscf_poles(frf.omega_rad_s, frf.channels[:, None, :], [4, 20])
+    for pack, tol_f, tol_z in ((low, 2e-3, 0.05), (high, 1e-9, 1e-7)):
+        got = pack.omega_n / (2 * np.pi)
+        nearest = [int(np.argmin(np.abs(got - x))) for x in fn]
+        np.testing.assert_allclose(got[nearest], fn, rtol=tol_f)
+        np.testing.assert_allclose(pack.damping_ratio[nearest], zeta, rtol=tol_z)
+
+
+def test_mpc_of_real_and_complex_vectors():
+    assert mpc(np.array([1.0, -2.0, 0.5]) * np.exp(0.7j)) == pytest.approx(1.0, abs=1e-12)
+    assert mpc(np.array([1.0, 1j])) == pytest.approx(0.0, abs=1e-12)
+
+
+def test_errors_are_calibrated_over_noise_seeds():
+    """2σ intervals hold the truth about 95 % of the time (the issue), over 120 noise seeds × 3 modes."""
+    fn, zeta = np.array([40.0, 65.0, 90.0]), np.array([0.02, 0.015, 0.01])
+    const = np.array([[1.0, 0.6, 0.5], [0.6, -0.9, 0.4], [0.5, 0.4, -0.8], [0.3, 0.8, 0.7]])
+    f = np.arange(20, 120.001, 0.2)
+    clean = modal.modal_frf(f, fn, zeta, const, kind="accelerance")
+    z = []
+    for seed in range(120):
+        result = _fit(modal.add_noise(clean, 0.01, seed=seed), max_order=12)
+        found = np.array([m.natural_frequency_hz for m in result])
+        for k in range(3):
+            m = result[int(np.argmin(np.abs(found - fn[k])))]
+            z.append([(m.natural_frequency_hz - fn[k]) / m.std.natural_frequency_hz,
+                      (m.damping_ratio - zeta[k]) / m.std.damping_ratio])
+    z = np.array(z)
+    # 360 z-scores per quantity: the standard deviation of a standard normal sample of 360 is 1 ± 0.037;
+    # ±15 % (the issue's bound for calibration) is four of those
+    assert np.all(np.abs(z.std(axis=0) - 1) < 0.15), z.std(axis=0)
+    coverage = np.mean(np.abs(z) < 2, axis=0)
+    # 95.4 % expected, binomial SE 1.1 %: 4 of them either side
+    assert np.all(np.abs(coverage - 0.954) < 0.045), coverage
+
+
+def test_real_beam_modes_and_synthesis():
+    paths = sorted(REAL.glob("pyuff_meas_point_*.txt"))
+    channels = [modal.read_frf(p, frequency_step=1.0, kind="accelerance") for p in paths]
+    frf = modal.FRF(channels[0].frequency_hz, np.array([c.response for c in channels]), kind="accelerance",
+                    response_points=["1"] * 3, reference_points=["1", "2", "3"])
+    result = _fit(frf)
+    assert result.settings["transposed_by_reciprocity"]  # one response, three hammer points
+    found = np.array([m.natural_frequency_hz for m in result])
+    for f_ref in BEAM_HZ:
+        nearest = found[np.argmin(np.abs(found - f_ref))]
+        # the reference values are printed to 0.1 Hz: 0.05 % (the issue) is 0.03-0.3 Hz here
+        assert abs(nearest / f_ref - 1) < 5e-4, (f_ref, found)
+    below = [m for m in result if m.natural_frequency_hz < BEAM_HZ[0] * 0.95]
+    assert all(not m.ok for m in below)  # nothing unflagged below the first flexible mode
+    for m in result:
+        if np.min(np.abs(m.natural_frequency_hz / BEAM_HZ - 1)) < 5e-4:
+            # the five modes are explained within the data's own scatter: no model_inadequate fatigue
+            assert "model_inadequate" not in m.flags, (m.natural_frequency_hz, m.flags)
+    f = frf.frequency_hz
+    band = (f >= 20) & (f <= 990)
+    error = np.abs(result.synthesize(f[band]).channels - frf.channels[:, band]) / np.abs(frf.channels[:, band])
+    assert np.median(error) < 0.06 and np.percentile(error, 90) < 0.35  # the issue's 6 % and 35 %
