@@ -14,7 +14,7 @@ import warnings
 from pathlib import Path
 
 
-from .cli_time import add_time_options, frf_from_time, wants_time
+from .cli_time import add_time_options, frf_from_time, save_time_plots, wants_time
 from .errors import ModalError
 from .frf import FRF_KINDS
 from .report import jsonable
@@ -56,6 +56,8 @@ def build_parser() -> argparse.ArgumentParser:
                      help="output: .h5 keeps coherence, noise and settings; .uff/.csv/.mat the FRF only")
     frf.add_argument("--kind", choices=FRF_KINDS, help="FRF kind (default: from what the responses measured)")
     frf.add_argument("--json", action="store_true", help="print one JSON document on stdout")
+    frf.add_argument("--plot", metavar="OUT.png", help="write the FRFs with coherence and error band "
+                     "(and OUT_hits.png with the hits for --impact)")
     add_time_options(frf)
     return parser
 
@@ -70,8 +72,10 @@ def _fit(args) -> int:
 
     names = ("kind", "frequency_axis", "frequency_step", "frequency_start", "layout", "delimiter", "decimal", "dataset")
     hints = {k: getattr(args, k) for k in names if getattr(args, k) is not None}
+    time_data = None
     if len(args.path) == 1 and wants_time(args, args.path[0]):
-        frf = frf_from_time(args.path[0], args)
+        time_data = frf_from_time(args.path[0], args)
+        frf = time_data[0]
         _report_estimate(frf)
     else:
         frf = read_frf(args.path[0] if len(args.path) == 1 else args.path, **hints)
@@ -104,6 +108,11 @@ def _fit(args) -> int:
         with atomic_path(args.plot) as tmp:
             fig.savefig(tmp, dpi=110, format=Path(args.plot).suffix.lstrip(".") or "png")
         print(f"plot: {args.plot}", file=sys.stderr)
+        if time_data is not None:
+            stem = Path(args.plot)
+            for path in save_time_plots(stem.with_name(f"{stem.stem}_estimate{stem.suffix}"), *time_data,
+                                        hits_target=stem.with_name(f"{stem.stem}_hits{stem.suffix}")):
+                print(f"plot: {path}", file=sys.stderr)
     if args.archive:
         from .archive import write_archive
 
@@ -124,9 +133,12 @@ def _report_estimate(frf) -> None:
 def _frf(args) -> int:
     from .io import write_frf
 
-    frf = frf_from_time(args.path, args)
+    frf, *record = frf_from_time(args.path, args)
     _report_estimate(frf)
     write_frf(frf, args.out)
+    if args.plot:
+        for path in save_time_plots(args.plot, frf, *record):
+            print(f"plot: {path}", file=sys.stderr)
     if args.json:
         doc = {"file": args.path, "out": args.out, "kind": frf.kind, "n_channels": frf.n_channels,
                "n_lines": frf.n_freq, "averages": frf.averages, "estimator": frf.estimator, "window": frf.window,

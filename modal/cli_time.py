@@ -12,7 +12,7 @@ from .errors import FormatError
 from .estimate import ESTIMATORS, WINDOWS, EstimatedFRF, estimate_frf
 from .frf import FRF_KINDS
 
-__all__ = ["add_time_options", "frf_from_time", "TIME_OPTIONS"]
+__all__ = ["add_time_options", "frf_from_time", "save_time_plots", "wants_time", "TIME_OPTIONS"]
 
 #: the attribute names the time options set (None when not given)
 TIME_OPTIONS = ("excitation", "response", "impact", "estimator", "window", "exponential_decay_s", "segment_length",
@@ -48,8 +48,14 @@ def wants_time(args, path) -> bool:
     return given or is_time_file(path)
 
 
-def frf_from_time(path, args) -> EstimatedFRF:
-    """Read a time file and estimate its FRFs with the command line's options."""
+def frf_from_time(path, args):
+    """Read a time file and estimate its FRFs with the command line's options.
+
+    Returns
+    -------
+    (EstimatedFRF, TimeRecord, list of int, list of int)
+        The estimate, the record, and the excitation and response channel indices.
+    """
     from .io.timedata import read_time
 
     record = read_time(path)
@@ -81,10 +87,35 @@ def frf_from_time(path, args) -> EstimatedFRF:
         raise FormatError(f"{src}: the file does not say what the response channels measured; give --kind "
                           f"({', '.join(FRF_KINDS)})")
     window = args.window or ("force" if args.impact else "hann")
-    return estimate_frf(
+    estimate = estimate_frf(
         record.signals[inputs], record.signals[outputs], record.sample_rate_hz,
         estimator=args.estimator or "H1", kind=kind, segment_length=args.segment_length,
         overlap=0.5 if args.overlap is None else args.overlap, window=window,
         exponential_decay_s=args.exponential_decay_s, impact=args.impact,
         response_quantity=quantity, excitation_points=[record.names[k] for k in inputs],
         response_points=[record.names[k] for k in outputs], source=src)
+    return estimate, record, inputs, outputs
+
+
+def save_time_plots(target, estimate: EstimatedFRF, record, inputs, outputs, hits_target=None) -> list[str]:
+    """Write the estimate's figure to ``target`` and, for impact records, the hits' figure; returns the paths.
+
+    The hits' figure goes to ``hits_target`` (default ``<target stem>_hits<suffix>``).
+    """
+    from pathlib import Path
+
+    from .estimate.plots import plot_estimate, plot_hits
+    from .io._atomic import atomic_path
+
+    target = Path(target)
+    figures = [(target, plot_estimate(estimate))]
+    if estimate.hit_times_s or estimate.rejected:
+        hits_path = Path(hits_target) if hits_target else target.with_name(f"{target.stem}_hits{target.suffix}")
+        figures.append((hits_path,
+                        plot_hits(record.signals[inputs[0]], record.signals[outputs], record.sample_rate_hz, estimate)))
+    written = []
+    for path, fig in figures:
+        with atomic_path(path) as tmp:
+            fig.savefig(tmp, dpi=110, format=path.suffix.lstrip(".") or "png")
+        written.append(str(path))
+    return written

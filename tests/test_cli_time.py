@@ -135,3 +135,20 @@ def test_unknown_channel_names_the_choices(tmp_path):
     out = run("frf", path, "--excitation", "7+Z", "--out", tmp_path / "x.h5")
     assert out.returncode == 1 and "no channel '7+Z'" in out.stderr and "1=1+Z" in out.stderr
     assert not (tmp_path / "x.h5").exists()
+
+
+def test_impact_file_fit_with_plots(tmp_path):
+    from timedata import hammer_force
+
+    n = int(8 * FS)
+    force = hammer_force(n, FS, [0.5, 2.5, 2.51, 4.5, 6.5])
+    resp = PLANT.respond(force)
+    path = tmp_path / "hammer.uff"
+    write_uff_time(path, force, resp)
+    plot = tmp_path / "fit.png"
+    out = run("fit", path, "--impact", "--response", 2, "--segment-length", 1024, "--plot", plot, "--json")
+    assert out.returncode == 0, out.stderr
+    assert "hit 2 at 2.501 s rejected: double hit" in out.stderr  # the trigger: force above 5 % of its peak
+    assert plot.exists() and (tmp_path / "fit_estimate.png").exists() and (tmp_path / "fit_hits.png").exists()
+    found = sorted({round(row["natural_frequency_hz"], 6) for row in json.loads(out.stdout)["modes"]})
+    np.testing.assert_allclose(found, PLANT.natural_frequency_hz, rtol=1e-3)

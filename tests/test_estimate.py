@@ -270,3 +270,32 @@ def test_bad_records_name_the_field():
         modal.estimate_frf(np.vstack([x, x[::-1]]), x, FS, estimator="H2")
     with pytest.raises(ParameterError, match="sample_rate_hz"):
         modal.estimate_frf(x, x, -1.0)
+
+
+def test_plots_draw_the_estimate_and_the_hits(plant):
+    from matplotlib.collections import PolyCollection
+
+    from modal.estimate.plots import plot_estimate, plot_hits
+
+    n = int(8 * FS)
+    force = hammer_force(n, FS, [0.5, 2.5, 2.51, 4.5, 6.5])
+    y = plant.respond(force)
+    y = y + 1e-6 * np.random.default_rng(12).standard_normal(y.shape)
+    est = modal.estimate_frf(force, y, FS, impact=True, window="force", segment_length=1024,
+                             response_points=["a", "b", "c", "d"], excitation_points="a")
+    fig = plot_estimate(est, channels=[0, 2])
+    ax_mag, ax_phase, ax_coh = fig.axes
+    np.testing.assert_allclose(ax_mag.lines[1].get_ydata(), np.abs(est.response[2]))
+    np.testing.assert_allclose(ax_coh.lines[0].get_ydata(), est.coherence[0])
+    assert [t.get_text() for t in ax_mag.get_legend().get_texts()] == ["a / a", "c / a"]
+    bands = [c for c in ax_mag.collections if isinstance(c, PolyCollection)]
+    assert len(bands) == 2  # one ±2σ band per channel drawn
+    top = bands[0].get_paths()[0].vertices[:, 1].max()
+    assert top == pytest.approx(np.max(np.abs(est.response[0]) + 2 * est.noise_std[0]), rel=1e-9)
+    fig = plot_hits(force, y, FS, est)
+    ax_f, _ = fig.axes
+    spans = [p for p in ax_f.patches]
+    assert len(spans) == est.averages == 3  # one shaded record per accepted hit
+    rejected_lines = [ln for ln in ax_f.lines if ln.get_linestyle() == "--"]
+    assert [ln.get_xdata()[0] for ln in rejected_lines] == [est.rejected[0]["time_s"]]
+    assert "hit 2: double hit" in [t.get_text() for t in ax_f.texts]

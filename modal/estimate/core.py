@@ -64,6 +64,8 @@ class EstimatedFRF(FRF):
         Fraction of a segment shared with the next (continuous records).
     n_inputs : int
         Excitation channels.
+    hit_times_s : tuple of float
+        Trigger time of each accepted hit, s (impact records; empty otherwise).
     """
 
     coherence: np.ndarray | None = None
@@ -78,6 +80,7 @@ class EstimatedFRF(FRF):
     segment_length: int | None = None
     overlap: float = 0.0
     n_inputs: int = 1
+    hit_times_s: tuple = ()
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -248,6 +251,7 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
     _check_finite(y, "response", source)
 
     rejected: list[dict] = []
+    hit_times: tuple = ()
     if impact:
         if window == "hann":
             raise ParameterError("field 'window': 'hann' would suppress the hit; impact records take "
@@ -270,6 +274,7 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
             double_hit_window_s=double_hit_window_s, decay_fraction=decay_fraction, decay_window=decay,
             full_scale=full_scale)
         rejected = hits.rejected
+        hit_times = tuple(float(t) / fs for t in hits.trigger_index[hits.accepted])
         starts = hits.record_start[hits.accepted]
         if starts.size == 0:
             reasons = "; ".join(f"hit {r['hit']} at {r['time_s']:.3f} s: {r['reason']}" for r in rejected)
@@ -350,4 +355,5 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
         segment_length=length,
         overlap=0.0 if impact else float(overlap),
         n_inputs=n_in,
+        hit_times_s=hit_times,
     )

@@ -92,7 +92,7 @@ def write_frf_group(group, frf: FRF) -> None:
 
 
 #: per-line arrays of an estimate from time data, and their units (None: the FRF's own unit)
-_ESTIMATE_ARRAYS = {"coherence": "1", "multiple_coherence": "1", "noise_std": None}
+_ESTIMATE_ARRAYS = {"coherence": "1", "multiple_coherence": "1", "noise_std": None, "hit_times_s": "s"}
 #: numbers of an estimate, and their units
 _ESTIMATE_NUMBERS = {"averages": "1", "sample_rate_hz": "Hz", "segment_length": "1", "overlap": "1",
                      "n_inputs": "1", "exponential_decay_s": "s"}
@@ -104,7 +104,7 @@ def _write_estimate(group, frf) -> None:
 
     for name, unit in _ESTIMATE_ARRAYS.items():
         value = getattr(frf, name)
-        if value is not None:
+        if value is not None and not (name == "hit_times_s" and len(value) == 0):
             ds = group.create_dataset(name, data=np.asarray(value, dtype=np.float64))
             ds.attrs["units"] = frf.units if unit is None else unit
     for name, unit in _ESTIMATE_NUMBERS.items():
@@ -130,7 +130,10 @@ def _read_estimate(group, frf: FRF, source: str) -> FRF:
         for name in _ESTIMATE_ARRAYS:
             if name in group:
                 arr = np.asarray(group[name][()], float)
-                extras[name] = arr if name == "multiple_coherence" else arr.reshape(np.shape(frf.response))
+                if name == "hit_times_s":
+                    extras[name] = tuple(float(t) for t in arr.ravel())
+                else:
+                    extras[name] = arr if name == "multiple_coherence" else arr.reshape(np.shape(frf.response))
         for name in _ESTIMATE_NUMBERS:
             if name in group:
                 value = group[name][()]
