@@ -149,6 +149,8 @@ class CorrectionResult:
         ``"least_squares"`` or ``"minmax"``.
     objective : float
         The minimised quantity: weighted RMS (least squares) or weighted worst (min-max).
+        With unequal weights, min-max's guarantee (never above least squares) holds for
+        this weighted worst, not for ``worst_residual``.
     max_unbalance_kg_m : float
         Bound on each plane's correction (inf: none).
     bound_active : bool
