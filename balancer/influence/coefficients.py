@@ -49,16 +49,17 @@ of 20-30 % in amplitude or 20-30 deg in phase)."""
 _RANK_TOLERANCE = 1e-10  # singular values below this times the largest: dependent planes
 
 
+_SHAPES = {"initial": "(n_readings,)", "trial_runs": "(n_planes, n_readings)", "trial_unbalances": "(n_planes,)",
+           "alpha": "(n_readings, n_planes)"}
+
+
 def _complex_array(values, field: str, ndim: int) -> np.ndarray:
     try:
         array = np.asarray(values, dtype=complex)
     except (TypeError, ValueError):
         raise ParameterError(f"{field}: expected complex numbers, got {type(values).__name__}") from None
     if array.ndim != ndim:
-        shape = "(n_readings,)" if ndim == 1 and field != "trial_unbalances" else "(n_planes,)" if ndim == 1 else "(n_planes, n_readings)"
-        if field == "alpha":
-            shape = "(n_readings, n_planes)"
-        raise ParameterError(f"{field}: shape {array.shape}; expected {shape}")
+        raise ParameterError(f"{field}: shape {array.shape}; expected {_SHAPES[field]}")
     if array.size == 0:
         raise ParameterError(f"{field}: empty; expected at least one value")
     flat = array.ravel()
@@ -149,6 +150,8 @@ class CorrectionResult:
         ``"least_squares"`` or ``"minmax"``.
     objective : float
         The minimised quantity: weighted RMS (least squares) or weighted worst (min-max).
+        With unequal weights, min-max's guarantee (never above least squares) holds for
+        this weighted worst, not for ``worst_residual``.
     max_unbalance_kg_m : float
         Bound on each plane's correction (inf: none).
     bound_active : bool
