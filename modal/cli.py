@@ -29,8 +29,16 @@ def build_parser() -> argparse.ArgumentParser:
                          description="Identify natural frequency, damping, modal constant and k, c, m of every mode.")
     fit.add_argument("path", nargs="+", help="FRF file(s) (UFF 58/58b, CSV, MAT, HDF5); several files on one "
                      "frequency axis become one multi-channel FRF")
-    fit.add_argument("--method", choices=["nls", "circle", "halfpower", "all"], default="nls",
-                     help="identification method (default: nls, the least-squares refinement)")
+    fit.add_argument("--method", choices=["nls", "circle", "halfpower", "global", "all"], default="nls",
+                     help="identification method (default: nls, the band-wise least-squares refinement; global: "
+                          "poly-reference LSCF with a stabilisation diagram and a joint refinement of all modes, "
+                          "for many modes, channels and references; all: the three band-wise methods)")
+    fit.add_argument("--modes-hz", dest="modes_hz", type=float, nargs="+", metavar="HZ",
+                     help="global: keep the modes nearest these frequencies (Hz) instead of the automatic choice")
+    fit.add_argument("--order", type=int, help="global: use this model order's poles instead of the stabilisation")
+    fit.add_argument("--max-order", dest="max_order", type=int, help="global: highest order of the sweep")
+    fit.add_argument("--stabilisation-plot", dest="stabilisation_plot", metavar="OUT.png",
+                     help="global: write the stabilisation diagram over the summed FRF")
     fit.add_argument("--band", nargs=2, type=float, action="append", metavar=("FMIN", "FMAX"),
                      help="fitting band of one mode in Hz (repeat for several modes); default: automatic")
     fit.add_argument("--kind", choices=FRF_KINDS, help="FRF kind when the file does not say")
@@ -81,7 +89,11 @@ def _fit(args) -> int:
         frf = read_frf(args.path[0] if len(args.path) == 1 else args.path, **hints)
     label = args.path[0] if len(args.path) == 1 else f"{args.path[0]} (+{len(args.path) - 1} files)"
     methods = ["nls", "circle", "halfpower"] if args.method == "all" else [args.method]
-    results = [identify(frf, method, bands_hz=args.band) for method in methods]
+    options = {k: getattr(args, k) for k in ("modes_hz", "order", "max_order") if getattr(args, k) is not None}
+    if options and methods != ["global"]:
+        raise ModalError(f"--{next(iter(options)).replace('_', '-')} applies to --method global only")
+    results = [identify(frf, method, bands_hz=args.band, **(options if method == "global" else {}))
+               for method in methods]
     points = None
     if frf.response_points is not None:
         refs = frf.reference_points or ("?",) * frf.n_channels
@@ -113,6 +125,17 @@ def _fit(args) -> int:
             for path in save_time_plots(stem.with_name(f"{stem.stem}_estimate{stem.suffix}"), *time_data,
                                         hits_target=stem.with_name(f"{stem.stem}_hits{stem.suffix}")):
                 print(f"plot: {path}", file=sys.stderr)
+    if getattr(args, "stabilisation_plot", None):
+        if results[0].stabilisation is None:
+            raise ModalError("--stabilisation-plot needs --method global")
+        from .global_.plots import plot_stabilisation
+        from .io._atomic import atomic_path
+
+        fig = plot_stabilisation(frf, results[0])
+        target = Path(args.stabilisation_plot)
+        with atomic_path(target) as tmp:
+            fig.savefig(tmp, dpi=110, format=target.suffix.lstrip(".") or "png")
+        print(f"plot: {target}", file=sys.stderr)
     if args.archive:
         from .archive import write_archive
 

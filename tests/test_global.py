@@ -176,3 +176,42 @@ def test_real_beam_modes_and_synthesis():
     band = (f >= 20) & (f <= 990)
     error = np.abs(result.synthesize(f[band]).channels - frf.channels[:, band]) / np.abs(frf.channels[:, band])
     assert np.median(error) < 0.06 and np.percentile(error, 90) < 0.35  # the 6 % and 35 %
+
+
+def test_cli_global_on_the_real_beam_with_a_stabilisation_plot(tmp_path):
+    import json
+    import os
+    import subprocess
+    import sys
+
+    from conftest import ROOT
+
+    paths = sorted(REAL.glob("pyuff_meas_point_*.txt"))
+    plot = tmp_path / "stab.png"
+    out = subprocess.run([sys.executable, "-m", "modal", "fit", *map(str, paths), "--frequency-step", "1", "--kind",
+                          "accelerance", "--method", "global", "--json", "--stabilisation-plot", str(plot)],
+                         capture_output=True, text=True, cwd=ROOT, env={**os.environ, "MPLBACKEND": "Agg"}, timeout=120)
+    assert out.returncode == 0, out.stderr
+    rows = json.loads(out.stdout)["modes"]
+    assert {row["method"] for row in rows} == {"global"} and {row["channel"] for row in rows} == {0, 1, 2}
+    found = np.array(sorted({row["natural_frequency_hz"] for row in rows}))
+    assert all(np.min(np.abs(found / f - 1)) < 5e-4 for f in BEAM_HZ)
+    assert plot.exists()
+    wrong = subprocess.run([sys.executable, "-m", "modal", "fit", *map(str, paths), "--frequency-step", "1", "--kind",
+                            "accelerance", "--order", "30"], capture_output=True, text=True, cwd=ROOT, timeout=120)
+    assert wrong.returncode == 1 and "--order applies to --method global only" in wrong.stderr
+
+
+def test_stabilisation_plot_draws_every_pole(multi_reference):
+    from modal.global_.plots import plot_mac, plot_stabilisation, plot_synthesis
+
+    *_, noisy, result = multi_reference
+    fig = plot_stabilisation(noisy, result)
+    ax = fig.axes[0]
+    drawn = sum(line.get_xdata().size for line in ax.lines if line.get_linestyle() == "None")
+    assert drawn == result.stabilisation.order.size  # every pole of every order, once
+    assert len([ln for ln in ax.lines if ln.get_linestyle() == "-"]) == len(result)  # one line per chosen mode
+    fig = plot_synthesis(noisy, result, channels=[0])
+    np.testing.assert_allclose(fig.axes[0].lines[1].get_ydata(), np.abs(result.synthesize(noisy.frequency_hz).channels[0]))
+    image = plot_mac(result).axes[0].images[0]
+    np.testing.assert_allclose(image.get_array(), result.mac())
