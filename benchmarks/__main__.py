@@ -454,7 +454,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--quick", action="store_true", help="small sizes (a smoke run of a minute or two)")
     parser.add_argument("--runs", type=int, default=5, help="repetitions for every median (default 5)")
     parser.add_argument("--trials", type=int, default=50, help="noise trials per SDOF grid cell (default 50)")
-    parser.add_argument("--only", nargs="+", choices=["identify", "io", "crank", "adb", "demo"],
+    parser.add_argument("--only", nargs="+", choices=["identify", "global", "estimate", "io", "crank", "adb",
+                                                      "influence", "demo"],
                         help="run only these sections")
     parser.add_argument("--out", type=Path, default=HERE / "REPORT.md", help="report file (default benchmarks/REPORT.md)")
     parser.add_argument("--refresh-stress", action="store_true",
@@ -467,7 +468,7 @@ def main(argv: list[str] | None = None) -> int:
         args.out.write_text(head + "\n## Stress run\n\n" + stress_summary() + "\n", encoding="utf-8")
         print(f"[benchmarks] refreshed the stress section of {args.out}", file=sys.stderr)
         return 0
-    wanted = set(args.only or ["identify", "io", "crank", "adb", "demo"])
+    wanted = set(args.only or ["identify", "global", "estimate", "io", "crank", "adb", "influence", "demo"])
     runs = max(1, args.runs)
     started = time.perf_counter()
     plots: list[str] = []
@@ -494,6 +495,14 @@ def main(argv: list[str] | None = None) -> int:
         status.append(line)
         return body
 
+    if "global" in wanted:
+        sections.append(("Global identification (pLSCF + joint refinement) against sdypy-EMA",
+                         run_module("bench_global", ["--runs", str(runs), "--seeds", "2" if args.quick else "5"])))
+    if "estimate" in wanted and (HERE / "bench_estimate.py").is_file():
+        sections.append(("FRFs from time data: estimate time and identification on estimates",
+                         run_module("bench_estimate", ["--quick"] if args.quick else [])))
+    if "influence" in wanted and (HERE / "bench_influence.py").is_file():
+        sections.append(("Field balancing: influence-coefficient corrections", run_module("bench_influence", [])))
     if "io" in wanted:
         io_args = ["--runs", str(runs)] + (["--channels", "100"] if args.quick else [])
         sections.append(("File reading and writing (1000 channels × 2001 lines per format)",

@@ -41,7 +41,7 @@ def _median(func, runs=3):
     return statistics.median(times), out
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
     rng = np.random.default_rng(0)
     print(f"{'n x p':>10} {'method':<22} {'time [s]':>9} {'worst / cutting-plane':>22} {'gap':>9}")
     for n, p in [(10, 3), (40, 4), (200, 8), (1000, 20)]:

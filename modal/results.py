@@ -37,8 +37,8 @@ FLAG_TEXT = {
                      "or lower min_prominence_db"),
     "window_damping_dominates": ("the exponential window's decay 1/tau is not below the mode's measured decay rate: "
                                  "all its damping may be the window's, so it was not removed; use a longer tau"),
-    "weak_evidence": ("global: the pole is stable in fewer than half of the model orders of the stabilisation "
-                      "diagram (or a modes_hz hint picked a pole stable in fewer than 3): a weakly excited mode or a "
+    "weak_evidence": ("global: the pole is stable in fewer than half of the upper half of the model orders of the "
+                      "stabilisation diagram (or a modes_hz hint picked a pole stable in fewer than 3): a weakly excited mode or a "
                       "noise pole; check the diagram and the shape before using it"),
     "outside_band": ("global: the mode lies below the first resolvable lines or above the band: its parameters "
                      "are extrapolated; widen the band or treat it as a residual"),

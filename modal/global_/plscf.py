@@ -96,8 +96,9 @@ def plscf_poles(omega: np.ndarray, frf: np.ndarray, orders, max_damping: float =
     r_seq = zd.sum(axis=1).real  # (2P+1,)
     h = frf.reshape(n_out * m, n_f)
     s_seq = (zd @ h.T).reshape(2 * p_max + 1, n_out, m)
-    hh = (frf.conj()[:, :, None, :] * frf[:, None, :, :]).reshape(n_out * m * m, n_f)
-    t_seq = (zd @ hh.T).reshape(2 * p_max + 1, n_out, m, m)
+    # only Σ_o T_o enters: sum the products over the outputs per line first (m² rows, not n_out·m²)
+    hh = np.einsum("orf,osf->rsf", frf.conj(), frf).reshape(m * m, n_f)
+    t_seq = (zd @ hh.T).reshape(2 * p_max + 1, m, m)
 
     packs = []
     for p in orders:
@@ -107,8 +108,8 @@ def plscf_poles(omega: np.ndarray, frf: np.ndarray, orders, max_damping: float =
         S = -_toeplitz_blocks(s_seq, p).real  # (n, n, n_out, m) [j, k, o, r]
         S = np.moveaxis(S, 2, 0).reshape(n_out, n, n * m)  # (o, j, k·m + r)
         # T_o[(j, r), (k, s)] = Re Σ conj(z^j H_or) z^k H_os = Re t_o,rs(k − j)
-        T = _toeplitz_blocks(t_seq, p).real  # (n, n, n_out, m, m) [j, k, o, r, s]
-        T_sum = np.transpose(T.sum(axis=2), (0, 2, 1, 3)).reshape(n * m, n * m)  # Σ_o, rows (j, r), cols (k, s)
+        T = _toeplitz_blocks(t_seq, p).real  # (n, n, m, m) [j, k, r, s], already summed over the outputs
+        T_sum = np.transpose(T, (0, 2, 1, 3)).reshape(n * m, n * m)  # rows (j, r), cols (k, s)
         try:
             RinvS = np.linalg.solve(R, np.moveaxis(S, 0, 1).reshape(n, n_out * n * m)).reshape(n, n_out, n * m)
         except np.linalg.LinAlgError:

@@ -59,6 +59,8 @@ class SelectedPole:
     n_stable_orders: int
     n_orders: int
     hinted: bool = False
+    # n_stable_orders counts the orders of the upper half of the sweep that hold the pole stable in
+    # frequency, out of n_orders (the upper half's size)
 
 
 def vector_mac(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -159,10 +161,12 @@ def select_poles(packs: list[PolePack], diagram: StabilisationDiagram, modes_hz=
                 continue
             pack, k = best
             f = pack.omega_n[k] / (2 * np.pi)
-            near = diagram.stable_frequency & (np.abs(diagram.frequency_hz / f - 1) < cluster_tol)
+            upper = [o for o in order_list if o >= order_list[len(order_list) // 2]]
+            near = diagram.stable_frequency & (np.abs(diagram.frequency_hz / f - 1) < cluster_tol) \
+                & np.isin(diagram.order, upper)
             count = int(np.unique(diagram.order[near]).size)
             chosen.append(SelectedPole(float(pack.omega_n[k]), float(pack.damping_ratio[k]), pack.participation[k],
-                                       count, n_orders, hinted=True))
+                                       count, len(upper), hinted=True))
         return _unique(chosen)
     # noise moves damping and participation more from order to order than frequency: chains follow
     # the poles stable in frequency
@@ -177,8 +181,11 @@ def select_poles(packs: list[PolePack], diagram: StabilisationDiagram, modes_hz=
         top = pool[np.argmax(diagram.order[pool])]
         pack = packs[order_list.index(diagram.order[top])]
         k = int(np.argmin(np.abs(pack.omega_n / (2 * np.pi * diagram.frequency_hz[top]) - 1)))
+        # the evidence: how many of the upper half of the sweep's orders (where the model has room for
+        # every mode) hold the pole stable
+        upper = [o for o in order_list if o >= order_list[len(order_list) // 2]]
         chosen.append(SelectedPole(float(pack.omega_n[k]), float(pack.damping_ratio[k]), pack.participation[k],
-                                   int(orders_seen.size), n_orders))
+                                   int(np.isin(orders_seen, upper).sum()), len(upper)))
     return _unique(chosen)
 
 
