@@ -53,7 +53,10 @@ def build_parser() -> argparse.ArgumentParser:
     fit.add_argument("--decimal", help="CSV decimal mark, e.g. ','")
     fit.add_argument("--dataset", type=int, help="UFF dataset number (1-based) when the file holds several axes")
     fit.add_argument("--json", action="store_true", help="print one JSON document on stdout")
-    fit.add_argument("--plot", metavar="OUT.png", help="write a figure of the fit")
+    fit.add_argument("--plot", metavar="OUT.png", help="write a figure of the fit (every method's model over the data)")
+    fit.add_argument("--channel", type=int, metavar="N",
+                     help="--plot: draw only channel N (0-based); default every channel (the RMS over channels "
+                          "above 8)")
     fit.add_argument("--archive", metavar="OUT.h5", help="write the FRF and results to an HDF5 archive")
     add_time_options(fit)
     frf = sub.add_parser("frf", help="estimate FRFs from a time record (force and responses)",
@@ -116,7 +119,7 @@ def _fit(args) -> int:
         from .io._atomic import atomic_path
         from .plots import plot_fit
 
-        fig = plot_fit(frf, results[0])
+        fig = plot_fit(frf, results, channel=args.channel)
         with atomic_path(args.plot) as tmp:
             fig.savefig(tmp, dpi=110, format=Path(args.plot).suffix.lstrip(".") or "png")
         print(f"plot: {args.plot}", file=sys.stderr)

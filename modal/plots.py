@@ -2,77 +2,183 @@
 built without pyplot (no global state, nothing shown)."""
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 from matplotlib.figure import Figure
+from matplotlib.ticker import MaxNLocator
 
+from .errors import ModalError
 from .frf import FRF, KIND_POWER
 from .model import mode_basis
 from .results import IdentificationResult
 
-__all__ = ["plot_fit", "model_response"]
+__all__ = ["plot_fit", "model_response", "modes_response", "nyquist_omega", "MAX_DRAWN_CHANNELS"]
+
+#: Above this many channels the magnitude panel shows the RMS over channels only.
+MAX_DRAWN_CHANNELS = 8
+_NYQUIST_COLUMNS = 6
+_STYLES = ("-", "--", ":", "-.")
 
 
-def model_response(frf: FRF, result: IdentificationResult) -> np.ndarray:
-    """The fitted modes summed on the FRF's lines, shape (n_channels, n_freq)."""
-    omega = frf.omega_rad_s
-    power = KIND_POWER[frf.kind]
-    total = np.zeros((frf.n_channels, frf.n_freq), dtype=complex)
+def modes_response(omega_rad_s: np.ndarray, kind: str, result: IdentificationResult) -> np.ndarray:
+    """The fitted modes (and residual terms, where fitted) summed on any lines.
+
+    Parameters
+    ----------
+    omega_rad_s : ndarray
+        Lines, rad/s.
+    kind : str
+        FRF kind of the result (its modal constants are receptance constants, 1/kg).
+    result : IdentificationResult
+
+    Returns
+    -------
+    ndarray of complex, shape (result.n_channels, n_lines)
+    """
+    omega = np.asarray(omega_rad_s, float)
+    power = KIND_POWER[kind]
+    total = np.zeros((result.n_channels, omega.size), dtype=complex)
     for mode in result:
         phi = mode_basis(omega, mode.omega_n_rad_s, mode.damping_ratio, power)[0]
-        const = np.atleast_1d(np.asarray(mode.modal_constant, complex))
-        total += np.nan_to_num(const)[:, None] * phi[None, :]
+        const = np.nan_to_num(np.atleast_1d(np.asarray(mode.modal_constant, complex)))
+        total += const[:, None] * phi[None, :]
+    if result.residuals is not None:
+        upper, lower = np.asarray(result.residuals, complex).T
+        with np.errstate(divide="ignore", invalid="ignore"):
+            factor = (1j * omega) ** power
+            low = np.where(omega > 0, factor / np.where(omega > 0, omega, 1.0) ** 2, 0.0)
+        total += upper[:, None] * factor[None, :] - lower[:, None] * low[None, :]
     return total
 
 
-def plot_fit(frf: FRF, result: IdentificationResult, channel: int = 0, figure: Figure | None = None) -> Figure:
-    """Magnitude and phase with the fitted model over the data, and each mode's Nyquist plot.
+def model_response(frf: FRF, result: IdentificationResult) -> np.ndarray:
+    """The fitted model on the FRF's lines, shape (n_channels, n_freq)."""
+    return modes_response(frf.omega_rad_s, frf.kind, result)
+
+
+def nyquist_omega(omega_n: float, zeta: float, low: float, high: float, n: int = 721) -> np.ndarray:
+    """Lines (rad/s) in [low, high] that trace a mode's Nyquist circle evenly.
+
+    Around a mode the circle's angle θ moves as ω = ωn (1 + ζ tan(θ/2)); equal
+    steps in θ give a smooth circle however narrow the resonance is next to the
+    band. Half of the points go there, the other half evenly over the band.
+    """
+    theta = np.linspace(-np.pi, np.pi, n // 2 + 2)[1:-1]
+    near = omega_n * (1.0 + max(zeta, 1e-9) * np.tan(theta / 2))
+    lines = np.concatenate([near, np.linspace(low, high, n - near.size)])
+    lines = lines[(lines >= low) & (lines <= high)]
+    return np.unique(lines)
+
+
+def _as_results(result) -> list[IdentificationResult]:
+    if isinstance(result, IdentificationResult):
+        return [result]
+    results = list(result)
+    if not results:
+        raise ModalError("plot_fit: no identification result to draw")
+    return results
+
+
+def plot_fit(frf: FRF, result: IdentificationResult | Sequence[IdentificationResult], channel: int | None = None,
+             figure: Figure | None = None) -> Figure:
+    """Magnitude and phase with the fitted model(s) over the data, and each mode's Nyquist plot.
 
     Parameters
     ----------
     frf : FRF
-    result : IdentificationResult
-        From :func:`modal.identify` on ``frf``.
-    channel : int
-        Channel to draw.
+    result : IdentificationResult or sequence of them
+        From :func:`modal.identify` on ``frf``; several (e.g. one per method) are
+        drawn over each other, each method with its own line style.
+    channel : int, optional
+        Channel to draw (0-based). Default: every channel up to
+        :data:`MAX_DRAWN_CHANNELS` (each with its model), and for more channels the
+        RMS magnitude over channels of the data and of each model; the Nyquist
+        plot of each mode shows the channel where that mode is strongest.
     figure : Figure, optional
         Figure to draw into (a new one by default).
     """
-    fig = figure if figure is not None else Figure(figsize=(11, 7), layout="constrained")
-    n_modes = max(len(result), 1)
-    grid = fig.add_gridspec(3, max(n_modes, 2))
+    results = _as_results(result)
+    if channel is not None and not 0 <= channel < frf.n_channels:
+        raise ModalError(f"channel {channel} does not exist; the FRF has channels 0..{frf.n_channels - 1}")
+    first = results[0]
+    f = frf.frequency_hz
+    omega = frf.omega_rad_s
+    data = np.atleast_2d(frf.channels)
+    models = [model_response(frf, r) for r in results]
+    channels = [channel] if channel is not None else list(range(frf.n_channels))
+    rms = len(channels) > MAX_DRAWN_CHANNELS
+
+    n_modes = len(first)
+    ncols = max(min(n_modes, _NYQUIST_COLUMNS), 2)
+    nrows_nyq = max(-(-n_modes // _NYQUIST_COLUMNS), 1)
+    fig = figure if figure is not None else Figure(figsize=(11, 5 + 2.2 * nrows_nyq), layout="constrained")
+    grid = fig.add_gridspec(2 + nrows_nyq, ncols, height_ratios=[1.4, 1.0] + [1.1] * nrows_nyq)
     ax_mag = fig.add_subplot(grid[0, :])
     ax_phase = fig.add_subplot(grid[1, :], sharex=ax_mag)
-    f = frf.frequency_hz
-    data = frf.channels[channel]
-    model = model_response(frf, result)[channel]
-    ax_mag.semilogy(f, np.abs(data), ".", ms=2, label="data")
-    ax_mag.semilogy(f, np.abs(model), "-", lw=1, label=f"model ({result.method})")
+    colours = [f"C{i % 10}" for i in range(len(channels))]
+    if rms:
+        data_rms = np.sqrt(np.mean(np.abs(data) ** 2, axis=0))
+        ax_mag.semilogy(f, data_rms, ".", ms=2, color="0.3", label=f"data, RMS of {len(channels)} channels")
+        for k, (res, model) in enumerate(zip(results, models)):
+            ax_mag.semilogy(f, np.sqrt(np.mean(np.abs(model) ** 2, axis=0)), _STYLES[k % 4], lw=1.2,
+                            color="C3", label=f"model ({res.method}), RMS")
+        strongest = int(np.argmax(np.sum(np.abs(data) ** 2, axis=1)))
+        phase_channels = [strongest]
+        ax_phase.set_title(f"phase of channel {strongest} (the strongest)", fontsize="small")
+    else:
+        for colour, ch in zip(colours, channels):
+            tag = f"ch {ch} " if frf.n_channels > 1 else ""
+            ax_mag.semilogy(f, np.abs(data[ch]), ".", ms=2, color=colour, label=f"{tag}data")
+            for k, (res, model) in enumerate(zip(results, models)):
+                ax_mag.semilogy(f, np.abs(model[ch]), _STYLES[k % 4], lw=1, color=colour,
+                                label=f"{tag}model ({res.method})")
+        phase_channels = channels
+    for colour, ch in zip(colours if not rms else ["0.3"], phase_channels):
+        ax_phase.plot(f, np.degrees(np.angle(data[ch])), ".", ms=2, color=colour)
+        for k, model in enumerate(models):
+            ax_phase.plot(f, np.degrees(np.angle(model[ch])), _STYLES[k % 4], lw=1, color=colour)
     ax_mag.set_ylabel(f"|H| [{frf.units}]")
-    ax_mag.legend(loc="best", fontsize="small")
-    ax_phase.plot(f, np.degrees(np.angle(data)), ".", ms=2)
-    ax_phase.plot(f, np.degrees(np.angle(model)), "-", lw=1)
+    ax_mag.legend(loc="best", fontsize="x-small", ncol=1 + (len(channels) * (1 + len(results)) > 6))
     ax_phase.set_ylabel("phase [deg]")
+    ax_phase.set_yticks([-180, -90, 0, 90, 180])
     ax_phase.set_xlabel("frequency [Hz]")
-    for mode in result:
+    for mode in first:
         for ax in (ax_mag, ax_phase):
             ax.axvline(mode.natural_frequency_hz, color="0.7", lw=0.6, zorder=0)
+
     power = KIND_POWER[frf.kind]
-    for r, mode in enumerate(result):
-        ax = fig.add_subplot(grid[2, r])
+    for r, mode in enumerate(first):
+        ax = fig.add_subplot(grid[2 + r // _NYQUIST_COLUMNS, r % _NYQUIST_COLUMNS])
+        if channel is not None:
+            ch = channel
+        else:
+            ch = int(np.nanargmax(np.abs(np.atleast_1d(np.nan_to_num(np.asarray(mode.modal_constant, complex))))))
         low, high = mode.band_hz
         keep = (f >= low) & (f <= high)
-        omega = frf.omega_rad_s[keep]
-        to_mobility = (1j * omega) ** (1 - power) if not np.any(omega == 0) else np.ones_like(omega)
-        y = data[keep] * to_mobility
-        dense = np.linspace(omega[0], omega[-1], 400)
-        ym = model_response(FRF(dense / (2 * np.pi), np.zeros(dense.size), kind=frf.kind), result)[channel]
-        ym = ym * ((1j * dense) ** (1 - power) if not np.any(dense == 0) else 1)
-        offset = np.mean(y - model[keep] * to_mobility)
-        ax.plot(y.real, y.imag, ".", ms=3)
-        ax.plot((ym + offset).real, (ym + offset).imag, "-", lw=1)
+        if np.count_nonzero(keep) < 2:
+            keep = np.abs(f - mode.natural_frequency_hz) <= max(3 * mode.damping_ratio * mode.natural_frequency_hz,
+                                                                  2 * (f[1] - f[0]))
+        w = omega[keep]
+        to_mobility = (1j * w) ** (1 - power) if np.all(w > 0) else np.ones_like(w)
+        y = data[ch, keep] * to_mobility
+        ax.plot(y.real, y.imag, ".", ms=3, color="0.3")
+        for k, (res, model) in enumerate(zip(results, models)):
+            match = min(res.modes, key=lambda m: abs(m.natural_frequency_hz - mode.natural_frequency_hz), default=None)
+            if match is None:
+                continue
+            dense = nyquist_omega(match.omega_n_rad_s, match.damping_ratio, w[0], w[-1])
+            ym = modes_response(dense, frf.kind, res)[ch] * ((1j * dense) ** (1 - power) if np.all(dense > 0) else 1)
+            offset = np.mean(y - model[ch, keep] * to_mobility)  # what the model leaves out (other modes' tails)
+            ax.plot((ym + offset).real, (ym + offset).imag, _STYLES[k % 4], lw=1, color="C3" if k == 0 else f"C{k + 3}")
         ax.set_aspect("equal", adjustable="datalim")
-        ax.set_title(f"mode {r + 1}: {mode.natural_frequency_hz:.4g} Hz", fontsize="small")
-        ax.set_xlabel("Re Y")
-        if r == 0:
-            ax.set_ylabel("Im Y (mobility)")
+        ax.set_title(f"mode {r + 1}: {mode.natural_frequency_hz:.4g} Hz"
+                     + (f" (ch {ch})" if frf.n_channels > 1 else ""), fontsize="small")
+        ax.xaxis.set_major_locator(MaxNLocator(3))
+        ax.yaxis.set_major_locator(MaxNLocator(4))
+        ax.ticklabel_format(style="sci", scilimits=(-2, 3))
+        ax.tick_params(labelsize="x-small")
+        ax.set_xlabel("Re Y", fontsize="small")
+        if r % _NYQUIST_COLUMNS == 0:
+            ax.set_ylabel("Im Y (mobility)", fontsize="small")
     return fig

@@ -293,6 +293,9 @@ def _read_frf_hdf5_here(path: str | os.PathLike, hints: dict[str, Any]) -> FRF:
     with fh:
         try:
             check_schema(fh, src)
+            stored = _archive_frfs(fh, h5py)
+            if stored is not None:  # a result archive (modal fit --archive, balancer run): FRF items by name
+                return _pick_archive_frf(fh, stored, src, hints)
             if FRF_GROUP not in fh or not isinstance(fh[FRF_GROUP], h5py.Group):
                 have = ", ".join(sorted(fh.keys())) or "nothing"
                 raise FormatError(f"{src}: no group /{FRF_GROUP} (the file holds {have}); expected /{FRF_GROUP}/<name>")
@@ -313,3 +316,42 @@ def _read_frf_hdf5_here(path: str | os.PathLike, hints: dict[str, Any]) -> FRF:
             raise
         except (OSError, KeyError, RuntimeError, TypeError, ValueError) as exc:  # damaged file or object
             raise FormatError(f"{src}: damaged HDF5 content ({exc}); expected an archive written by modalbal") from None
+
+
+def _archive_frfs(fh, h5py) -> list[str] | None:
+    """Names of the top-level FRF items of a result archive (``@__type__ = "frf"``), or None
+    when the file is not a result archive (then it holds ``/frf/<name>`` groups)."""
+    def kind(node) -> str:
+        value = node.attrs.get("__type__", "")
+        return value.decode() if isinstance(value, bytes) else str(value)
+
+    typed = [name for name in fh.keys() if name != "scene" and kind(fh[name])]
+    if not typed and "scene" not in fh:
+        return None
+    return [name for name in typed if kind(fh[name]) == "frf"]
+
+
+def _pick_archive_frf(fh, names: list[str], src: str, hints: dict[str, Any]) -> FRF:
+    if not names:
+        held = ", ".join(f"{k} ({_describe(fh[k])})" for k in fh.keys()) or "nothing"
+        raise FormatError(f"{src}: this archive holds no FRF (it holds {held}); expected an archive written by "
+                          f"'modal fit --archive', 'modal frf --out' or a scene with an [frf] stage")
+    choice = hints.get("dataset")
+    if choice is not None:
+        if str(choice) not in names:
+            raise FormatError(f"{src}: archive item {choice!r} is not an FRF; its FRFs are {', '.join(names)}")
+        name = str(choice)
+    elif len(names) == 1:
+        name = names[0]
+    else:
+        raise FormatError(f"{src}: the archive holds {len(names)} FRFs ({', '.join(names)}); expected one, "
+                          f"or dataset= naming it")
+    return read_frf_group(fh[name], src, hints)
+
+
+def _describe(node) -> str:
+    value = node.attrs.get("__type__", "")
+    value = value.decode() if isinstance(value, bytes) else str(value)
+    if value == "dataclass":
+        return str(node.attrs.get("__class__", "result")).rpartition(":")[2]
+    return value or "data"

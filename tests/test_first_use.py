@@ -1,0 +1,144 @@
+"""What a new user meets first (issue 20): multi-channel plots, the toolkit reading its own
+archives, units on every archived number, flags that do not contradict each other."""
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from matplotlib.lines import Line2D
+
+from modal import identify
+from modal.errors import FormatError, ModalError
+from modal.io import read_frf
+from modal.plots import MAX_DRAWN_CHANNELS, model_response, plot_fit
+from modal.synthetic import add_noise, modal_frf
+
+ROOT = Path(__file__).resolve().parents[1]
+REAL = sorted((ROOT / "data" / "real").glob("pyuff_meas_point_*.txt"))
+
+
+def run(module, *args, cwd=None):
+    return subprocess.run([sys.executable, "-m", module, *map(str, args)], capture_output=True, text=True,
+                          cwd=cwd, timeout=180)
+
+
+def _three_channel(n_channels=3, seed=3):
+    rng = np.random.default_rng(seed)
+    constants = rng.normal(size=(n_channels, 2)) * np.array([1.0, 0.5])
+    constants[0] = np.abs(constants[0])  # channel 0 is a driving point
+    frf = modal_frf(np.linspace(20, 300, 1201), [80.0, 190.0], [0.02, 0.015], constants, kind="mobility")
+    return add_noise(frf, 1e-4, seed=seed)
+
+
+def _identify(frf, method="nls"):
+    import warnings
+
+    from modal.errors import QualityWarning
+
+    with warnings.catch_warnings():  # flags are not what these tests are about
+        warnings.simplefilter("ignore", QualityWarning)
+        return identify(frf, method)
+
+
+def _lines(ax):
+    return [line for line in ax.get_lines() if isinstance(line, Line2D) and np.asarray(line.get_xdata()).size > 2]
+
+
+# ---- item 1: plots of multi-channel FRFs ---------------------------------------------------------------------
+
+def test_multichannel_plot_draws_every_channel_with_its_model():
+    frf = _three_channel()
+    result = _identify(frf)
+    fig = plot_fit(frf, result)
+    ax_mag = fig.axes[0]
+    model = model_response(frf, result)
+    drawn = [np.asarray(line.get_ydata()) for line in _lines(ax_mag)]
+    for ch in range(frf.n_channels):  # the data and the model of every channel are on the magnitude panel
+        assert any(d.shape == (frf.n_freq,) and np.allclose(d, np.abs(frf.channels[ch])) for d in drawn)
+        assert any(d.shape == (frf.n_freq,) and np.allclose(d, np.abs(model[ch])) for d in drawn)
+    assert len(fig.axes) == 2 + len(result)  # magnitude, phase, one Nyquist panel per mode
+
+
+def test_channel_option_draws_one_channel_and_rejects_a_missing_one():
+    frf = _three_channel()
+    result = _identify(frf)
+    fig = plot_fit(frf, result, channel=2)
+    drawn = [np.asarray(line.get_ydata()) for line in _lines(fig.axes[0])]
+    assert len(drawn) == 2  # data and model of channel 2 only
+    assert np.allclose(drawn[0], np.abs(frf.channels[2]))
+    with pytest.raises(ModalError, match="channel 5 does not exist"):
+        plot_fit(frf, result, channel=5)
+
+
+def test_many_channels_show_the_rms_magnitude():
+    frf = _three_channel(n_channels=MAX_DRAWN_CHANNELS + 4)
+    result = _identify(frf)
+    fig = plot_fit(frf, result)
+    drawn = [np.asarray(line.get_ydata()) for line in _lines(fig.axes[0])]
+    rms = np.sqrt(np.mean(np.abs(frf.channels) ** 2, axis=0))
+    assert len(drawn) == 2 and np.allclose(drawn[0], rms)
+
+
+def test_nyquist_model_circle_is_smooth():
+    """The model circle is drawn with at most a few degrees between points (was a visible polygon)."""
+    frf = modal_frf(np.linspace(20, 300, 281), [100.0], [0.002], [1.0], kind="mobility")  # 0.4 Hz wide, 1 Hz lines
+    result = _identify(frf)
+    fig = plot_fit(frf, result)
+    line = [ln for ln in fig.axes[2].get_lines() if ln.get_linestyle() == "-"][0]
+    z = np.asarray(line.get_xdata()) + 1j * np.asarray(line.get_ydata())
+    centre = 0.5 * (z[np.argmax(np.abs(z - z[0]))] + z[0])  # the circle passes near the origin
+    steps = np.abs(np.diff(np.unwrap(np.angle(z - centre))))
+    assert np.degrees(steps.max()) < 5.0
+
+
+def test_method_all_draws_every_method():
+    frf = _three_channel(n_channels=1)
+    results = [_identify(frf, m) for m in ("nls", "circle", "halfpower")]
+    fig = plot_fit(frf, results)
+    labels = [line.get_label() for line in fig.axes[0].get_lines()]
+    for method in ("nls", "circle", "halfpower"):
+        assert any(method in label for label in labels)
+
+
+# ---- items 1 + 2 on the real beam: fit with --plot and --archive in one command, read the archive back ----------
+
+def test_real_beam_plot_archive_and_read_back(tmp_path):
+    out = run("modal", "fit", *REAL, "--frequency-step", "1", "--kind", "accelerance",
+              "--plot", tmp_path / "beam.png", "--archive", tmp_path / "beam.h5", "--method", "all")
+    assert out.returncode == 0, out.stderr
+    assert "Traceback" not in out.stderr
+    assert (tmp_path / "beam.png").stat().st_size > 10_000
+    back = run("modal", "fit", tmp_path / "beam.h5", "--json")
+    assert back.returncode == 0, back.stderr
+    assert '"n_channels": 3' in back.stdout
+    one = run("modal", "fit", *REAL, "--frequency-step", "1", "--kind", "accelerance", "--channel", "1",
+              "--plot", tmp_path / "ch1.png")
+    assert one.returncode == 0, one.stderr
+
+
+# ---- item 2: every archive holding an FRF is an input; others get a clear error ------------------------------
+
+def test_scene_archive_is_an_frf_input(tmp_path):
+    archive = tmp_path / "demo.h5"
+    out = run("balancer", "run", ROOT / "data" / "synthetic" / "demo_scene.toml", "--out", archive,
+              "--plots", tmp_path / "plots", cwd=tmp_path)
+    assert out.returncode == 0, out.stderr
+    frf = read_frf(archive)
+    assert frf.n_channels == 1 and frf.kind == "accelerance"
+    fit = run("modal", "fit", archive)
+    assert fit.returncode == 0, fit.stderr
+    assert "1 channel(s)" in fit.stdout
+
+
+def test_archive_without_frf_says_what_it_holds(tmp_path):
+    from modal.archive import write_archive
+
+    result = _identify(_three_channel(n_channels=1))
+    path = write_archive(tmp_path / "results.h5", {"identify": result, "speed_rpm": 1500.0})
+    with pytest.raises(FormatError, match=r"holds no FRF \(it holds identify \(IdentificationResult\), speed_rpm"):
+        read_frf(path)
+    out = run("modal", "fit", path)
+    assert out.returncode == 1 and out.stderr.startswith("error: ") and "holds no FRF" in out.stderr
