@@ -39,6 +39,7 @@ _COMPRESS_BYTES = 16384  # gzip+shuffle only where it pays: arrays above 16 kB
 
 # longest suffix first
 _UNIT_SUFFIXES = [
+    ("_per_s", "1/s"), ("_per_m", "1/m"),
     ("_n_s_per_m", "N s/m"), ("_n_m_s", "N m s"), ("_n_per_m", "N/m"), ("_kg_m2", "kg m^2"), ("_kg_m", "kg m"),
     ("_rad_s", "rad/s"), ("_m_s", "m/s"), ("_hz", "Hz"), ("_rpm", "rpm"), ("_kg", "kg"), ("_rad", "rad"),
     ("_deg", "deg"), ("_mm", "mm"), ("_pa", "Pa"), ("_mpa", "MPa"), ("_n_m", "N m"), ("_w", "W"), ("_kw", "kW"),
@@ -46,12 +47,30 @@ _UNIT_SUFFIXES = [
 ]
 
 
+#: Units of names that carry no unit suffix (the toolkit's conventions; "1" = dimensionless).
+_NAMED_UNITS = {
+    "modal_constant": "1/kg",  # receptance modal constant, whatever the FRF kind
+    "damping_ratio": "1", "chi2": "1", "quality": "1", "mpc": "1", "lines_per_bandwidth": "1",
+    "mode_shape": "1", "participation": "1", "coherence": "1", "multiple_coherence": "1",
+    "rtol": "1", "atol": "1", "settle_tolerance": "1", "balance_fraction": "1", "reduction": "1",
+    "efficiency": "1", "slip": "1", "fraction": "1", "mac": "1", "order": "1", "orders": "1", "harmonics": "1",
+}
+
+
 def units_of(name: str) -> str | None:
-    """Unit implied by a field name's suffix (``stiffness_n_per_m`` → ``N/m``), or None."""
+    """Unit implied by a field name (``stiffness_n_per_m`` → ``N/m``, ``damping_ratio`` → ``1``), or None.
+
+    Suffixes first (longest first), then the names of :data:`_NAMED_UNITS`, then
+    counts (``n_…``) and ratios (``…_ratio``), which are dimensionless.
+    """
     lower = name.lower()
-    for suffix, unit in _UNIT_SUFFIXES:
+    if lower in _NAMED_UNITS:
+        return _NAMED_UNITS[lower]
+    for suffix, unit in sorted(_UNIT_SUFFIXES, key=lambda item: -len(item[0])):  # longest first
         if lower.endswith(suffix):
             return unit
+    if lower.startswith("n_") or lower.endswith(("_ratio", "_fraction", "_count")):
+        return "1"
     return None
 
 
@@ -68,14 +87,22 @@ class Archive:
         return self.items[name]
 
 
-def _set_units(node, name: str) -> None:
-    unit = units_of(name)
+def _set_units(node, name: str, unit: str | None = None) -> None:
+    """``units`` attribute: the explicit unit, else the name's, else "1" for integers and booleans
+    (counts, indices, orders, flags)."""
+    unit = unit or units_of(name)
+    if unit is None and node.dtype.kind in "biu":
+        unit = "1"
     if unit is not None:
         node.attrs["units"] = unit
 
 
-def write_node(parent: h5py.Group, name: str, obj: Any) -> None:
-    """Write ``obj`` as child ``name`` of ``parent`` (recursively)."""
+def write_node(parent: h5py.Group, name: str, obj: Any, unit: str | None = None) -> None:
+    """Write ``obj`` as child ``name`` of ``parent`` (recursively).
+
+    ``unit`` overrides the unit derived from the name (a dataclass's ``archive_units()``);
+    the items of a tuple, list or dict take the unit of the container (or of their key).
+    """
     from .frf import FRF
 
     if isinstance(obj, FRF):
@@ -90,7 +117,7 @@ def write_node(parent: h5py.Group, name: str, obj: Any) -> None:
         group.attrs["__class__"] = f"{cls.__module__}:{cls.__qualname__}"
         explicit = obj.archive_units() if callable(getattr(obj, "archive_units", None)) else {}
         for f in dataclasses.fields(obj):
-            write_node(group, f.name, getattr(obj, f.name))
+            write_node(group, f.name, getattr(obj, f.name), unit=explicit.get(f.name))
             if f.name in explicit and isinstance(group[f.name], h5py.Dataset):
                 group[f.name].attrs["units"] = explicit[f.name]  # units the field name cannot say
         return
@@ -100,17 +127,18 @@ def write_node(parent: h5py.Group, name: str, obj: Any) -> None:
     if isinstance(obj, (bool, np.bool_)):
         ds = parent.create_dataset(name, data=np.bool_(obj))
         ds.attrs["__type__"] = "bool"
+        ds.attrs["units"] = "1"
         return
     if isinstance(obj, (int, float, complex)) and not isinstance(obj, np.generic):
         kind = type(obj).__name__
         ds = parent.create_dataset(name, data=obj)
         ds.attrs["__type__"] = kind
-        _set_units(ds, name)
+        _set_units(ds, name, unit)
         return
     if isinstance(obj, np.generic):
         ds = parent.create_dataset(name, data=obj)
         ds.attrs["__type__"] = "npscalar"
-        _set_units(ds, name)
+        _set_units(ds, name, unit)
         return
     if isinstance(obj, str):
         ds = parent.create_dataset(name, data=obj, dtype=h5py.string_dtype())
@@ -128,14 +156,14 @@ def write_node(parent: h5py.Group, name: str, obj: Any) -> None:
             kwargs = {"compression": "gzip", "compression_opts": 4, "shuffle": True}
         ds = parent.create_dataset(name, data=obj, **kwargs)
         ds.attrs["__type__"] = "ndarray"
-        _set_units(ds, name)
+        _set_units(ds, name, unit)
         return
     if isinstance(obj, (tuple, list)):
         group = parent.create_group(name)
         group.attrs["__type__"] = type(obj).__name__
         group.attrs["__len__"] = len(obj)
         for i, item in enumerate(obj):
-            write_node(group, str(i), item)
+            write_node(group, str(i), item, unit=unit or units_of(name))
         return
     if isinstance(obj, dict):
         group = parent.create_group(name)
@@ -143,7 +171,7 @@ def write_node(parent: h5py.Group, name: str, obj: Any) -> None:
         for i, (key, item) in enumerate(obj.items()):
             if not isinstance(key, str):
                 raise ArchiveError(f"archive: dict '{name}' has a key of type {type(key).__name__}; expected str")
-            write_node(group, f"k{i}", item)
+            write_node(group, f"k{i}", item, unit=units_of(key))
             group[f"k{i}"].attrs["__key__"] = key
         return
     raise ArchiveError(f"archive: cannot store field '{name}' of type {type(obj).__name__}")

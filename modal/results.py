@@ -172,6 +172,13 @@ class IdentificationResult:
     stabilisation: Any = None
     settings: dict = field(default_factory=dict)
 
+    def archive_units(self) -> dict[str, str]:
+        """Units of the fields whose names do not say them (for :mod:`modal.archive`)."""
+        from .frf import DEFAULT_UNITS
+
+        return {"noise_std": DEFAULT_UNITS[self.kind], "n_channels": "1",
+                "residuals": "m/N (column 0: upper residual), 1/kg (column 1: lower residual)"}
+
     def synthesize(self, frequency_hz) -> "FRF":
         """The identified model (modes, plus residual terms where fitted) as an FRF on any axis.
 

@@ -103,15 +103,35 @@ def test_method_all_draws_every_method():
         assert any(method in label for label in labels)
 
 
-# ---- items 1 + 2 on the real beam: fit with --plot and --archive in one command, read the archive back ----------
+# ---- every archive the toolkit writes (items 1, 2, 4) ---------------------------------------------------------
 
-def test_real_beam_plot_archive_and_read_back(tmp_path):
-    out = run("modal", "fit", *REAL, "--frequency-step", "1", "--kind", "accelerance",
-              "--plot", tmp_path / "beam.png", "--archive", tmp_path / "beam.h5", "--method", "all")
-    assert out.returncode == 0, out.stderr
-    assert "Traceback" not in out.stderr
-    assert (tmp_path / "beam.png").stat().st_size > 10_000
-    back = run("modal", "fit", tmp_path / "beam.h5", "--json")
+@pytest.fixture(scope="module")
+def archives(tmp_path_factory):
+    """Run every command that writes an archive, once, as a user would (subprocesses)."""
+    out = tmp_path_factory.mktemp("archives")
+    beam = [*REAL, "--frequency-step", "1", "--kind", "accelerance"]
+    uff = ROOT / "data" / "real" / "pyuff_MPSTD_Set001_2024_10_08_10_27_07.uff"
+    commands = {
+        "fit_all.h5": ("modal", "fit", *beam, "--method", "all", "--plot", out / "beam.png",
+                       "--archive", out / "fit_all.h5"),
+        "fit_global.h5": ("modal", "fit", *beam, "--method", "global", "--archive", out / "fit_global.h5"),
+        "estimate.h5": ("modal", "frf", uff, "--excitation", "4", "--out", out / "estimate.h5"),
+        "demo.h5": ("balancer", "run", ROOT / "data" / "synthetic" / "demo_scene.toml", "--out", out / "demo.h5",
+                    "--plots", out / "demo_plots"),
+        "balance.h5": ("balancer", "run", ROOT / "data" / "synthetic" / "balance_scene.toml",
+                       "--out", out / "balance.h5", "--plots", out / "balance_plots"),
+    }
+    for name, (module, *args) in commands.items():
+        done = run(module, *args, cwd=out)
+        assert done.returncode == 0, f"{name}: {done.stderr}"
+        assert "Traceback" not in done.stderr
+    return out
+
+
+def test_real_beam_plot_archive_and_read_back(archives, tmp_path):
+    """The three real beam files fitted with --plot and --archive in one command; the archive read back."""
+    assert (archives / "beam.png").stat().st_size > 10_000
+    back = run("modal", "fit", archives / "fit_all.h5", "--json")
     assert back.returncode == 0, back.stderr
     assert '"n_channels": 3' in back.stdout
     one = run("modal", "fit", *REAL, "--frequency-step", "1", "--kind", "accelerance", "--channel", "1",
@@ -119,18 +139,33 @@ def test_real_beam_plot_archive_and_read_back(tmp_path):
     assert one.returncode == 0, one.stderr
 
 
-# ---- item 2: every archive holding an FRF is an input; others get a clear error ------------------------------
-
-def test_scene_archive_is_an_frf_input(tmp_path):
-    archive = tmp_path / "demo.h5"
-    out = run("balancer", "run", ROOT / "data" / "synthetic" / "demo_scene.toml", "--out", archive,
-              "--plots", tmp_path / "plots", cwd=tmp_path)
-    assert out.returncode == 0, out.stderr
+def test_scene_archive_is_an_frf_input(archives):
+    archive = archives / "demo.h5"
     frf = read_frf(archive)
     assert frf.n_channels == 1 and frf.kind == "accelerance"
     fit = run("modal", "fit", archive)
     assert fit.returncode == 0, fit.stderr
     assert "1 channel(s)" in fit.stdout
+
+
+def test_every_number_in_every_archive_has_units(archives):
+    import h5py
+
+    missing, files = [], sorted(archives.glob("*.h5"))
+    assert len(files) == 5
+    for path in files:
+        with h5py.File(path, "r") as f:
+            def visit(name, node, path=path):
+                if isinstance(node, h5py.Dataset) and node.dtype.kind in "biufc" and "units" not in node.attrs:
+                    missing.append(f"{path.name}:{name}")
+            f.visititems(visit)
+    assert missing == []
+    with h5py.File(archives / "demo.h5", "r") as f:
+        assert f["adb_stability/max_real_part_per_s"].attrs["units"] == "1/s"  # was "s"
+        assert f["identify/modes/0/modal_constant"].attrs["units"] == "1/kg"
+        assert f["identify/modes/0/band_hz/0"].attrs["units"] == "Hz"
+        assert f["rotor/params/k"].attrs["units"] == "N/m" and f["rotor/params/M"].attrs["units"] == "kg"
+        assert f["identify/modes/0/damping_ratio"].attrs["units"] == "1"
 
 
 def test_archive_without_frf_says_what_it_holds(tmp_path):

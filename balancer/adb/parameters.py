@@ -109,6 +109,10 @@ class ADBParameters:
     c: float
     D: float
 
+    def archive_units(self) -> dict[str, str]:
+        """Units of the fields whose names do not say them (for :mod:`modal.archive`)."""
+        return {"M": "kg", "m": "kg", "n": "1", "R": "m", "e": "m", "k": "N/m", "c": "N s/m", "D": "N m s"}
+
     def __post_init__(self) -> None:
         set_ = object.__setattr__
         for name in ("M", "m", "R", "k"):
@@ -336,6 +340,10 @@ class ParameterStd:
     k: float = 0.0
     c: float = 0.0
     M: float = 0.0
+
+    def archive_units(self) -> dict[str, str]:
+        """Units of the fields whose names do not say them (for :mod:`modal.archive`)."""
+        return {"k": "N/m", "c": "N s/m", "M": "kg"}
 
     def __post_init__(self) -> None:
         for name in ("k", "c", "M"):

@@ -429,6 +429,10 @@ class HarmonicResponse:
     base_force_n: np.ndarray
     points_m: np.ndarray
 
+    def archive_units(self) -> dict[str, str]:
+        """Units of the fields whose names do not say them (for :mod:`modal.archive`)."""
+        return {"load": "N (columns 0-2), N m (columns 3-5)", "displacement": "m (columns 0-2), rad (columns 3-5)"}
+
 
 def _points(points_m) -> np.ndarray:
     if points_m is None:

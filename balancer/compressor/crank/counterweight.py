@@ -168,6 +168,10 @@ class OptimalCurve:
     counterweight_radius_m: np.ndarray
     radius_ratio: np.ndarray
 
+    def archive_units(self) -> dict[str, str]:
+        """Units of the fields whose names do not say them (for :mod:`modal.archive`)."""
+        return {"k": "1"}
+
 
 @dataclass(frozen=True)
 class OptimalCounterweight:
@@ -348,6 +352,10 @@ class Counterweight:
     mass_kg: float
     radius_m: float
     radius_ratio: float
+
+    def archive_units(self) -> dict[str, str]:
+        """Units of the fields whose names do not say them (for :mod:`modal.archive`)."""
+        return {"k": "1"}
     rule: str
 
 
@@ -416,6 +424,10 @@ class GridSearchResult:
     counterweight_radius_m: float
     max_force_n: float
     n_evaluations: int
+
+    def archive_units(self) -> dict[str, str]:
+        """Units of the fields whose names do not say them (for :mod:`modal.archive`)."""
+        return {"k": "1"}
 
 
 def grid_search_counterweight(mech: SliderCrank, speed_rpm: float, k_values, radius_values_m,
