@@ -39,6 +39,8 @@ def build_parser() -> argparse.ArgumentParser:
     fit.add_argument("--max-order", dest="max_order", type=int, help="global: highest order of the sweep")
     fit.add_argument("--stabilisation-plot", dest="stabilisation_plot", metavar="OUT.png",
                      help="global: write the stabilisation diagram over the summed FRF")
+    fit.add_argument("--export-uff", dest="export_uff", metavar="OUT.uff",
+                     help="write the mode shapes (UFF 55) and the synthesised FRFs (UFF 58) of the first method")
     fit.add_argument("--band", nargs=2, type=float, action="append", metavar=("FMIN", "FMAX"),
                      help="fitting band of one mode in Hz (repeat for several modes); default: automatic")
     fit.add_argument("--kind", choices=FRF_KINDS, help="FRF kind when the file does not say")
@@ -134,6 +136,11 @@ def _fit(args) -> int:
             for path in save_time_plots(stem.with_name(f"{stem.stem}_estimate{stem.suffix}"), *time_data,
                                         hits_target=stem.with_name(f"{stem.stem}_hits{stem.suffix}")):
                 print(f"plot: {path}", file=sys.stderr)
+    if getattr(args, "export_uff", None):
+        from .global_.export import export_uff
+
+        export_uff(results[0], frf, args.export_uff)
+        print(f"uff: {args.export_uff}", file=sys.stderr)
     if getattr(args, "stabilisation_plot", None):
         if results[0].stabilisation is None:
             raise ModalError("--stabilisation-plot needs --method global")

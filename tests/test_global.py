@@ -215,3 +215,30 @@ def test_stabilisation_plot_draws_every_pole(multi_reference):
     np.testing.assert_allclose(fig.axes[0].lines[1].get_ydata(), np.abs(result.synthesize(noisy.frequency_hz).channels[0]))
     image = plot_mac(result).axes[0].images[0]
     np.testing.assert_allclose(image.get_array(), result.mac())
+
+
+def test_uff_export_of_shapes_and_synthesis(tmp_path, multi_reference):
+    import gc
+
+    import pyuff
+
+    from modal.global_.export import export_uff
+
+    fn, zeta, const, clean, noisy, result = multi_reference
+    path = tmp_path / "modes.uff"
+    export_uff(result, noisy, path)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # pyuff leaves its file handles to the garbage collector
+        uff = pyuff.UFF(str(path))
+        types = list(uff.get_set_types())
+        first = uff.read_sets(0)
+        gc.collect()
+    assert types == [55] * len(result) + [58] * noisy.n_channels
+    # the shape of mode 1 on the first reference's channels (every other channel: references alternate),
+    # on the nodes of the point ids ("0".."11" are bare nodes: z direction), to the 6 digits of ASCII UFF
+    np.testing.assert_allclose(first["r3"], np.asarray(result[0].modal_constant)[0::2], rtol=2e-5, atol=1e-9)
+    wn, z = result[0].omega_n_rad_s, result[0].damping_ratio
+    assert first["eig"] == pytest.approx(complex(-z * wn, wn * np.sqrt(1 - z**2)), rel=1e-5)
+    back = modal.read_frf(path)  # the FRF datasets: the synthesis, readable by the toolkit itself
+    np.testing.assert_allclose(back.response, result.synthesize(back.frequency_hz).channels, rtol=1e-5,
+                               atol=1e-5 * np.abs(back.response).max())
