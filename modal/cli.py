@@ -44,6 +44,10 @@ def build_parser() -> argparse.ArgumentParser:
     fit.add_argument("--band", nargs=2, type=float, action="append", metavar=("FMIN", "FMAX"),
                      help="fitting band of one mode in Hz (repeat for several modes); default: automatic")
     fit.add_argument("--kind", choices=FRF_KINDS, help="FRF kind when the file does not say")
+    fit.add_argument("--driving-point", dest="driving_point", nargs="+", metavar="CHANNEL",
+                     help="the channel(s) measured at the excitation point (0-based index or response point id); "
+                          "k, c, m are given for these only (default: from the point ids in the file, a single "
+                          "channel without ids is assumed to be one)")
     fit.add_argument("--frequency-axis", dest="frequency_axis", choices=["hz", "khz", "rad/s", "cpm", "rpm"],
                      help="unit of the file's frequency column when it does not say")
     fit.add_argument("--frequency-step", dest="frequency_step", type=float, metavar="HZ",
@@ -97,7 +101,9 @@ def _fit(args) -> int:
     options = {k: getattr(args, k) for k in ("modes_hz", "order", "max_order") if getattr(args, k) is not None}
     if options and methods != ["global"]:
         raise ModalError(f"--{next(iter(options)).replace('_', '-')} applies to --method global only")
-    results = [identify(frf, method, bands_hz=args.band, **(options if method == "global" else {}))
+    driving = _driving_channels(frf, args.driving_point) if args.driving_point else None
+    results = [identify(frf, method, bands_hz=args.band, driving_point=driving,
+                        **(options if method == "global" else {}))
                for method in methods]
     points = None
     if frf.response_points is not None:
@@ -152,6 +158,26 @@ def _fit(args) -> int:
         write_archive(args.archive, {"frf": frf, **{f"identify_{r.method}": r for r in results}})
         print(f"archive: {args.archive}", file=sys.stderr)
     return 0
+
+
+def _driving_channels(frf, names: list[str]):
+    """Boolean mask over channels from --driving-point values (indexes or response point ids)."""
+    import numpy as np
+
+    mask = np.zeros(frf.n_channels, bool)
+    points = list(frf.response_points or [])
+    for name in names:
+        if name.lstrip("-").isdigit():
+            index = int(name)
+            if not 0 <= index < frf.n_channels:
+                raise ModalError(f"--driving-point {name}: no such channel; expected 0..{frf.n_channels - 1}")
+        elif name in points:
+            index = points.index(name)
+        else:
+            raise ModalError(f"--driving-point {name}: no channel has that response point; expected a channel index "
+                             f"0..{frf.n_channels - 1}" + (f" or one of {', '.join(points)}" if points else ""))
+        mask[index] = True
+    return mask
 
 
 def _report_estimate(frf) -> None:

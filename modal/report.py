@@ -32,7 +32,7 @@ def format_table(result: IdentificationResult, point_ids: list[str] | None = Non
             std = row["std"]
             A = row["modal_constant"]
             a_text = f"{A.real:.4g}{A.imag:+.3g}j" if np.isfinite(abs(A)) else "n/a"
-            flags = ",".join(f for f in row["flags"] if f != "driving_point_assumed") or "-"
+            flags = ",".join(row["flags"]) or "-"
             lines.append(
                 f"{row['mode']:>4}  {_pm(row['natural_frequency_hz'], std['natural_frequency_hz'], '.6g'):>22}  "
                 f"{_pm(100 * row['damping_ratio'], 100 * std['damping_ratio'], '.4g'):>20}  {a_text:>26}  "

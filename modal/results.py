@@ -231,6 +231,8 @@ class IdentificationResult:
 
     def rows(self) -> list[dict]:
         """One plain dict per mode and channel (JSON-ready; keys as the fields)."""
+        from .flags import channel_flags
+
         out = []
         names = ("modal_constant", "stiffness_n_per_m", "damping_n_s_per_m", "mass_kg")
         for number, mode in enumerate(self.modes, start=1):
@@ -249,7 +251,8 @@ class IdentificationResult:
                 for name in names:
                     row[name] = complex(pick(getattr(mode, name))) if name == "modal_constant" else float(pick(getattr(mode, name)))
                 row["std"] = {f.name: float(pick(getattr(mode.std, f.name))) for f in fields(ModeStd)}
-                row["flags"] = list(mode.flags)
+                row["driving_point"] = bool(pick(mode.driving_point))
+                row["flags"] = channel_flags(mode.flags, row["driving_point"])  # only those that apply here
                 row["band_hz"] = [float(b) for b in mode.band_hz]
                 row["driving_point"] = bool(pick(mode.driving_point))
                 row["chi2"] = float(mode.chi2)

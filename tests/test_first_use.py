@@ -36,10 +36,11 @@ def _three_channel(n_channels=3, seed=3):
 def _identify(frf, method="nls"):
     import warnings
 
-    from modal.errors import QualityWarning
+    from modal.errors import QualityWarning, ResolutionWarning
 
     with warnings.catch_warnings():  # flags are not what these tests are about
         warnings.simplefilter("ignore", QualityWarning)
+        warnings.simplefilter("ignore", ResolutionWarning)
         return identify(frf, method)
 
 
@@ -177,3 +178,90 @@ def test_archive_without_frf_says_what_it_holds(tmp_path):
         read_frf(path)
     out = run("modal", "fit", path)
     assert out.returncode == 1 and out.stderr.startswith("error: ") and "holds no FRF" in out.stderr
+
+
+# ---- item 3: each flag defined once, no result contradicts itself -------------------------------------------
+
+def test_every_flag_has_a_meaning_and_an_action_and_the_docs_table_is_current():
+    from modal.flags import FLAG_ACTION, flags_markdown
+    from modal.results import FLAG_TEXT
+
+    assert set(FLAG_ACTION) == set(FLAG_TEXT)
+    assert all(text.strip() for text in FLAG_ACTION.values())
+    docs = (ROOT / "docs" / "flags.md").read_text()
+    assert docs == flags_markdown(), "docs/flags.md is stale: run `python -m modal.flags > docs/flags.md`"
+
+
+def _all_results():
+    """Results of every method on driving-point, transfer and mixed FRFs, synthetic and real."""
+    frfs = [_three_channel()]  # channel 0 positive constants, others mixed signs; no point ids
+    frfs.append(modal_frf(np.linspace(20, 300, 1201), [80.0, 190.0], [0.02, 0.015], [[1.0, 0.5], [0.3, -0.4]],
+                          kind="mobility", response_points=["1+Z", "2+Z"], reference_points=["1+Z", "1+Z"]))
+    frfs.append(read_frf(REAL, frequency_step=1.0, kind="accelerance"))
+    out = []
+    for frf in frfs:
+        for method in ("nls", "circle", "halfpower", "global"):
+            out.append(_identify(frf, method))
+        out.append(_identify_driving(frf, method="nls"))
+    return out
+
+
+def _identify_driving(frf, method):
+    import warnings
+
+    from modal.errors import QualityWarning, ResolutionWarning
+
+    driving = np.zeros(frf.n_channels, bool)
+    driving[0] = True  # declared: channel 0 is the driving point
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", QualityWarning)
+        warnings.simplefilter("ignore", ResolutionWarning)
+        return identify(frf, method, driving_point=driving)
+
+
+def test_no_result_carries_contradictory_flags():
+    from modal.flags import contradictions
+
+    found = {}
+    n_rows = 0
+    for result in _all_results():
+        for row in result.rows():
+            n_rows += 1
+            bad = contradictions(row)
+            if bad:
+                found[(result.method, row["mode"], row["channel"])] = bad
+    assert n_rows > 50 and found == {}
+
+
+def test_contradictions_are_detected():
+    """The checker itself: the combination the issue reported is caught."""
+    from modal.flags import contradictions
+
+    row = {"flags": ["not_driving_point"], "driving_point": True, "stiffness_n_per_m": 1.0,
+           "damping_n_s_per_m": 1.0, "mass_kg": 1.0}
+    assert contradictions(row) == ["driving_point is true with flag not_driving_point"]
+    row.update(driving_point=False, flags=["complex_mode"])
+    assert len(contradictions(row)) == 4  # the flag and three physical parameters of a transfer channel
+
+
+# ---- item 9: --driving-point, and the assumption shown in the table --------------------------------------------
+
+def test_driving_point_option_and_assumption_in_table(tmp_path):
+    declared = run("modal", "fit", *REAL, "--frequency-step", "1", "--kind", "accelerance", "--driving-point", "0",
+                   "--json")
+    assert declared.returncode == 0, declared.stderr
+    import json
+
+    rows = json.loads(declared.stdout)["modes"]
+    assert {r["channel"] for r in rows if r["driving_point"]} == {0}
+    assert any(r["stiffness_n_per_m"] is not None for r in rows if r["channel"] == 0)
+    assert all(r["stiffness_n_per_m"] is None for r in rows if r["channel"] != 0)
+    bad = run("modal", "fit", *REAL, "--frequency-step", "1", "--kind", "accelerance", "--driving-point", "7")
+    assert bad.returncode == 1 and "--driving-point 7: no such channel" in bad.stderr
+    frf = modal_frf(np.linspace(20, 300, 801), [100.0], [0.02], [1.0], kind="receptance")
+    from modal.io import write_frf
+
+    write_frf(add_noise(frf, 1e-4, seed=2), tmp_path / "plain.csv")  # no point ids: a driving point is assumed
+    table = run("modal", "fit", tmp_path / "plain.csv")
+    assert table.returncode == 0, table.stderr
+    assert "driving_point_assumed" in table.stdout
