@@ -152,3 +152,30 @@ def test_impact_file_fit_with_plots(tmp_path):
     assert plot.exists() and (tmp_path / "fit_estimate.png").exists() and (tmp_path / "fit_hits.png").exists()
     found = sorted({round(row["natural_frequency_hz"], 6) for row in json.loads(out.stdout)["modes"]})
     np.testing.assert_allclose(found, PLANT.natural_frequency_hz, rtol=1e-3)
+
+
+@pytest.mark.parametrize("fmt", ["mat", "hdf5"])
+def test_read_time_from_mat_and_hdf5(tmp_path, fmt):
+    force, resp = _records(n=4096)
+    signals = np.vstack([force, resp])
+    names = ["hammer", "p1", "p2"]
+    if fmt == "mat":
+        from scipy.io import savemat
+
+        path = tmp_path / "rec.mat"
+        savemat(path, {"signals": signals, "sample_rate_hz": FS, "names": np.array(names, dtype=object),
+                       "units": np.array(["N", "mm", "mm"], dtype=object)})
+    else:
+        import h5py
+
+        path = tmp_path / "rec.h5"
+        with h5py.File(path, "w") as fh:
+            ds = fh.create_dataset("signals", data=signals)
+            ds.attrs["names"] = names
+            ds.attrs["units"] = ["N", "mm", "mm"]
+            fh.create_dataset("time", data=np.arange(signals.shape[1]) / FS)
+    record = read_time(path)
+    assert record.names == tuple(names) and record.quantities == ("force", "displacement", "displacement")
+    assert record.sample_rate_hz == pytest.approx(FS, rel=1e-9)
+    np.testing.assert_allclose(record.signals[1], resp[0] * 1e-3, rtol=1e-12)  # mm -> m at the edge
+    assert record.units == ("N", "m", "m")
