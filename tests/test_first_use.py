@@ -326,3 +326,45 @@ def test_write_errors_name_the_target_not_the_temporary(tmp_path, option, name):
         out = run("modal", "fit", tmp_path / "plain.csv", option, target)
         assert out.returncode == 1
         assert out.stderr.startswith(f"error: {target}:") and ".tmp" not in out.stderr, out.stderr
+
+
+# ---- item 5: overflow-scale data -----------------------------------------------------------------------------
+
+@pytest.mark.parametrize("scale", [1e307, 1e-300])
+def test_extreme_scale_fits_like_unit_scale(scale):
+    """Identification is scale-invariant: H*g gives the same poles, A*g and k, c, m / g; no numpy warnings
+    (pytest turns them into errors), no phantom modes."""
+    from modal.frf import FRF
+
+    base = add_noise(modal_frf(np.linspace(10, 400, 1001), [50, 120, 300], [0.01, 0.02, 0.03], [1, 0.5, 2.0],
+                               kind="mobility"), 0.001, seed=1)
+    gain = scale / np.abs(base.response).max()
+    big = FRF(base.frequency_hz, base.response * gain, kind="mobility")
+    for method in ("nls", "circle", "halfpower", "global"):
+        ref, got = _identify(base, method), _identify(big, method)
+        assert len(got) == len(ref)
+        # gain is not a power of two: the data differ by rounding (1e-16 relative), the fits by its effect
+        assert np.allclose([m.natural_frequency_hz for m in got], [m.natural_frequency_hz for m in ref], rtol=1e-9)
+        assert np.allclose([m.damping_ratio for m in got], [m.damping_ratio for m in ref], rtol=1e-6)
+        a_ref = np.array([complex(m.modal_constant) for m in ref])
+        a_got = np.array([complex(m.modal_constant) for m in got]) / gain
+        assert np.allclose(a_got, a_ref, rtol=1e-6, equal_nan=True)
+        assert np.allclose([m.mass_kg * gain for m in got], [m.mass_kg for m in ref], rtol=1e-6,
+                           equal_nan=True)
+
+
+def test_overflow_scale_csv_on_the_command_line(tmp_path):
+    from modal.frf import FRF
+    from modal.io import write_frf
+
+    base = add_noise(modal_frf(np.linspace(10, 400, 1001), [50, 120, 300], [0.01, 0.02, 0.03], [1, 0.5, 2.0],
+                               kind="mobility"), 0.001, seed=1)
+    write_frf(FRF(base.frequency_hz, base.response * (5e306 / np.abs(base.response).max()), kind="mobility"),
+              tmp_path / "big.csv")
+    out = run("modal", "fit", tmp_path / "big.csv", "--json", "--plot", tmp_path / "big.png")
+    assert out.returncode == 0, out.stderr
+    assert "encountered" not in out.stderr and "RuntimeWarning" not in out.stderr  # no bare numpy warnings
+    import json
+
+    modes = json.loads(out.stdout)["modes"]
+    assert [round(m["natural_frequency_hz"]) for m in modes] == [50, 120, 300]  # no phantom mode
