@@ -265,3 +265,64 @@ def test_driving_point_option_and_assumption_in_table(tmp_path):
     table = run("modal", "fit", tmp_path / "plain.csv")
     assert table.returncode == 0, table.stderr
     assert "driving_point_assumed" in table.stdout
+
+
+# ---- item 7: temporaries of killed writers are cleaned, errors name the target ------------------------------------
+
+_WRITER = """
+import sys, time
+from modal.io._atomic import atomic_path
+with atomic_path(sys.argv[1]) as tmp:
+    tmp.write_bytes(b"half an archive")
+    print(tmp, flush=True)
+    time.sleep(60)
+"""
+
+
+def _start_writer(target):
+    proc = subprocess.Popen([sys.executable, "-c", _WRITER, str(target)], stdout=subprocess.PIPE, text=True)
+    tmp = Path(proc.stdout.readline().strip())
+    assert tmp.exists() and tmp.parent == target.parent
+    return proc, tmp
+
+
+def test_killed_writer_temporary_is_cleaned_on_the_next_write(tmp_path):
+    import signal
+
+    from modal.archive import read_archive, write_archive
+
+    target = tmp_path / "result.h5"
+    dead, dead_tmp = _start_writer(target)
+    dead.send_signal(signal.SIGKILL)  # kill -9 in the middle of the write
+    dead.wait(timeout=30)
+    dead.stdout.close()
+    assert dead_tmp.exists()  # what the issue saw: the killed writer's temporary is left behind
+    write_archive(target, {"speed_rpm": 1500.0})
+    assert not dead_tmp.exists()  # cleaned by the next write
+    assert read_archive(target)["speed_rpm"] == 1500.0
+    live, live_tmp = _start_writer(target)  # another writer of the same target, still running
+    try:
+        write_archive(target, {"speed_rpm": 1500.0})
+        assert live_tmp.exists()  # a live writer's file is not touched
+    finally:
+        live.kill()
+        live.wait(timeout=30)
+        live.stdout.close()
+    leftovers = sorted(p.name for p in tmp_path.iterdir() if p.name.endswith(".tmp"))
+    assert leftovers == [live_tmp.name]  # killed in turn: the next write cleans it
+    write_archive(target, {"speed_rpm": 1.0})
+    assert not any(p.name.endswith(".tmp") for p in tmp_path.iterdir())
+
+
+@pytest.mark.parametrize("option, name", [("--archive", "out.h5"), ("--plot", "out.png")])
+def test_write_errors_name_the_target_not_the_temporary(tmp_path, option, name):
+    (tmp_path / "a_file").write_text("not a folder")
+    frf = modal_frf(np.linspace(20, 300, 801), [100.0], [0.02], [1.0], kind="receptance")
+    from modal.io import write_frf
+
+    write_frf(frf, tmp_path / "plain.csv")
+    for folder in ("missing", "a_file"):
+        target = tmp_path / folder / name
+        out = run("modal", "fit", tmp_path / "plain.csv", option, target)
+        assert out.returncode == 1
+        assert out.stderr.startswith(f"error: {target}:") and ".tmp" not in out.stderr, out.stderr
