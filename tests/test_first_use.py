@@ -451,3 +451,16 @@ def test_scene_and_cli_share_the_read_options():
     from balancer.scene.schema import choice  # noqa: F401  (the scene accepts every CLI axis unit)
     for unit in axis.choices:
         assert SCHEMA["frf"]["frequency_axis"](unit) == unit
+
+
+# ---- item 9: the README's CLI reference is generated from the parsers ---------------------------------------------
+
+def test_readme_cli_reference_matches_the_parsers():
+    from balancer.cli_synopsis import BEGIN, END, synopsis
+
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    section = readme[readme.index(BEGIN):readme.index(END) + len(END) + 1]
+    assert section == synopsis(), ("README.md's CLI reference is stale: run "
+                                   "`python -m balancer.cli_synopsis --write README.md`")
+    for option in ("--frequency-step", "--driving-point", "--channel", "--archive", "--out", "--grade"):
+        assert f"  {option}" in section  # every option is documented, these among them
