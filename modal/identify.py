@@ -534,6 +534,16 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
         raise TypeError(f"identify() got options {', '.join(sorted(global_options))} that only method='global' takes")
     if method not in METHODS:
         raise IdentificationError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
+    from .scaling import scale_exponent, scaled_frf, unscale_result
+
+    exponent = scale_exponent(frf)
+    if exponent:  # values near over- or underflow: fit 2**e H (exact) and scale the results back
+        gain = 2.0**exponent
+        result = identify(scaled_frf(frf, exponent), method, bands_hz,
+                          noise_std=None if noise_std is None else np.asarray(noise_std, float) * gain,
+                          driving_point=driving_point, min_prominence_db=min_prominence_db, max_modes=max_modes,
+                          **global_options)
+        return unscale_result(result, gain)
     if method == "global":
         from .global_ import identify_global
 

@@ -326,3 +326,128 @@ def test_write_errors_name_the_target_not_the_temporary(tmp_path, option, name):
         out = run("modal", "fit", tmp_path / "plain.csv", option, target)
         assert out.returncode == 1
         assert out.stderr.startswith(f"error: {target}:") and ".tmp" not in out.stderr, out.stderr
+
+
+# ---- item 5: overflow-scale data -----------------------------------------------------------------------------
+
+@pytest.mark.parametrize("scale", [1e307, 1e-300])
+def test_extreme_scale_fits_like_unit_scale(scale):
+    """Identification is scale-invariant: H*g gives the same poles, A*g and k, c, m / g; no numpy warnings
+    (pytest turns them into errors), no phantom modes."""
+    from modal.frf import FRF
+
+    base = add_noise(modal_frf(np.linspace(10, 400, 1001), [50, 120, 300], [0.01, 0.02, 0.03], [1, 0.5, 2.0],
+                               kind="mobility"), 0.001, seed=1)
+    gain = scale / np.abs(base.response).max()
+    big = FRF(base.frequency_hz, base.response * gain, kind="mobility")
+    for method in ("nls", "circle", "halfpower", "global"):
+        ref, got = _identify(base, method), _identify(big, method)
+        assert len(got) == len(ref)
+        # gain is not a power of two: the data differ by rounding (1e-16 relative), the fits by its effect
+        assert np.allclose([m.natural_frequency_hz for m in got], [m.natural_frequency_hz for m in ref], rtol=1e-9)
+        assert np.allclose([m.damping_ratio for m in got], [m.damping_ratio for m in ref], rtol=1e-6)
+        a_ref = np.array([complex(m.modal_constant) for m in ref])
+        a_got = np.array([complex(m.modal_constant) for m in got]) / gain
+        assert np.allclose(a_got, a_ref, rtol=1e-6, equal_nan=True)
+        assert np.allclose([m.mass_kg * gain for m in got], [m.mass_kg for m in ref], rtol=1e-6,
+                           equal_nan=True)
+
+
+def test_overflow_scale_csv_on_the_command_line(tmp_path):
+    from modal.frf import FRF
+    from modal.io import write_frf
+
+    base = add_noise(modal_frf(np.linspace(10, 400, 1001), [50, 120, 300], [0.01, 0.02, 0.03], [1, 0.5, 2.0],
+                               kind="mobility"), 0.001, seed=1)
+    write_frf(FRF(base.frequency_hz, base.response * (5e306 / np.abs(base.response).max()), kind="mobility"),
+              tmp_path / "big.csv")
+    out = run("modal", "fit", tmp_path / "big.csv", "--json", "--plot", tmp_path / "big.png")
+    assert out.returncode == 0, out.stderr
+    assert "encountered" not in out.stderr and "RuntimeWarning" not in out.stderr  # no bare numpy warnings
+    import json
+
+    modes = json.loads(out.stdout)["modes"]
+    assert [round(m["natural_frequency_hz"]) for m in modes] == [50, 120, 300]  # no phantom mode
+
+
+# ---- item 6: scenes say which mode they used and refuse flagged ones; one option vocabulary ----------------------
+
+_BEAM_SCENE = """
+[scene]
+name = "beam"
+
+[frf]
+file = "{file}"
+frequency_step = 1.0        # the option of `modal fit --frequency-step`, same name
+kind = "accelerance"
+
+[identify]
+method = "nls"
+{accept}
+
+[rotor]
+M = "identified:mode{mode}.mass"
+k = "identified:mode{mode}.stiffness"
+c = "identified:mode{mode}.damping"
+e = 0.0005
+mass_includes_balls = false
+
+[adb]
+m = 0.02
+n = 2
+R = 0.05
+D = 0.001
+
+[outputs]
+tables = ["identify", "rotor"]
+archive = true
+"""
+
+
+def _beam_scene(tmp_path, mode, accept=""):
+    path = tmp_path / f"beam_{mode}_{bool(accept)}.toml"
+    path.write_text(_BEAM_SCENE.format(file=REAL[0].as_posix(), mode=mode, accept=accept))
+    return path
+
+
+def _beam_flags():
+    frf = read_frf(REAL[0], frequency_step=1.0, kind="accelerance")
+    from modal.flags import INFORMATIONAL
+
+    return [sorted(set(m.flags) - INFORMATIONAL) for m in _identify(frf)]
+
+
+def test_scene_refuses_a_flagged_mode_and_says_which_mode_it_used(tmp_path):
+    flags = _beam_flags()
+    flagged = next(i for i, f in enumerate(flags) if f) + 1
+    refused = run("balancer", "run", _beam_scene(tmp_path, flagged), "--out", tmp_path / "a.h5", cwd=tmp_path)
+    assert refused.returncode == 1, refused.stderr
+    assert f"mode {flagged} (" in refused.stderr and "is flagged" in refused.stderr
+    assert "identify.accept_flagged = true" in refused.stderr
+    accepted = run("balancer", "run", _beam_scene(tmp_path, flagged, "accept_flagged = true"),
+                   "--out", tmp_path / "b.h5", cwd=tmp_path)
+    assert accepted.returncode == 0, accepted.stderr
+    assert f"k = 'identified:mode{flagged}.stiffness' (mode {flagged} at " in accepted.stdout
+    assert "(accepted: identify.accept_flagged)" in accepted.stdout
+    clean = [i + 1 for i, f in enumerate(flags) if not f]
+    if clean:  # a clean mode runs without the explicit choice and names itself
+        ok = run("balancer", "run", _beam_scene(tmp_path, clean[0]), "--out", tmp_path / "c.h5", cwd=tmp_path)
+        assert ok.returncode == 0, ok.stderr
+        assert f"(mode {clean[0]} at " in ok.stdout and "flags: none" in ok.stdout
+
+
+def test_scene_and_cli_share_the_read_options():
+    """Every read option of `modal fit` is a key of a scene's [frf] table, under the same name."""
+    from balancer.scene.schema import SCHEMA
+    from balancer.scene.stages import FRF_READ_OPTIONS
+    from modal.cli import build_parser
+
+    fit = build_parser()._subparsers._group_actions[0].choices["fit"]
+    cli = {a.dest for a in fit._actions} & {"kind", "frequency_axis", "frequency_step", "frequency_start", "layout",
+                                            "delimiter", "decimal", "dataset"}
+    assert cli == set(FRF_READ_OPTIONS) and cli <= set(SCHEMA["frf"])
+    axis = next(a for a in fit._actions if a.dest == "frequency_axis")
+    assert set(axis.choices) <= {"hz", "khz", "rad/s", "cpm", "rpm"}
+    from balancer.scene.schema import choice  # noqa: F401  (the scene accepts every CLI axis unit)
+    for unit in axis.choices:
+        assert SCHEMA["frf"]["frequency_axis"](unit) == unit

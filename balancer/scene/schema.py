@@ -159,7 +159,9 @@ SCHEMA: dict[str, Any] = {
     "scene": {"name": STR, "description": STR},
     "frf": {
         "file": STR, "kind": choice("receptance", "mobility", "accelerance"),
-        "frequency_axis": choice("hz", "rad/s", "cpm"),
+        # the read options of `python -m modal fit`, under the same names
+        "frequency_axis": choice("hz", "khz", "rad/s", "cpm", "rpm"), "frequency_step": POS,
+        "frequency_start": NONNEG, "layout": STR, "delimiter": STR, "decimal": STR, "dataset": INT,
         "synthetic": {
             "natural_frequency_hz": list_of(POS), "damping_ratio": list_of(NONNEG),
             "modal_constant": list_of(complex_value), "kind": choice("receptance", "mobility", "accelerance"),
@@ -168,7 +170,7 @@ SCHEMA: dict[str, Any] = {
     },
     "identify": {
         "method": choice("nls", "circle", "halfpower"), "bands_hz": list_of(list_of(NONNEG, length=2)),
-        "channel": INT, "min_prominence_db": POS, "max_modes": INT,
+        "channel": INT, "min_prominence_db": POS, "max_modes": INT, "accept_flagged": BOOL,
     },
     "rotor": {
         "M": ref_or(POS, ("identified",)), "k": ref_or(POS), "c": ref_or(NONNEG, ("identified",)), "e": NONNEG,

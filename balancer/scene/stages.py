@@ -77,7 +77,27 @@ class MountsStage:
     comparison: object  # balancer.mounts.BalancingComparison
 
 
+#: [frf] keys passed to modal.io.read_frf: the read options of ``python -m modal fit`` under the same names
+FRF_READ_OPTIONS = ("kind", "frequency_axis", "frequency_step", "frequency_start", "layout", "delimiter", "decimal",
+                    "dataset")
+
+
 # ---------------------------------------------------------------- references
+def _serious_flags(mode) -> list[str]:
+    from modal.flags import INFORMATIONAL
+
+    return sorted(set(mode.flags) - INFORMATIONAL)
+
+
+def describe_mode(identified, ref: Reference, scene: Scene) -> str:
+    """Which identified mode a reference used: number, frequency, damping, channel and flags."""
+    mode = identified[ref.mode - 1]
+    flags = _serious_flags(mode)
+    return (f"mode {ref.mode} at {mode.natural_frequency_hz:.6g} Hz, zeta {100 * mode.damping_ratio:.4g} %, "
+            f"channel {_channel(identified, scene)}, flags: {', '.join(flags) or 'none'}"
+            + (" (accepted: identify.accept_flagged)" if flags else ""))
+
+
 def _identified_mode(identified, ref: Reference, key: str, scene: Scene):
     if ref.mode > len(identified):
         raise SceneError(f"{scene.source}: key '{key}' = {ref.text!r}: identification found "
@@ -105,6 +125,12 @@ def resolve(value, key: str, scene: Scene, identified=None, drive=None) -> float
         return value
     if value.source == "identified":
         mode = _identified_mode(identified, value, key, scene)
+        flags = _serious_flags(mode)
+        if flags and not scene.section("identify.accept_flagged", False):
+            raise SceneError(
+                f"{scene.source}: key '{key}' = {value.text!r}: mode {value.mode} ({mode.natural_frequency_hz:.6g} Hz) "
+                f"is flagged ({', '.join(flags)}; see docs/flags.md); expected an unflagged mode: refer to another "
+                f"mode, give identify.bands_hz, or set identify.accept_flagged = true to use it anyway")
         raw = np.atleast_1d(getattr(mode, IDENTIFIED_FIELDS[value.field]))
         number = float(raw[_channel(identified, scene)] if raw.size > 1 else raw[0])
         if not math.isfinite(number):
@@ -124,7 +150,7 @@ def stage_frf(scene: Scene) -> modal.FRF:
     if "file" in cfg:
         from modal.io import read_frf
 
-        hints = {k: cfg[k] for k in ("kind", "frequency_axis") if k in cfg}
+        hints = {k: cfg[k] for k in FRF_READ_OPTIONS if k in cfg}
         return read_frf(scene.folder / cfg["file"], **hints)
     syn = cfg["synthetic"]
     from modal.synthetic import add_noise, modal_frf
@@ -174,7 +200,9 @@ def stage_rotor(scene: Scene, identify=None, drive=None) -> RotorStage:
     for key in ("M", "k", "c"):
         raw = rotor[key]
         values[key] = resolve(raw, f"rotor.{key}", scene, identify, drive)
-        sources.append(f"{key} = {raw.text if isinstance(raw, Reference) else raw!r}")
+        used = (f" ({describe_mode(identify, raw, scene)})"
+                if isinstance(raw, Reference) and raw.source == "identified" else "")
+        sources.append(f"{key} = {raw.text if isinstance(raw, Reference) else raw!r}{used}")
     std = {"k": 0.0, "c": 0.0, "M": 0.0}
     if identify is not None:
         channel = _channel(identify, scene)

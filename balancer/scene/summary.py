@@ -28,7 +28,8 @@ def digest(stage: str, result) -> dict:
         p = result.params
         return {"M_kg": p.M, "m_kg": p.m, "n": p.n, "R_m": p.R, "e_m": p.e, "k_n_per_m": p.k, "c_n_s_per_m": p.c,
                 "D_n_m_s": p.D, "natural_frequency_rad_s": p.natural_frequency_rad_s,
-                "std": {"M_kg": result.std.M, "k_n_per_m": result.std.k, "c_n_s_per_m": result.std.c}}
+                "std": {"M_kg": result.std.M, "k_n_per_m": result.std.k, "c_n_s_per_m": result.std.c},
+                "sources": list(result.sources)}
     if stage == "adb_stability":
         return {"stable_intervals_rad_s": [list(map(float, row)) for row in result.intervals.intervals_rad_s],
                 "stable_intervals_ratio": [list(map(float, row)) for row in result.intervals.intervals_ratio],
@@ -102,7 +103,7 @@ def _table(stage: str, result) -> list[str]:
                 f"(± {_fmt(d['std']['k_n_per_m'], digits=2)}), c = {_fmt(d['c_n_s_per_m'], 'N s/m')} "
                 f"(± {_fmt(d['std']['c_n_s_per_m'], digits=2)}), e = {_fmt(d['e_m'], 'm')}",
                 f"  balls: n = {d['n']}, m = {_fmt(d['m_kg'], 'kg')}, R = {_fmt(d['R_m'], 'm')}, D = {_fmt(d['D_n_m_s'], 'N m s')};"
-                f" ωn = {_fmt(d['natural_frequency_rad_s'], 'rad/s')}"]
+                f" ωn = {_fmt(d['natural_frequency_rad_s'], 'rad/s')}"] + [f"  {s}" for s in d["sources"]]
     if stage == "adb_stability":
         rows = [f"  stable from {lo:.5g} to {hi:.5g} rad/s  (Ω/ωn {rlo:.4f} – {rhi:.4f})"
                 for (lo, hi), (rlo, rhi) in zip(d["stable_intervals_rad_s"], d["stable_intervals_ratio"])]
