@@ -29,8 +29,9 @@ def build_parser() -> argparse.ArgumentParser:
                          description="Identify natural frequency, damping, modal constant and k, c, m of every mode.")
     fit.add_argument("path", nargs="+", help="FRF file(s) (UFF 58/58b, CSV, MAT, HDF5); several files on one "
                      "frequency axis become one multi-channel FRF")
-    fit.add_argument("--method", choices=["nls", "circle", "halfpower", "global", "all"], default="nls",
-                     help="identification method (default: nls, the band-wise least-squares refinement; global: "
+    fit.add_argument("--method", choices=["auto", "nls", "circle", "halfpower", "global", "all"], default="auto",
+                     help="identification method (default: auto = global for poly-reference or many-mode data, "
+                          "else nls, the band-wise least-squares refinement; the output says which ran; global: "
                           "poly-reference LSCF with a stabilisation diagram and a joint refinement of all modes, "
                           "for many modes, channels and references; all: the three band-wise methods)")
     fit.add_argument("--modes-hz", dest="modes_hz", type=float, nargs="+", metavar="HZ",
@@ -99,12 +100,15 @@ def _fit(args) -> int:
     label = args.path[0] if len(args.path) == 1 else f"{args.path[0]} (+{len(args.path) - 1} files)"
     methods = ["nls", "circle", "halfpower"] if args.method == "all" else [args.method]
     options = {k: getattr(args, k) for k in ("modes_hz", "order", "max_order") if getattr(args, k) is not None}
+    if options and methods == ["auto"]:
+        methods = ["global"]  # options of the global method choose it
     if options and methods != ["global"]:
         raise ModalError(f"--{next(iter(options)).replace('_', '-')} applies to --method global only")
     driving = _driving_channels(frf, args.driving_point) if args.driving_point else None
     results = [identify(frf, method, bands_hz=args.band, driving_point=driving,
                         **(options if method == "global" else {}))
                for method in methods]
+    methods = [r.method for r in results]  # what ran ("auto" chooses)
     points = None
     if frf.response_points is not None:
         refs = frf.reference_points or ("?",) * frf.n_channels

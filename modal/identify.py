@@ -451,7 +451,32 @@ def _physical(frf, wn, zeta, const, cov, driving, flags):
     return (k, c, m), (sk, sc, sm)
 
 
-def identify(frf: FRF, method: str = "nls", bands_hz=None, *, noise_std=None, driving_point=None,
+#: automatic choice: the global method for a poly-reference grid or at least this many peaks
+AUTO_GLOBAL_PEAKS = 5
+
+
+def choose_method(frf: FRF, bands_hz=None, min_prominence_db: float = 6.0) -> str:
+    """The method ``identify(frf, "auto")`` runs: ``"global"`` for a poly-reference test (an outputs ×
+    references grid with several references) or at least :data:`AUTO_GLOBAL_PEAKS` peaks (a many-mode
+    measurement, where band-wise fits each see their neighbours only as an offset), else ``"nls"``
+    (one to a few well-separated modes, where it is the Cramér–Rao-efficient choice). Bands given
+    explicitly keep the band-wise method.
+    """
+    if bands_hz is not None:
+        return "nls"
+    from .global_ import channel_grid
+
+    index, _, transposed = channel_grid(frf)
+    if index.shape[1] > 1:
+        return "global"
+    try:
+        peaks = len(find_modes(frf, min_prominence_db=min_prominence_db))
+    except IdentificationError:
+        return "nls"
+    return "global" if peaks >= AUTO_GLOBAL_PEAKS else "nls"
+
+
+def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, driving_point=None,
              min_prominence_db: float = 6.0, max_modes: int | None = None, **global_options) -> IdentificationResult:
     """Identify every mode of an FRF.
 
@@ -459,8 +484,11 @@ def identify(frf: FRF, method: str = "nls", bands_hz=None, *, noise_std=None, dr
     ----------
     frf : FRF
         One or many channels (poles are shared by all channels).
-    method : {"nls", "circle", "halfpower", "global"}
-        ``"nls"`` (default): complex nonlinear least squares of all modes
+    method : {"auto", "nls", "circle", "halfpower", "global"}
+        ``"auto"`` (default): ``"global"`` for poly-reference or many-mode
+        data, else ``"nls"`` (:func:`choose_method`); ``result.method`` says
+        which ran.
+        ``"nls"``: complex nonlinear least squares of all modes
         together, started from the better of half-power and circle fit.
         ``"global"``: poly-reference LSCF (PolyMAX) poles with a stabilisation
         diagram, then a joint refinement of all poles, modal constants and
@@ -500,6 +528,8 @@ def identify(frf: FRF, method: str = "nls", bands_hz=None, *, noise_std=None, dr
     """
     if not isinstance(frf, FRF):
         raise TypeError(f"identify() expects a modal.FRF, got {type(frf).__name__}")
+    if method == "auto":
+        method = choose_method(frf, bands_hz, min_prominence_db)
     if global_options and method != "global":
         raise TypeError(f"identify() got options {', '.join(sorted(global_options))} that only method='global' takes")
     if method not in METHODS:

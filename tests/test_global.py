@@ -198,7 +198,8 @@ def test_cli_global_on_the_real_beam_with_a_stabilisation_plot(tmp_path):
     assert all(np.min(np.abs(found / f - 1)) < 5e-4 for f in BEAM_HZ)
     assert plot.exists()
     wrong = subprocess.run([sys.executable, "-m", "modal", "fit", *map(str, paths), "--frequency-step", "1", "--kind",
-                            "accelerance", "--order", "30"], capture_output=True, text=True, cwd=ROOT, timeout=120)
+                            "accelerance", "--method", "nls", "--order", "30"], capture_output=True, text=True, cwd=ROOT,
+                           timeout=120)
     assert wrong.returncode == 1 and "--order applies to --method global only" in wrong.stderr
 
 
@@ -242,3 +243,20 @@ def test_uff_export_of_shapes_and_synthesis(tmp_path, multi_reference):
     back = modal.read_frf(path)  # the FRF datasets: the synthesis, readable by the toolkit itself
     np.testing.assert_allclose(back.response, result.synthesize(back.frequency_hz).channels, rtol=1e-5,
                                atol=1e-5 * np.abs(back.response).max())
+
+
+def test_automatic_choice_of_method(multi_reference):
+    from modal.identify import choose_method
+
+    *_, noisy, _ = multi_reference
+    assert choose_method(noisy) == "global"  # a poly-reference grid
+    assert _fit_auto(noisy.channel(0)).method == "global"  # one channel, 14 peaks: many modes
+    few = modal.modal_frf(np.linspace(10, 200, 800), [50.0, 120.0], [0.02, 0.01], [1.0, 0.5])
+    assert _fit_auto(few).method == "nls"  # two well-separated modes: the band-wise fit
+    assert choose_method(noisy, bands_hz=[(190, 210)]) == "nls"  # bands given: band-wise
+
+
+def _fit_auto(frf):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", modal.ModalWarning)
+        return modal.identify(frf)
