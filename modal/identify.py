@@ -528,11 +528,9 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
     """
     if not isinstance(frf, FRF):
         raise TypeError(f"identify() expects a modal.FRF, got {type(frf).__name__}")
-    if method == "auto":
-        method = choose_method(frf, bands_hz, min_prominence_db)
-    if global_options and method != "global":
+    if global_options and method not in ("global", "auto"):
         raise TypeError(f"identify() got options {', '.join(sorted(global_options))} that only method='global' takes")
-    if method not in METHODS:
+    if method not in METHODS and method != "auto":
         raise IdentificationError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
     from .scaling import scale_exponent, scaled_frf, unscale_result
 
@@ -544,6 +542,8 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
                           driving_point=driving_point, min_prominence_db=min_prominence_db, max_modes=max_modes,
                           **global_options)
         return unscale_result(result, gain)
+    if method == "auto":  # chosen on the (possibly rescaled) data, so the choice never overflows
+        method = "global" if global_options else choose_method(frf, bands_hz, min_prominence_db)
     if method == "global":
         from .global_ import identify_global
 

@@ -260,3 +260,16 @@ def _fit_auto(frf):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", modal.ModalWarning)
         return modal.identify(frf)
+
+
+def test_no_phantom_mode_on_the_tail_of_a_wide_mode():
+    """One channel, three modes, 0.1 % noise: a pLSCF pole on the tail of the 300 Hz mode passed the
+    significance test at its pLSCF value, then shrank onto a noise spike in the joint fit (statistic 1.9 and
+    9.2 against the 1e-6 quantile 13.8 for seeds 1 and 7). The refined poles are tested again; a mode that
+    only fits noise passes once in 10⁶, so over 12 seeds exactly the three modes are expected."""
+    f = np.linspace(10, 400, 1001)
+    clean = modal.modal_frf(f, [50, 120, 300], [0.01, 0.02, 0.03], [1, 0.5, 2.0], kind="mobility")
+    for seed in range(12):
+        result = _fit(modal.add_noise(clean, 0.001, seed=seed))
+        assert len(result) == 3, (seed, [m.natural_frequency_hz for m in result])
+        assert np.allclose([m.natural_frequency_hz for m in result], [50, 120, 300], rtol=1e-3)
