@@ -17,6 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import IdentificationError, QualityWarning, ResolutionWarning, warn
+from ..flags import CHI2_LIMIT, RELATIVE_MISFIT
 from ..frf import FRF, KIND_POWER
 from ..model import mode_basis, solve_linear
 from ..nls import fit_modes
@@ -28,8 +29,6 @@ from .stabilisation import select_poles, stabilisation
 
 __all__ = ["identify_global", "channel_grid", "mpc"]
 
-#: chi-square above which the model is flagged (as for the band-wise methods)
-CHI2_LIMIT = 3.0
 #: relative standard error of ζ above which a mode is flagged high_uncertainty
 REL_STD_LIMIT = 0.1
 #: poles up to this factor above the highest line enter the model (flagged outside_band): a mode just above
@@ -37,8 +36,6 @@ REL_STD_LIMIT = 0.1
 BEYOND_BAND = 1.25
 #: a selected pole stable (in frequency) in fewer than this fraction of the swept orders has weak evidence
 WEAK_FRACTION = 0.5
-#: relative misfit near a mode above which (with chi-square above CHI2_LIMIT) it is flagged model_inadequate
-RELATIVE_MISFIT = 0.05
 #: modal overlap 2·max(ζωn)/|Δωn| above which two modes are flagged close_modes (as band-wise)
 OVERLAP_LIMIT = 1.5
 #: MPC below which a mode's shape counts as complex
