@@ -82,7 +82,7 @@ class _Plan:
     right: tuple | None
 
 
-def _peak_fit(omega, lo, hi, power):
+def _peak_fit(omega, lo, hi):
     """Design of the least-squares quadratic in ω² through lines lo..hi (pseudo-inverse, scale)."""
     u = omega[lo:hi + 1] ** 2
     scale = u[len(u) // 2]
@@ -95,7 +95,7 @@ def _peak_values(omega, mag, plan: _Plan, power: int):
     if plan.peak_lines is None:
         return np.full(mag.shape[0], omega[i] ** 2), mag[:, i] ** 2
     lo, hi = plan.peak_lines
-    pinv, u, scale = _peak_fit(omega, lo, hi, power)
+    pinv, u, scale = _peak_fit(omega, lo, hi)
     g = u**power / mag[:, lo:hi + 1] ** 2
     coef = g @ pinv.T
     a, b, c = coef[:, 0] / scale**2, coef[:, 1] / scale, coef[:, 2]
@@ -317,7 +317,7 @@ def _plan(omega, mag, db, power, i, peak_lines, noise_std, model=None):
     decide whether it enters (selecting on the noisy dB trims the noise the fit sees).
     """
     n = mag.size
-    u_peak, peak2 = (float(v[0]) for v in _peak_values(omega, mag[None, :], _Plan(i, peak_lines, None, None), power))
+    _, peak2 = (float(v[0]) for v in _peak_values(omega, mag[None, :], _Plan(i, peak_lines, None, None), power))
     level = np.sqrt(peak2 / 2)
     level_db = 10 * np.log10(peak2 / 2)
     lo = i

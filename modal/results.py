@@ -313,17 +313,9 @@ def physical_parameters(omega_n, damping_ratio, modal_constant, cov=None):
     if cov is None:
         nan = np.full(A.shape, np.nan)
         return (k, c, m), (nan, nan.copy(), nan.copy())
-    with np.errstate(divide="ignore", invalid="ignore"):
-        da_dre, da_dim = A.real / a, A.imag / a
-        # gradients with respect to (ωn, ζ, Re A, Im A)
-        zeros = np.zeros(A.shape)
-        g_m = np.stack([zeros, zeros, -m**2 * da_dre, -m**2 * da_dim], axis=-1)
-        g_k = np.stack([2 * m * omega_n + zeros, zeros, -k * m * da_dre, -k * m * da_dim], axis=-1)
-        g_c = np.stack([2 * damping_ratio * m + zeros, 2 * m * omega_n + zeros,
-                        -c * m * da_dre, -c * m * da_dim], axis=-1)
-
     cov_kcm = physical_covariance(omega_n, damping_ratio, A, cov)
-    diag = np.sqrt(np.maximum(np.diagonal(cov_kcm, axis1=-2, axis2=-1), 0.0))
+    with np.errstate(invalid="ignore"):
+        diag = np.sqrt(np.maximum(np.diagonal(cov_kcm, axis1=-2, axis2=-1), 0.0))
     return (k, c, m), (diag[..., 0], diag[..., 1], diag[..., 2])
 
 
