@@ -4,7 +4,10 @@ Usage::
 
     python -m benchmarks [--quick] [--runs N] [--trials N] [--only NAME ...] [--out PATH]
 
-Runs, in order: identification against the Cramér–Rao bound over damping, noise
+Runs, in order: the five speed ratios of issue 19 (``bench_speed``: SDOF identify
+against a bare least-squares fit, 1000 channels against sdypy-EMA, the stability map
+against numpy's eigenvalues, the demo scene against the import floor, a 100 000-line
+noisy FRF against a minute), identification against the Cramér–Rao bound over damping, noise
 and resolution (``bench_identify``), 1 and 1000 channels, file reading
 (``bench_io``), the counterweight optimiser against brute-force grids
 (``bench_crank``), the ball-balancer stability map and simulations against plain
@@ -449,13 +452,27 @@ def stress_summary() -> str:
     return f"From docs/stress.md (run with `.venv/bin/python -m pytest -m stress`):\n\n{section}"
 
 
+# --------------------------------------------------------------------------- speed ratios
+def speed_section(runs: int, quick: bool) -> str:
+    """The five ratios of issue 19 (``benchmarks.bench_speed``), also printed to stdout."""
+    from benchmarks import bench_speed
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        results = bench_speed.run(sorted(bench_speed.GOALS), 3 if quick else runs, 60.0 if quick else 180.0)
+    text = bench_speed.table(results)
+    print(machine_section() + "\n\n" + text, flush=True)
+    return ("`python -m benchmarks.bench_speed` (each ratio measured in this run; goal 2's peer is the optional "
+            "`bench` extra):\n\n" + text)
+
+
 # --------------------------------------------------------------------------- main
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m benchmarks", description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="small sizes (a smoke run of a minute or two)")
     parser.add_argument("--runs", type=int, default=5, help="repetitions for every median (default 5)")
     parser.add_argument("--trials", type=int, default=50, help="noise trials per SDOF grid cell (default 50)")
-    parser.add_argument("--only", nargs="+", choices=["identify", "global", "estimate", "io", "crank", "adb",
+    parser.add_argument("--only", nargs="+", choices=["speed", "identify", "global", "estimate", "io", "crank", "adb",
                                                       "influence", "batch", "demo"],
                         help="run only these sections")
     parser.add_argument("--out", type=Path, default=HERE / "REPORT.md", help="report file (default benchmarks/REPORT.md)")
@@ -469,7 +486,8 @@ def main(argv: list[str] | None = None) -> int:
         args.out.write_text(head + "\n## Stress run\n\n" + stress_summary() + "\n", encoding="utf-8")
         print(f"[benchmarks] refreshed the stress section of {args.out}", file=sys.stderr)
         return 0
-    wanted = set(args.only or ["identify", "global", "estimate", "io", "crank", "adb", "influence", "batch", "demo"])
+    wanted = set(args.only or ["speed", "identify", "global", "estimate", "io", "crank", "adb", "influence", "batch",
+                               "demo"])
     runs = max(1, args.runs)
     started = time.perf_counter()
     plots: list[str] = []
@@ -487,6 +505,8 @@ def main(argv: list[str] | None = None) -> int:
             status.append(f"{key}: FAILED")
         sections.append((title, body))
 
+    if "speed" in wanted:
+        section("Speed against the floor: the five ratios of issue 19", lambda: speed_section(runs, args.quick), "bench_speed")
     if "identify" in wanted:
         section("Identification: methods against the Cramér–Rao bound, 1 and 1000 channels",
                 lambda: identify_section(5 if args.quick else args.trials, runs, args.quick, plots), "bench_identify")
