@@ -234,7 +234,7 @@ def test_killed_client_loses_only_files_in_flight_and_never_the_archive(dask_clu
 
 # ---- 100+ files with two broken ones ------------------------------------------------------------------------
 
-def test_hundred_files_with_two_broken_then_rerun_reuses_everything(tmp_path):
+def test_hundred_files_with_two_broken_then_rerun_reuses_everything(dask_cluster, tmp_path):
     folder = tmp_path / "survey"
     good = write_files(folder, 100)
     truncated = folder / "broken_truncated.uff"
@@ -243,8 +243,9 @@ def test_hundred_files_with_two_broken_then_rerun_reuses_everything(tmp_path):
     garbage = folder / "sub" / "broken_garbage.csv"
     garbage.write_text("not,an\nfrf,file\n")
     out = tmp_path / "res.h5"
-    first = run_cli(folder, "--out", out, "--table", tmp_path / "table.csv", "--workers", "2", "--json",
-                    "--method", "nls")
+    options = ("--out", out, "--table", tmp_path / "table.csv", "--scheduler", dask_cluster[0], "--json",
+               "--method", "nls")
+    first = run_cli(folder, *options)
     assert first.returncode == 1, first.stderr
     doc = json.loads(first.stdout)
     assert (doc["files"], doc["fitted"], doc["reused"]) == (102, 100, 0)
@@ -259,8 +260,7 @@ def test_hundred_files_with_two_broken_then_rerun_reuses_everything(tmp_path):
     assert len(archive["files"]) == 102 and archive["batch"].n_failed == 2
     assert sorted(archive["batch"].failed_files) == sorted([str(truncated), str(garbage)])
 
-    second = run_cli(folder, "--out", out, "--table", tmp_path / "table.csv", "--workers", "2", "--json",
-                     "--method", "nls")
+    second = run_cli(folder, *options)
     assert second.returncode == 1, second.stderr
     again = json.loads(second.stdout)
     # every unchanged file reused, nothing fitted (the two broken files are reported again from the archive)
@@ -271,19 +271,25 @@ def test_hundred_files_with_two_broken_then_rerun_reuses_everything(tmp_path):
 
 # ---- usage and discovery ------------------------------------------------------------------------------------
 
-def test_bad_usage_exits_2(small_set, tmp_path):
+def test_bad_usage_exits_2(small_set, tmp_path, capsys):
+    from modal.cli import main
+
     cases = [
         (tmp_path / "nothing_here", "--out", tmp_path / "r.h5"),  # no file found
         (small_set, "--out", tmp_path / "r.h5", "--scheduler", "tcp://127.0.0.1:1", "--workers", "2"),
         (small_set, "--out", tmp_path / "r.h5", "--method", "nls", "--modes-hz", "70"),
         (small_set, "--out", tmp_path / "missing" / "r.h5"),
         (small_set, "--out", tmp_path / "r.h5", "--workers", "0"),
-        (small_set,),  # no --out
     ]
-    for args in cases:
-        done = run_cli(*args)
-        assert done.returncode == 2, (args, done.stderr)
-        assert "error" in done.stderr and "Traceback" not in done.stderr
+    for args in cases:  # in this process (the same main() as the command; a subprocess below)
+        try:
+            code = main(["batch", *map(str, args)])
+        except SystemExit as exc:  # argparse
+            code = exc.code
+        assert code == 2, args
+        assert "error" in capsys.readouterr().err
+    done = run_cli(small_set)  # no --out
+    assert done.returncode == 2 and "--out" in done.stderr and "Traceback" not in done.stderr
     assert not (tmp_path / "r.h5").exists()
 
 
