@@ -45,8 +45,11 @@ def main(argv: list[str] | None = None) -> int:
     from .scene.summary import digest
 
     try:
+        import os
+
         run = run_scene(args.scene, out=args.out, plots_dir=args.plots, archive=args.archive,
-                        progress=lambda msg: print(msg, file=sys.stderr, flush=True))
+                        progress=lambda msg: print(msg, file=sys.stderr, flush=True),
+                        plot_jobs=2 if (os.cpu_count() or 1) > 1 else 1)
     except ModalError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 1
