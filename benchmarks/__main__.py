@@ -11,7 +11,8 @@ noisy FRF against a minute), identification against the Cramér–Rao bound over
 and resolution (``bench_identify``), 1 and 1000 channels, file reading
 (``bench_io``), the counterweight optimiser against brute-force grids
 (``bench_crank``), the ball-balancer stability map and simulations against plain
-``solve_ivp`` (``bench_adb``), and the demo scene end to end (``python -m
+``solve_ivp`` (``bench_adb``), batches of files on Dask against one process
+looping (``bench_batch``), and the demo scene end to end (``python -m
 balancer run`` as a subprocess).  sdypy-EMA, when importable, is run side by side
 on the same FRFs (optional; never a dependency).
 
@@ -474,7 +475,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--runs", type=int, default=5, help="repetitions for every median (default 5)")
     parser.add_argument("--trials", type=int, default=50, help="noise trials per SDOF grid cell (default 50)")
     parser.add_argument("--only", nargs="+", choices=["speed", "identify", "global", "estimate", "io", "crank", "adb",
-                                                      "influence", "demo"],
+                                                      "influence", "batch", "demo"],
                         help="run only these sections")
     parser.add_argument("--out", type=Path, default=HERE / "REPORT.md", help="report file (default benchmarks/REPORT.md)")
     parser.add_argument("--refresh-stress", action="store_true",
@@ -487,7 +488,8 @@ def main(argv: list[str] | None = None) -> int:
         args.out.write_text(head + "\n## Stress run\n\n" + stress_summary() + "\n", encoding="utf-8")
         print(f"[benchmarks] refreshed the stress section of {args.out}", file=sys.stderr)
         return 0
-    wanted = set(args.only or ["speed", "identify", "global", "estimate", "io", "crank", "adb", "influence", "demo"])
+    wanted = set(args.only or ["speed", "identify", "global", "estimate", "io", "crank", "adb", "influence", "batch",
+                               "demo"])
     runs = max(1, args.runs)
     started = time.perf_counter()
     plots: list[str] = []
@@ -541,6 +543,10 @@ def main(argv: list[str] | None = None) -> int:
                              run_module("bench_adb", ["--quick"] if args.quick else [])))
         else:
             sections.append(("Ball balancer", "benchmarks/bench_adb.py is not present; skipped."))
+    if "batch" in wanted:
+        batch_args = ["--runs", str(min(runs, 3))] + (["--files", "60"] if args.quick else [])
+        sections.append(("Batches of files on Dask (modal batch): files per second and workers",
+                         run_module("bench_batch", batch_args)))
     if "demo" in wanted:
         section("Demo scene end to end", lambda: demo_section(min(runs, 3) if args.quick else runs, plots), "demo")
 
