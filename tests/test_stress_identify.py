@@ -30,6 +30,7 @@ that biases it has to raise ``missing_mode``.
 """
 from __future__ import annotations
 
+import functools
 import math
 import os
 import warnings
@@ -37,7 +38,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, event, given, note, seed, settings
+from hypothesis import HealthCheck, Phase, event, given, note, seed, settings
 from hypothesis import strategies as st
 
 import modal
@@ -463,3 +464,147 @@ def test_channel_combination_does_not_underflow():
         value, std = _combine(np.array([0.1, 0.1]), np.array([1e-200, 1e-3]), np.array([1.0, 1.0]))
     # the inverse-variance combination is dominated by the tiny error; it must stay finite and > 0
     assert value == 0.1 and np.isfinite(std) and 0 < std < 1e-150
+
+
+# --------------------------------------------------------------------------- well-posed cases
+#: a well-posed case: 1-3 modes at overlap 0.1-0.3, 0.1-3 % noise, 4-40 lines per half-power
+#: band, ζ 3e-3 ... 0.05, peaks of comparable height (within 1:3). Here no flag may excuse
+#: an estimate, few modes may be flagged at all, and the z-scores (estimate − truth)/std
+#: across cases must have the spread of a calibrated error.
+#: Cap on the share of flagged modes. A flag from a 3-sigma test (method_bias,
+#: high_uncertainty) fires on noise alone in < 1 % of estimates; 5 % for NLS and half-power
+#: leaves room for that (observed: NLS 0 of 70 and 0 of 373, half-power 2 of 40 and 0 of 200).
+#: The circle's damping_pair_spread (damping pairs > 10 % apart, a fixed threshold, not scaled
+#: to the noise) fires on noise at 3 % and few lines: 3 of 40, 20 of 200; capped at 15 %.
+WELL_POSED_FLAG_RATE = {"nls": 0.05, "circle": 0.15, "halfpower": 0.1}
+#: the single-mode methods are well posed on one mode only: a neighbour even at overlap 0.01
+#: bends the circle and the -3 dB points beyond their noise-driven errors at 0.1 % noise, and
+#: the refinement check rightly flags that (method_bias on 13 and 17 of 27 modes with 1-3)
+WELL_POSED_MODES = {"nls": 3, "circle": 1, "halfpower": 1}
+
+
+def z_bounds(n: int) -> tuple[float, float, float]:
+    """Bounds on the spread (standard deviation) and the mean of n z-scores of a calibrated,
+    unbiased error: 1 and 0, with the sample's own scatter ±1/sqrt(2n) and ±1/sqrt(n);
+    3 of it (n = 40 in the default run: spread 0.66-1.34, |mean| <= 0.47; n = 200 under
+    -m stress: 0.85-1.15, the issue's ±15 %, |mean| <= 0.21). Two-sided: an error 1.5x too
+    wide (spread 0.67) or too narrow fails."""
+    return 1 - 3 / math.sqrt(2 * n), 1 + 3 / math.sqrt(2 * n), 3 / math.sqrt(n)
+
+
+@st.composite
+def well_posed_cases(draw, max_modes: int = 3) -> Case:
+    n = draw(st.integers(1, max_modes))
+    kind = draw(st.sampled_from(KINDS))
+    f1 = 10 ** draw(st.floats(0.0, 4.0))
+    zeta = np.full(n, 10 ** draw(st.floats(math.log10(3e-3), math.log10(0.05))))
+    # neighbours at overlap 0.1-0.3: separated, and near enough that the axis stays within
+    # N_MAX lines at the drawn resolution (~30 lines per band-width of spread)
+    overlap = 10 ** np.array(draw(st.lists(st.floats(-1.0, math.log10(0.3)), min_size=n - 1, max_size=n - 1)))
+    fn = [f1]
+    for r in range(n - 1):
+        fn.append(fn[-1] * (1 + 2 * zeta[r] / overlap[r]))
+    fn = np.array(fn)
+    m = 10 ** draw(st.floats(-2.0, 2.0))
+    # peaks of comparable height in the drawn kind (|A| ωn^(p-2) / 2ζ), within 1:3, so that
+    # every mode stands well above the noise
+    ratios = 10 ** np.array(draw(st.lists(st.floats(-0.5, 0.5), min_size=n - 1, max_size=n - 1)))
+    const = np.r_[1.0, ratios] * (fn / fn[0]) ** (2 - KIND_POWER[kind]) / m
+    noise = 10 ** draw(st.floats(-3.0, math.log10(0.03)))
+    lines = 10 ** draw(st.floats(math.log10(4.0), math.log10(40.0)))
+    bw = 2 * zeta * fn
+    f_lo, f_hi = fn[0] - 5 * bw[0], fn[-1] + 5 * bw[-1]
+    df = bw.min() / lines
+    f = f_lo + (np.arange(int((f_hi - f_lo) / df)) + draw(st.floats(0.0, 0.999))) * df
+    assert f.size <= N_MAX
+    return Case(f, fn, zeta, const, kind, noise, draw(st.integers(0, 2**31)), float(lines), True, True)
+
+
+QUANTITIES = ("natural_frequency_hz", "damping_ratio", "mass_kg", "stiffness_n_per_m")
+
+
+def collect_well_posed(case: Case, method: str, tally: dict) -> None:
+    """Every mode found and unflagged (or counted as flagged); its z-scores collected."""
+    describe(case)
+    result = run(case, method)
+    assert result is not None and len(result) == case.fn.size, "a well-posed case must be identified"
+    check_finite(result)
+    truth = {"natural_frequency_hz": case.fn, "damping_ratio": case.zeta, "mass_kg": case.mass,
+             "stiffness_n_per_m": case.stiffness}
+    for r, mode in enumerate(result):
+        tally["modes"] += 1
+        if serious(mode):
+            tally["flagged"].append(sorted(serious(mode)))
+        for name in QUANTITIES:
+            value, std = float(getattr(mode, name)), float(getattr(mode.std, name))
+            z = (value - truth[name][r]) / std
+            # no flag excuses a well-posed estimate: within K_SIGMA of its own error
+            assert abs(z) <= K_SIGMA, (name, value, truth[name][r], std, mode.flags)
+            tally[name].append(z)
+
+
+def check_well_posed_flags(tally: dict, method: str) -> None:
+    rate = len(tally["flagged"]) / tally["modes"]
+    assert rate <= WELL_POSED_FLAG_RATE[method], (rate, tally["flagged"])
+
+
+def check_well_posed_spread(tally: dict) -> None:
+    for name in QUANTITIES:
+        z = np.asarray(tally[name])
+        low, high, mean = z_bounds(z.size)
+        assert abs(float(np.mean(z))) <= mean, (name, float(np.mean(z)), mean, z.size)
+        assert low <= float(np.std(z)) <= high, (name, float(np.std(z)), (low, high), z.size)
+
+
+@functools.lru_cache(maxsize=None)
+def well_posed_tally(method: str, stress: bool) -> dict:
+    """Draw the well-posed cases once per method and run (the tests below share them)."""
+    tally = {"modes": 0, "flagged": [], **{name: [] for name in QUANTITIES}}
+    if stress:
+        chosen = settings(STRESS, max_examples=int(os.environ.get("STRESS_EXAMPLES", "200")), phases=[Phase.generate])
+    else:
+        chosen = WELL_POSED_FAST
+
+    @chosen
+    @given(well_posed_cases(WELL_POSED_MODES[method]))
+    def draw(case):
+        collect_well_posed(case, method, tally)
+
+    (seed(STRESS_SEED + 5)(draw) if stress else draw)()
+    return tally
+
+
+WELL_POSED_FAST = settings(max_examples=40, deadline=None, database=None, derandomize=True,
+                           suppress_health_check=list(HealthCheck), phases=[Phase.generate])
+
+#: the single-mode methods' reported errors are too large: half-power's frequency 1.8-2x
+#: (spread of z 0.51 in the default cases, 0.54 under -m stress; 0.64-0.67 in issue 21's
+#: 400-trial measurement), the circle's damping 1.4-1.7x (0.58, 0.71). The calibration part of issue 21 (another
+#: branch) fixes them; strict, so the fix makes these fail until the mark goes.
+CALIBRATION_PENDING = pytest.mark.xfail(strict=True, reason="issue 21: circle and half-power errors too large")
+METHODS = ["nls", "circle", "halfpower"]
+SPREAD_METHODS = ["nls", pytest.param("circle", marks=CALIBRATION_PENDING),
+                  pytest.param("halfpower", marks=CALIBRATION_PENDING)]
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_well_posed_cases_are_found_within_their_errors_and_unflagged(method):
+    # every estimate within K_SIGMA of its own error (no flag excuses it), <= 10 % flagged
+    check_well_posed_flags(well_posed_tally(method, False), method)
+
+
+@pytest.mark.parametrize("method", SPREAD_METHODS)
+def test_well_posed_errors_have_the_spread_of_the_errors(method):
+    check_well_posed_spread(well_posed_tally(method, False))
+
+
+@pytest.mark.stress
+@pytest.mark.parametrize("method", METHODS)
+def test_stress_well_posed_cases_are_found_within_their_errors_and_unflagged(method):
+    check_well_posed_flags(well_posed_tally(method, True), method)
+
+
+@pytest.mark.stress
+@pytest.mark.parametrize("method", SPREAD_METHODS)
+def test_stress_well_posed_errors_have_the_spread_of_the_errors(method):
+    check_well_posed_spread(well_posed_tally(method, True))
