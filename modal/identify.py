@@ -9,6 +9,7 @@ from .checks import find_missing_mode, residual_noise_std, residual_structure, r
 from .circlefit import circle_fit_curve
 from .errors import IdentificationError, QualityWarning, ResolutionWarning, warn
 from .estimate.correction import remove_window_damping
+from .flags import CHI2_LIMIT, RELATIVE_MISFIT
 from .frf import FRF, KIND_POWER
 from .halfpower import half_power_curve
 from .model import mode_basis, solve_linear
@@ -22,8 +23,6 @@ __all__ = ["identify", "METHODS"]
 #: the band-wise methods (one band per mode) and all methods
 BANDWISE_METHODS = ("nls", "circle", "halfpower")
 METHODS = BANDWISE_METHODS + ("global",)
-#: chi-square above which the model is flagged as not explaining the data
-CHI2_LIMIT = 3.0
 #: relative standard error of ζ above which an estimate is flagged
 REL_STD_LIMIT = 0.1
 #: modal overlap 2·max(ζωn)/Δωn with a neighbour above which ``close_modes`` is raised:
@@ -328,6 +327,32 @@ def _band_noise(frf, bands, line_noise):
     return np.sqrt(np.mean(line_noise[:, lines] ** 2, axis=1))
 
 
+def _local_misfit(frf, bands, power, omega_n, damping_ratio) -> np.ndarray:
+    """Per mode, the misfit near it relative to the data there (RMS over the strong channels).
+
+    In each band every fitted mode and a complex offset are solved linearly at the
+    fitted poles; the residual is taken on the lines within ±3 half-power widths
+    (at least ±3 lines) of the band's mode.
+    """
+    out = np.full(len(bands), np.nan)
+    for b, (band, wn, zeta) in enumerate(zip(bands, omega_n, damping_ratio)):
+        omega, h = _mode_arrays(frf, band)
+        if omega.size < 3:
+            continue
+        basis = mode_basis(omega, omega_n, damping_ratio, power).T
+        design = np.hstack([basis, ((1j * omega) ** power)[:, None]])
+        coef = solve_linear(design, h.T)
+        residual = h - (design @ coef).T
+        spacing = float(np.median(np.diff(omega)))
+        near = np.abs(omega - wn) <= max(3 * 2 * zeta * wn, 3 * spacing)
+        if near.sum() < 3:
+            near = np.argsort(np.abs(omega - wn))[:3]
+        data = np.linalg.norm(h[:, near])
+        if data > 0:
+            out[b] = np.linalg.norm(residual[:, near]) / data
+    return out
+
+
 def _fit_noise(frf, bands, power, omega_n, damping_ratio, estimated_noise, channels=None, known=False):
     """:func:`modal.checks.residual_noise_std` on the lines of the bands (all or some channels).
 
@@ -591,10 +616,17 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
             consts[missing] = filled[missing]
         check, missing_mode = _refinement_check(frf, bands, power, poles, consts, noise, estimated_noise,
                                                 known_noise)
-        for band, (wn, zeta, s_wn, s_z, _, flags, q), const, geometric, reference in zip(
-                bands, poles, consts, ~missing, check):
+        # the misfit near each mode of the refined model (the model whose chi-square is tested)
+        refined = np.array([[p[0] - c[0], p[1] - c[1]] for p, c in zip(poles, check)], float)
+        usable = np.all(np.isfinite(refined), axis=1) & np.all(refined > 0, axis=1)
+        relative = np.full(len(bands), np.nan)
+        if usable.all():
+            relative = _local_misfit(frf, bands, power, refined[:, 0], refined[:, 1])
+        for b, (band, (wn, zeta, s_wn, s_z, _, flags, q), const, geometric, reference) in enumerate(zip(
+                bands, poles, consts, ~missing, check)):
             d_wn, d_z, d_const, chi2, bound_wn, bound_z = reference
-            if np.isfinite(chi2) and chi2 > CHI2_LIMIT:
+            # inadequate where a user should act (as for nls: modal.flags.RELATIVE_MISFIT)
+            if np.isfinite(chi2) and chi2 > CHI2_LIMIT and not relative[b] <= RELATIVE_MISFIT:
                 flags.add("model_inadequate")
             # no estimator beats the Cramér–Rao bound of the refinement: a smaller own
             # error (a formula that sees only a few lines) is raised to it
@@ -637,13 +669,16 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
         # beyond their white-noise errors; its measured shift is added to them (finding 26)
         shift = _truncation(frf, bands, power, fit)
         order = np.argsort(fit.omega_n)  # two close poles may cross during the fit
-        for band, r in zip(bands, order):
+        relative = _local_misfit(frf, bands, power, fit.omega_n[order], fit.damping_ratio[order])
+        for b, (band, r) in enumerate(zip(bands, order)):
             flags: set[str] = set()
             if not fit.converged:
                 flags.add("did_not_converge")
             if not np.all(np.isfinite(fit.noise_var)):
                 flags.add("too_few_points")  # no lines left over for a residual: no errors
-            if np.isfinite(chi2) and chi2 > CHI2_LIMIT:
+            # inadequate where a user should act: beyond the noise and beyond what a linear model explains
+            # of clean measured data (modal.flags.RELATIVE_MISFIT)
+            if np.isfinite(chi2) and chi2 > CHI2_LIMIT and not relative[b] <= RELATIVE_MISFIT:
                 flags.add("model_inadequate")
             cov = fit.mode_cov[r] if shift is None else _with_shift(fit.mode_cov[r], shift[0][r], shift[1][r])
             s_wn = float(np.sqrt(max(cov[0, 0, 0], 0))) if np.isfinite(cov[0, 0, 0]) else np.nan

@@ -80,6 +80,20 @@ def _as_results(result) -> list[IdentificationResult]:
     return results
 
 
+def _serious(mode) -> bool:
+    """Whether a mode carries a flag a user should act on (not only driving-point bookkeeping)."""
+    from .flags import INFORMATIONAL
+
+    return bool(set(mode.flags) - INFORMATIONAL)
+
+
+def _model_name(result: IdentificationResult) -> str:
+    """Legend name of a result's model: its method, and how many of its modes are flagged (a flagged
+    model far from the data is then read as what it is, not as a drawing error)."""
+    flagged = sum(_serious(m) for m in result.modes)
+    return result.method + (f"; {flagged} of {len(result.modes)} modes flagged" if flagged else "")
+
+
 def plot_fit(frf: FRF, result: IdentificationResult | Sequence[IdentificationResult], channel: int | None = None,
              figure: Figure | None = None) -> Figure:
     """Magnitude and phase with the fitted model(s) over the data, and each mode's Nyquist plot.
@@ -99,6 +113,7 @@ def plot_fit(frf: FRF, result: IdentificationResult | Sequence[IdentificationRes
         Figure to draw into (a new one by default).
     """
     results = _as_results(result)
+    names = [_model_name(r) for r in results]
     if channel is not None and not 0 <= channel < frf.n_channels:
         raise ModalError(f"channel {channel} does not exist; the FRF has channels 0..{frf.n_channels - 1}")
     first = results[0]
@@ -120,9 +135,9 @@ def plot_fit(frf: FRF, result: IdentificationResult | Sequence[IdentificationRes
     if rms:
         data_rms = np.sqrt(np.mean(np.abs(data) ** 2, axis=0))
         ax_mag.semilogy(f, data_rms, ".", ms=2, color="0.3", label=f"data, RMS of {len(channels)} channels")
-        for k, (res, model) in enumerate(zip(results, models)):
+        for k, (name, model) in enumerate(zip(names, models)):
             ax_mag.semilogy(f, np.sqrt(np.mean(np.abs(model) ** 2, axis=0)), _STYLES[k % 4], lw=1.2,
-                            color="C3", label=f"model ({res.method}), RMS")
+                            color="C3", label=f"model ({name}), RMS")
         strongest = int(np.argmax(np.sum(np.abs(data) ** 2, axis=1)))
         phase_channels = [strongest]
         ax_phase.set_title(f"phase of channel {strongest} (the strongest)", fontsize="small")
@@ -130,9 +145,9 @@ def plot_fit(frf: FRF, result: IdentificationResult | Sequence[IdentificationRes
         for colour, ch in zip(colours, channels):
             tag = f"ch {ch} " if frf.n_channels > 1 else ""
             ax_mag.semilogy(f, np.abs(data[ch]), ".", ms=2, color=colour, label=f"{tag}data")
-            for k, (res, model) in enumerate(zip(results, models)):
+            for k, (name, model) in enumerate(zip(names, models)):
                 ax_mag.semilogy(f, np.abs(model[ch]), _STYLES[k % 4], lw=1, color=colour,
-                                label=f"{tag}model ({res.method})")
+                                label=f"{tag}model ({name})")
         phase_channels = channels
     for colour, ch in zip(colours if not rms else ["0.3"], phase_channels):
         ax_phase.plot(f, np.degrees(np.angle(data[ch])), ".", ms=2, color=colour)
@@ -173,7 +188,8 @@ def plot_fit(frf: FRF, result: IdentificationResult | Sequence[IdentificationRes
             ax.plot((ym + offset).real, (ym + offset).imag, _STYLES[k % 4], lw=1, color="C3" if k == 0 else f"C{k + 3}")
         ax.set_aspect("equal", adjustable="datalim")
         ax.set_title(f"mode {r + 1}: {mode.natural_frequency_hz:.4g} Hz"
-                     + (f" (ch {ch})" if frf.n_channels > 1 else ""), fontsize="small")
+                     + (f" (ch {ch})" if frf.n_channels > 1 else "")
+                     + (", flagged" if _serious(mode) else ""), fontsize="small")
         ax.xaxis.set_major_locator(MaxNLocator(3))
         ax.yaxis.set_major_locator(MaxNLocator(4))
         ax.ticklabel_format(style="sci", scilimits=(-2, 3))

@@ -22,7 +22,7 @@ FLAG_TEXT = {
     "band_edge_peak": "the peak lies at the edge of the band: the band does not contain the resonance",
     "too_few_points": "too few lines near resonance for this method",
     "damping_pair_spread": "circle fit: the damping estimates from point pairs disagree by more than 10 %",
-    "model_inadequate": "residual is much larger than the noise (chi-square): the model does not explain the data (close modes, missing mode, nonlinearity)",
+    "model_inadequate": "residual is much larger than the noise (chi-square > 3) and more than 3 % of the data near the mode: the model does not explain the data (close modes, missing mode, nonlinearity)",
     "high_uncertainty": "standard error of the damping ratio exceeds 10 % of its value",
     "did_not_converge": "least-squares refinement did not converge; the start values are reported",
     "driving_point_assumed": "single-channel FRF without point ids: taken as a driving point",

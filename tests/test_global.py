@@ -273,3 +273,23 @@ def test_no_phantom_mode_on_the_tail_of_a_wide_mode():
         result = _fit(modal.add_noise(clean, 0.001, seed=seed))
         assert len(result) == 3, (seed, [m.natural_frequency_hz for m in result])
         assert np.allclose([m.natural_frequency_hz for m in result], [50, 120, 300], rtol=1e-3)
+
+
+def test_mode_just_above_the_band_enters_the_model():
+    """The benchmark case (60 outputs x 2 references, 4000 lines over 20-400 Hz, a mode at 430 Hz) at noise seed 4:
+    pLSCF saw the 430 Hz mode only as a chain wandering over 405-409 Hz in 4 of 17 orders, the selection left it
+    out, the residual terms absorbed it badly and the 190 Hz damping came out 10 of its errors off, unflagged.
+    Chains outside the lines now enter the joint fit and its significance test keeps the real one: every
+    in-band mode within 4 errors (a 4σ excursion among 24 values has probability 1.5e-3), the 430 Hz mode found
+    and flagged outside_band."""
+    from benchmarks.bench_global import BAND, FN, ZETA, make_case
+
+    _, noisy = make_case(seed=4)
+    result = _fit(noisy)
+    found = np.array([m.natural_frequency_hz for m in result])
+    above = result[int(np.argmin(np.abs(found - 430.0)))]
+    assert abs(above.natural_frequency_hz / 430.0 - 1) < 3e-3 and "outside_band" in above.flags
+    for f_true, z_true in zip(FN[FN < BAND[1]], ZETA[FN < BAND[1]]):
+        m = result[int(np.argmin(np.abs(found - f_true)))]
+        assert abs(m.natural_frequency_hz - f_true) < 4 * m.std.natural_frequency_hz, (f_true, m.natural_frequency_hz)
+        assert abs(m.damping_ratio - z_true) < 4 * m.std.damping_ratio, (f_true, m.damping_ratio, m.std.damping_ratio)

@@ -106,6 +106,14 @@ def plot_amplitude(result: SimulationResult, *, ax: Axes | None = None, log: boo
     return figure
 
 
+def _break_at_wraps(time_s: np.ndarray, angle_deg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The curve with a gap (NaN) where the wrapped angle jumps by more than 180°, so that a ball passing
+    ±180° is not drawn as a vertical line across the panel."""
+    jumps = np.flatnonzero(np.abs(np.diff(angle_deg)) > 180.0) + 1
+    return (np.insert(np.asarray(time_s, float), jumps, np.nan),
+            np.insert(np.asarray(angle_deg, float), jumps, np.nan))
+
+
 def plot_ball_angles(result: SimulationResult, *, ax: Axes | None = None) -> Figure:
     """Ball angles relative to the unbalance (degrees) against time, with the balanced angles.
 
@@ -119,7 +127,8 @@ def plot_ball_angles(result: SimulationResult, *, ax: Axes | None = None) -> Fig
     figure, ax = _axes(ax)
     wrapped = np.degrees(np.angle(np.exp(1j * result.ball_angles_rad)))
     for index in range(wrapped.shape[1]):
-        ax.plot(result.time_s, wrapped[:, index], lw=0.8, label=f"ball {index + 1}")
+        time_s, angle = _break_at_wraps(result.time_s, wrapped[:, index])
+        ax.plot(time_s, angle, lw=0.8, label=f"ball {index + 1}")
     for angle in np.degrees(result.balanced_ball_angles_rad):
         ax.axhline(angle, ls=":", color="k", lw=0.8)
     ax.set_xlabel("time (s)")
