@@ -58,10 +58,14 @@ def test_time_plots(run):
     angles = plot_ball_angles(run).axes[0]
     ends = []
     for index in range(2):
-        y = _line(angles, f"ball {index + 1}").get_ydata()
-        # wrapped to (-180, 180] degrees
-        np.testing.assert_allclose(y, np.degrees(np.angle(np.exp(1j * run.ball_angles_rad[:, index]))))
-        ends.append(y[-1])
+        line = _line(angles, f"ball {index + 1}")
+        x, y = np.asarray(line.get_xdata(), float), np.asarray(line.get_ydata(), float)
+        # the samples, wrapped to (-180, 180] degrees, with a gap (NaN) where the wrap jumps
+        drawn = ~np.isnan(y)
+        np.testing.assert_array_equal(x[drawn], run.time_s)
+        np.testing.assert_allclose(y[drawn], np.degrees(np.angle(np.exp(1j * run.ball_angles_rad[:, index]))))
+        assert not np.any(np.abs(np.diff(y)) > 180.0)  # no vertical line across the panel (NaN gaps)
+        ends.append(y[drawn][-1])
     # the run settled (0.76 s): each ball within settle_tolerance (1 %) of its balanced angle
     balanced = np.sort(np.degrees(run.balanced_ball_angles_rad))
     assert run.settled and np.all(np.abs(np.sort(ends) - balanced) <= run.settle_tolerance * np.abs(balanced))
