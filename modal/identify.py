@@ -328,7 +328,8 @@ def _band_noise(frf, bands, line_noise):
 
 
 def _local_misfit(frf, bands, power, omega_n, damping_ratio) -> np.ndarray:
-    """Per mode, the misfit near it relative to the data there (RMS over the strong channels).
+    """Per mode, the misfit near it relative to the data there (RMS over the strongest channels, at most
+    ``POLE_CHANNELS``).
 
     In each band every fitted mode and a complex offset are solved linearly at the
     fitted poles; the residual is taken on the lines within ±3 half-power widths
@@ -339,6 +340,8 @@ def _local_misfit(frf, bands, power, omega_n, damping_ratio) -> np.ndarray:
         omega, h = _mode_arrays(frf, band)
         if omega.size < 3:
             continue
+        if h.shape[0] > POLE_CHANNELS:  # the strong channels carry the misfit that matters; O(1) in channels
+            h = h[np.argsort(np.abs(h).max(axis=1))[::-1][:POLE_CHANNELS]]
         basis = mode_basis(omega, omega_n, damping_ratio, power).T
         design = np.hstack([basis, ((1j * omega) ** power)[:, None]])
         coef = solve_linear(design, h.T)
