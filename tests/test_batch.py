@@ -141,6 +141,19 @@ def test_archive_has_one_group_per_file_with_hash_settings_and_modes(dask_cluste
     assert len(result.rows()) == 24 and result.summary()["fitted"] == 12
 
 
+def test_without_an_archive_the_results_come_back_whole_and_nothing_is_written(dask_cluster, small_set, tmp_path):
+    before = sorted(p.name for p in small_set.rglob("*"))
+    result = fit_files(small_set, client=dask_cluster[0], method="nls")
+    assert (result.archive, result.table, result.fitted) == (None, None, 12)
+    assert sorted(p.name for p in small_set.rglob("*")) == before  # no parts, no archive, no table
+    for outcome in result.outcomes:
+        fit = outcome.fit  # the whole FileFit when no archive holds it
+        assert fit.ok and fit.source == outcome.file and len(fit.results[0]) == 2
+        assert [r["natural_frequency_hz"] for r in outcome.rows] == [m.natural_frequency_hz for m in fit.results[0]]
+    with pytest.raises(ParameterError, match="table needs out"):
+        fit_files(small_set, table=tmp_path / "t.csv")
+
+
 # ---- resumable: content hash and settings ---------------------------------------------------------------------
 
 def test_rerun_refits_only_changed_files_and_changed_settings(dask_cluster, tmp_path):
