@@ -282,6 +282,16 @@ def test_hundred_files_with_two_broken_then_rerun_reuses_everything(dask_cluster
     assert_same_tables(read_table(tmp_path / "table.csv"), rows)
 
 
+def test_a_worker_with_another_version_fits_nothing_and_says_why(tmp_path):
+    from modal.batch.task import fit_and_store
+    from modal.fitting import FitOptions
+
+    path = str(write_files(tmp_path, 1)[0])
+    entry, = fit_and_store([path], FitOptions(), [file_sha256(path)], str(tmp_path / "r.h5"), client_version="0.0.0")
+    assert entry.retry and "worker has modalbal" in entry.error and "client 0.0.0" in entry.error
+    assert not (tmp_path / "r.h5.parts").exists()
+
+
 # ---- usage and discovery ------------------------------------------------------------------------------------
 
 def test_bad_usage_exits_2(small_set, tmp_path, capsys):

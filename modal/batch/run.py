@@ -187,6 +187,7 @@ def chunk_size(n_files: int, n_workers: int) -> int:
 def _fit_pending(pending, options, hashes, client, workers, store, done, statuses, bar) -> Iterator[Outcome]:
     from distributed import as_completed
 
+    from .. import __version__
     from .cluster import open_client
     from .task import fit_and_store
 
@@ -194,7 +195,8 @@ def _fit_pending(pending, options, hashes, client, workers, store, done, statuse
     with open_client(client, workers) as dask:
         size = chunk_size(len(pending), len(dask.scheduler_info().get("workers", {})))
         chunks = [pending[i:i + size] for i in range(0, len(pending), size)]
-        futures = {dask.submit(fit_and_store, chunk, options, [hashes[p] for p in chunk], archive, pure=False): chunk
+        futures = {dask.submit(fit_and_store, chunk, options, [hashes[p] for p in chunk], archive, __version__,
+                               pure=False): chunk
                    for chunk in chunks}
         for future in as_completed(futures, loop=dask.loop):
             chunk = futures[future]
