@@ -303,6 +303,7 @@ def test_bad_usage_exits_2(small_set, tmp_path, capsys):
         (small_set, "--out", tmp_path / "r.h5", "--method", "nls", "--modes-hz", "70"),
         (small_set, "--out", tmp_path / "missing" / "r.h5"),
         (small_set, "--out", tmp_path / "r.h5", "--workers", "0"),
+        (small_set, "--out", tmp_path),  # a folder, not an archive name
     ]
     for args in cases:  # in this process (the same main() as the command; a subprocess below)
         try:

@@ -117,6 +117,8 @@ def iter_fit(paths: str | os.PathLike | Sequence[str | os.PathLike], *, client: 
         for target, name in ((out, "out"), (table, "table")):
             if not target.parent.is_dir() and str(target.parent):
                 raise ParameterError(f"--{name} {target}: folder {target.parent} does not exist")
+            if target.is_dir():
+                raise ParameterError(f"--{name} {target}: is a folder; expected a file name")
     elif table is not None:
         raise ParameterError("table needs out (the archive that makes a run resumable)")
     exclude = [] if out is None else [out, table, parts_folder(out)]
