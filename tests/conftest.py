@@ -7,6 +7,15 @@ from pathlib import Path
 import pytest
 
 os.environ.setdefault("MPLBACKEND", "Agg")
+# hypothesis writes a cache (``constants``, and the example database where a test keeps one)
+# under .hypothesis/ in the working directory even with database=None; the runs here are
+# derandomised or seeded, so nothing of it is needed: keep it out of the source tree
+if "HYPOTHESIS_STORAGE_DIRECTORY" not in os.environ:
+    import tempfile
+
+    from hypothesis.configuration import set_hypothesis_home_dir
+
+    set_hypothesis_home_dir(os.path.join(tempfile.gettempdir(), f"modalbal-hypothesis-{os.getuid()}"))
 
 import modal  # noqa: E402
 
