@@ -141,6 +141,19 @@ def test_archive_has_one_group_per_file_with_hash_settings_and_modes(dask_cluste
     assert len(result.rows()) == 24 and result.summary()["fitted"] == 12
 
 
+def test_without_an_archive_the_results_come_back_whole_and_nothing_is_written(dask_cluster, small_set, tmp_path):
+    before = sorted(p.name for p in small_set.rglob("*"))
+    result = fit_files(small_set, client=dask_cluster[0], method="nls")
+    assert (result.archive, result.table, result.fitted) == (None, None, 12)
+    assert sorted(p.name for p in small_set.rglob("*")) == before  # no parts, no archive, no table
+    for outcome in result.outcomes:
+        fit = outcome.fit  # the whole FileFit when no archive holds it
+        assert fit.ok and fit.source == outcome.file and len(fit.results[0]) == 2
+        assert [r["natural_frequency_hz"] for r in outcome.rows] == [m.natural_frequency_hz for m in fit.results[0]]
+    with pytest.raises(ParameterError, match="table needs out"):
+        fit_files(small_set, table=tmp_path / "t.csv")
+
+
 # ---- resumable: content hash and settings ---------------------------------------------------------------------
 
 def test_rerun_refits_only_changed_files_and_changed_settings(dask_cluster, tmp_path):
@@ -269,6 +282,16 @@ def test_hundred_files_with_two_broken_then_rerun_reuses_everything(dask_cluster
     assert_same_tables(read_table(tmp_path / "table.csv"), rows)
 
 
+def test_a_worker_with_another_version_fits_nothing_and_says_why(tmp_path):
+    from modal.batch.task import fit_and_store
+    from modal.fitting import FitOptions
+
+    path = str(write_files(tmp_path, 1)[0])
+    entry, = fit_and_store([path], FitOptions(), [file_sha256(path)], str(tmp_path / "r.h5"), client_version="0.0.0")
+    assert entry.retry and "worker has modalbal" in entry.error and "client 0.0.0" in entry.error
+    assert not (tmp_path / "r.h5.parts").exists()
+
+
 # ---- usage and discovery ------------------------------------------------------------------------------------
 
 def test_bad_usage_exits_2(small_set, tmp_path, capsys):
@@ -280,6 +303,7 @@ def test_bad_usage_exits_2(small_set, tmp_path, capsys):
         (small_set, "--out", tmp_path / "r.h5", "--method", "nls", "--modes-hz", "70"),
         (small_set, "--out", tmp_path / "missing" / "r.h5"),
         (small_set, "--out", tmp_path / "r.h5", "--workers", "0"),
+        (small_set, "--out", tmp_path),  # a folder, not an archive name
     ]
     for args in cases:  # in this process (the same main() as the command; a subprocess below)
         try:

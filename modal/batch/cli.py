@@ -58,6 +58,9 @@ def run_batch(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
     except ModalError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 1
+    except OSError as exc:  # the archive, the table or the parts folder cannot be written
+        print(f"error: {exc.filename or args.out}: {exc.strerror or exc}", file=sys.stderr)
+        return 1
     except KeyboardInterrupt:
         print(f"interrupted: the files fitted so far are kept in {args.out}.parts; run the same command again "
               "to finish", file=sys.stderr)

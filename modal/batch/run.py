@@ -117,6 +117,8 @@ def iter_fit(paths: str | os.PathLike | Sequence[str | os.PathLike], *, client: 
         for target, name in ((out, "out"), (table, "table")):
             if not target.parent.is_dir() and str(target.parent):
                 raise ParameterError(f"--{name} {target}: folder {target.parent} does not exist")
+            if target.is_dir():
+                raise ParameterError(f"--{name} {target}: is a folder; expected a file name")
     elif table is not None:
         raise ParameterError("table needs out (the archive that makes a run resumable)")
     exclude = [] if out is None else [out, table, parts_folder(out)]
@@ -187,6 +189,7 @@ def chunk_size(n_files: int, n_workers: int) -> int:
 def _fit_pending(pending, options, hashes, client, workers, store, done, statuses, bar) -> Iterator[Outcome]:
     from distributed import as_completed
 
+    from .. import __version__
     from .cluster import open_client
     from .task import fit_and_store
 
@@ -194,7 +197,8 @@ def _fit_pending(pending, options, hashes, client, workers, store, done, statuse
     with open_client(client, workers) as dask:
         size = chunk_size(len(pending), len(dask.scheduler_info().get("workers", {})))
         chunks = [pending[i:i + size] for i in range(0, len(pending), size)]
-        futures = {dask.submit(fit_and_store, chunk, options, [hashes[p] for p in chunk], archive, pure=False): chunk
+        futures = {dask.submit(fit_and_store, chunk, options, [hashes[p] for p in chunk], archive, __version__,
+                               pure=False): chunk
                    for chunk in chunks}
         for future in as_completed(futures, loop=dask.loop):
             chunk = futures[future]
