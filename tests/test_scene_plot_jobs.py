@@ -88,3 +88,18 @@ except SceneError as exc:
     assert out["forks"] >= 1 and "broken on purpose" in out["error"]
     assert not (tmp_path / "d.h5").exists()
     assert not list((tmp_path / "d").glob("*"))
+
+
+@pytest.mark.parametrize("jobs", [1, 2])
+def test_a_failing_plot_is_reported_with_its_stage(tmp_path, monkeypatch, jobs):
+    from balancer.scene import plots, run_scene
+
+    def broken(results):
+        raise ValueError("no figure today")
+
+    # with 2 jobs the identify plot is handed to a child as soon as its stage is done (no child is running
+    # yet then) when forking is usable (no other thread in the process: a Dask cluster of another test in the
+    # same session makes it draw here instead); wherever it is drawn, the failure reaches the caller the same way
+    monkeypatch.setitem(plots._FIGURES, "identify", broken)
+    with pytest.raises(RuntimeError, match="plots of identify.*ValueError: no figure today"):
+        run_scene(DEMO, out=tmp_path / "c.h5", plots_dir=tmp_path / "c", plot_jobs=jobs)

@@ -37,6 +37,16 @@ def default_initial_ball_angles(n: int) -> np.ndarray:
     """Default start: balls resting near the heavy spot, spread over 0.3-0.5 rad (rad).
 
     With the rotor at rest this is never an equilibrium (the balls add to the unbalance).
+
+    Parameters
+    ----------
+    n : int
+        Number of balls.
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        Ball angles from the unbalance, rad.
     """
     if n == 1:
         return np.array([0.3])

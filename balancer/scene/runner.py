@@ -343,7 +343,12 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, p
             half = (len(pending) + 1) // 2
             if workers.submit(tuple(pending[half:])):
                 pending = pending[:half]
-            mine = {stage: save_stage_plot(stage, results, folder) for stage in pending}
+            mine = {}
+            for stage in pending:
+                try:
+                    mine[stage] = save_stage_plot(stage, results, folder)
+                except Exception as exc:  # the same report as from a child: the stage and the cause
+                    raise RuntimeError(f"plots of {stage}: {type(exc).__name__}: {exc}") from exc
             theirs = workers.collect()
             for stage in plotted:
                 plot_paths += mine.get(stage, theirs.get(stage, []))
