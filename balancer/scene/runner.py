@@ -175,6 +175,7 @@ class _PlotWorkers:
         self.results = results
         self.children: list[tuple[int, int, tuple[str, ...]]] = []
         self.finished: set[int] = set()
+        self._drawn: list[Path] = []
         self.usable = self.jobs > 1 and hasattr(os, "fork") and threading.active_count() == 1
 
     def submit(self, stages: tuple[str, ...]) -> bool:
@@ -185,6 +186,7 @@ class _PlotWorkers:
             return False
         from .plots import save_stage_plot
 
+        self.folder.mkdir(parents=True, exist_ok=True)
         sys.stdout.flush()
         sys.stderr.flush()
         read, write = os.pipe()
@@ -214,6 +216,15 @@ class _PlotWorkers:
                 self.finished.add(pid)
         return sum(pid not in self.finished for pid, _read, _stages in self.children)
 
+    def abandon(self) -> None:
+        """Wait for every child and remove the plots they drew (the run failed)."""
+        try:
+            self.collect()
+        except RuntimeError:
+            pass
+        for path in self._drawn:
+            path.unlink(missing_ok=True)
+
     def collect(self) -> dict[str, list[Path]]:
         """Wait for every child; the paths of each stage's plots (raises if a child failed)."""
         import os
@@ -235,6 +246,7 @@ class _PlotWorkers:
                 errors.append(f"plots of {', '.join(stages)}: {report['error']}")
                 continue
             for path in map(Path, report["paths"]):
+                self._drawn.append(path)
                 done.setdefault(next(s for s in stages if path.name.startswith(s + "_")), []).append(path)
         self.children, self.finished = [], set()
         if errors:
@@ -294,7 +306,6 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, p
     if plotted:
         folder = Path(plots_dir) if plots_dir is not None else (
             archive_path.with_name(archive_path.stem + "_plots") if archive_path else Path("out") / f"{_slug(name)}_plots")
-        folder.mkdir(parents=True, exist_ok=True)
     workers = _PlotWorkers(plot_jobs, folder, results) if plotted else None
     pending = list(plotted)  # plot stages not yet handed to a child, in output order
 
@@ -306,39 +317,45 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, p
             for s in ready:
                 pending.remove(s)
 
-    for stage in STAGES:
-        if status[stage] != "ran":
-            continue
-        say(f"{stage}: running")
-        t0 = time.perf_counter()
-        kwargs = {dep: results[dep] for dep in dependencies(scene, stage) if dep in results}
-        results[stage] = STAGE_FUNCTIONS[stage](scene, **kwargs)
-        timings[stage] = time.perf_counter() - t0
-        say(f"{stage}: done in {timings[stage]:.2f} s")
-        if stage in pending:
-            hand_over()
-    if archive_path is not None:
-        keep = [s for s in STAGES if s in results and (stored is True or stored is False or s in stored)]
-        archive_path.parent.mkdir(parents=True, exist_ok=True)
-        write_archive(archive_path, {s: results[s] for s in keep}, scene_text=scene.text or None,
-                      inputs_hash={s: hashes[s] for s in keep})
     plot_paths = []
-    if plotted:
-        from .plots import save_stage_plot
+    try:
+        for stage in STAGES:
+            if status[stage] != "ran":
+                continue
+            say(f"{stage}: running")
+            t0 = time.perf_counter()
+            kwargs = {dep: results[dep] for dep in dependencies(scene, stage) if dep in results}
+            results[stage] = STAGE_FUNCTIONS[stage](scene, **kwargs)
+            timings[stage] = time.perf_counter() - t0
+            say(f"{stage}: done in {timings[stage]:.2f} s")
+            if stage in pending:
+                hand_over()
+        if archive_path is not None:
+            keep = [s for s in STAGES if s in results and (stored is True or stored is False or s in stored)]
+            archive_path.parent.mkdir(parents=True, exist_ok=True)
+            write_archive(archive_path, {s: results[s] for s in keep}, scene_text=scene.text or None,
+                          inputs_hash={s: hashes[s] for s in keep})
+        if plotted:
+            from .plots import save_stage_plot
 
-        # split what is left: a child takes the second half while this process draws the first
-        half = (len(pending) + 1) // 2
-        if workers.submit(tuple(pending[half:])):
-            pending = pending[:half]
-        mine = {}
-        for stage in pending:
-            try:
-                mine[stage] = save_stage_plot(stage, results, folder)
-            except Exception as exc:  # the same report as from a child: the stage and the cause
-                raise RuntimeError(f"plots of {stage}: {type(exc).__name__}: {exc}") from exc
-        theirs = workers.collect()
-        for stage in plotted:
-            plot_paths += mine.get(stage, theirs.get(stage, []))
+            folder.mkdir(parents=True, exist_ok=True)
+            # split what is left: a child takes the second half while this process draws the first
+            half = (len(pending) + 1) // 2
+            if workers.submit(tuple(pending[half:])):
+                pending = pending[:half]
+            mine = {}
+            for stage in pending:
+                try:
+                    mine[stage] = save_stage_plot(stage, results, folder)
+                except Exception as exc:  # the same report as from a child: the stage and the cause
+                    raise RuntimeError(f"plots of {stage}: {type(exc).__name__}: {exc}") from exc
+            theirs = workers.collect()
+            for stage in plotted:
+                plot_paths += mine.get(stage, theirs.get(stage, []))
+    except BaseException:
+        if workers is not None:  # a failed run leaves no plots drawn early by a child
+            workers.abandon()
+        raise
     from .summary import format_summary
 
     summary = format_summary(name, status, results, outputs.get("tables", []), timings,
