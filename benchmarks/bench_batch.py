@@ -5,12 +5,17 @@ The files are UFF 58 driving-point mobilities with two modes and 0.1 % noise, fi
 default options (method auto: band-wise NLS). Rows:
 
 - one process looping: :func:`modal.batch.task.fit_one` over the files in this process (no Dask,
-  no archive): the baseline;
+  no archive): the baseline; and the same loop writing the same archive at the end (one
+  :func:`modal.archive.write_archive` of every result: what the batch's archive costs per file);
 - ``fit_files(..., workers=N, out=...)`` on the embedded LocalCluster (start of the cluster,
   hashing, fitting, per-file parts, archive and table; a fresh archive every run);
 - the rerun of the same batch (every file reused: no cluster is started);
 - a scheduler with N workers already running (``client=`` an open client): the batch without the
   cluster's start, as on an existing cluster.
+
+Then the ball-balancer studies of :mod:`balancer.adb.montecarlo` (Monte-Carlo probability of
+stable operation, chunked stability map) in this process against a local cluster with the same
+chunks (same numbers, checked).
 
 Times are medians of ``--runs`` runs with the [min–max] spread; files/s = files / median. The
 machine's cores and load are printed: workers beyond the free cores cannot scale.
@@ -29,6 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
+from modal.archive import write_archive
 from modal.batch import fit_files, find_files
 from modal.batch.cluster import default_workers
 from modal.batch.task import fit_one
@@ -86,6 +92,13 @@ def main(argv: list[str] | None = None) -> int:
         print(row("one process looping (fit_one, no archive)", n, loop, loop[0]))
         counter = iter(range(10**6))
 
+        def loop_archive() -> None:
+            fits = [fit_one(p, options) for p in files]
+            write_archive(Path(tmp) / f"loop{next(counter)}.h5", {"files": fits})
+
+        print(row("one process looping + one write_archive of all results", n, timed(loop_archive, args.runs),
+                  loop[0]))
+
         def fresh(workers: int) -> None:
             out = Path(tmp) / f"run{next(counter)}.h5"
             result = fit_files(folder, out=out, workers=workers)
@@ -110,8 +123,46 @@ def main(argv: list[str] | None = None) -> int:
 
                 print(row(f"running scheduler + {workers} worker(s) (client=)", n, timed(running, args.runs),
                           loop[0]))
+    studies(args.runs, args.workers)
     print(f"\nload average after: {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
     return 0
+
+
+def studies(runs: int, worker_counts: list[int]) -> None:
+    """Monte-Carlo stability probability and a chunked stability map, here and on local clusters."""
+    from distributed import Client, LocalCluster
+
+    from balancer.adb import ADBParameters, ParameterStd
+    from balancer.adb.montecarlo import chunked_stability_map, stability_probability
+
+    params = ADBParameters(M=1.0, m=0.02, n=2, R=0.05, e=0.5e-3, k=1e4, c=20.0, D=1e-3)
+    wn = params.natural_frequency_rad_s
+    std = ParameterStd(k=200.0, c=1.0, M=0.02)
+    speeds = np.linspace(0.5, 6.0, 50) * wn
+    values = np.linspace(1.0, 60.0, 400)
+
+    def mc(client=None):
+        return stability_probability(params, std, speeds, 2000, seed=0, client=client, chunk_size=250)
+
+    def smap(client=None):
+        return chunked_stability_map(params, speeds, "c", values, client=client, chunk_size=25)
+
+    print("\nBall-balancer studies: Monte-Carlo P(stable) (2000 draws x 50 speeds, chunks of 250) and a "
+          "stability map (400 damping values x 50 speeds, chunks of 25)\n")
+    print("| run | Monte-Carlo (s) | stability map (s) | same numbers |")
+    print("|---|---|---|---|")
+    ref_mc, ref_map = mc(), smap()
+    t_mc, t_map = timed(mc, runs), timed(smap, runs)
+    print(f"| this process | {t_mc[0]:.2f} [{t_mc[1]:.2f}–{t_mc[2]:.2f}] | {t_map[0]:.2f} [{t_map[1]:.2f}–{t_map[2]:.2f}] "
+          "| (reference) |")
+    for workers in worker_counts:
+        with LocalCluster(n_workers=workers, threads_per_worker=1, dashboard_address=None,
+                          silence_logs=logging.ERROR) as cluster, Client(cluster) as client:
+            same = (np.array_equal(mc(client).stable_count, ref_mc.stable_count)
+                    and np.array_equal(smap(client).stability_class, ref_map.stability_class))
+            t_mc, t_map = timed(lambda: mc(client), runs), timed(lambda: smap(client), runs)
+            print(f"| running scheduler + {workers} worker(s) | {t_mc[0]:.2f} [{t_mc[1]:.2f}–{t_mc[2]:.2f}] | "
+                  f"{t_map[0]:.2f} [{t_map[1]:.2f}–{t_map[2]:.2f}] | {'yes' if same else 'NO'} |")
 
 
 if __name__ == "__main__":

@@ -7,6 +7,15 @@ from pathlib import Path
 import pytest
 
 os.environ.setdefault("MPLBACKEND", "Agg")
+# hypothesis writes a cache (``constants``, and the example database where a test keeps one)
+# under .hypothesis/ in the working directory even with database=None; the runs here are
+# derandomised or seeded, so nothing of it is needed: keep it out of the source tree
+if "HYPOTHESIS_STORAGE_DIRECTORY" not in os.environ:
+    import tempfile
+
+    from hypothesis.configuration import set_hypothesis_home_dir
+
+    set_hypothesis_home_dir(os.path.join(tempfile.gettempdir(), f"modalbal-hypothesis-{os.getuid()}"))
 
 import modal  # noqa: E402
 
@@ -30,3 +39,11 @@ def synthetic_dir() -> Path:
 @pytest.fixture
 def real_dir() -> Path:
     return REAL
+
+
+@pytest.fixture(scope="session")
+def dask_cluster(tmp_path_factory):
+    """A real ``dask scheduler`` and two ``dask worker`` processes on 127.0.0.1: (address, folder, processes)."""
+    from daskcluster import cluster
+
+    yield from cluster(tmp_path_factory)

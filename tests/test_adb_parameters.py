@@ -1,6 +1,7 @@
 """ADBParameters: validation, nondimensional groups, construction from identification."""
 from __future__ import annotations
 
+import dataclasses
 import math
 from types import SimpleNamespace
 
@@ -9,6 +10,7 @@ import pytest
 
 from balancer.adb import ADBParameters, ParameterBatch, identified_std
 from modal.errors import ParameterError
+from identified import identified_mode, within
 
 REFERENCE = dict(M=1.0, m=0.02, n=2, R=0.05, e=0.5e-3, k=1e4, c=20.0, D=1e-3)
 
@@ -63,38 +65,39 @@ def test_nondimensional_round_trip():
         assert getattr(q, name) == pytest.approx(getattr(p, name), rel=1e-13)
 
 
-def _mode(k, c, mass, std=None):
-    return SimpleNamespace(
-        natural_frequency_hz=np.sqrt(np.abs(np.asarray(k)) / np.asarray(mass)) / (2 * np.pi),
-        damping_ratio=np.asarray(c) / (2 * np.sqrt(np.abs(np.asarray(k)) * np.asarray(mass))),
-        stiffness_n_per_m=k, damping_n_s_per_m=c, mass_kg=mass, std=std, flags=(),
-    )
-
-
+# Fed real identification results (modal.identify on a known rotor's receptance, 0.1 % noise)
 def test_from_identified_scalar_and_channels():
-    std = SimpleNamespace(stiffness_n_per_m=np.array([100.0, 50.0]), damping_n_s_per_m=np.array([1.0, 2.0]),
-                          mass_kg=np.array([0.01, 0.02]))
-    mode = _mode(np.array([1e4, 1.2e4]), np.array([20.0, 22.0]), np.array([1.0, 1.1]), std)
+    # one rotor measured on two driving-point channels (modal masses 1.0 and 1.1 kg)
+    mode = identified_mode(np.array([1.0, 1.1]), 1e4, 20.0)
     p = ADBParameters.from_identified(mode, m=0.02, n=2, R=0.05, e=5e-4, D=1e-3, channel=1)
-    assert (p.k, p.c, p.M) == (1.2e4, 22.0, 1.1)
+    assert (p.k, p.c, p.M) == (mode.stiffness_n_per_m[1], mode.damping_n_s_per_m[1], mode.mass_kg[1])
+    assert within([p.k, p.c, p.M], [1.1e4, 22.0, 1.1],
+                  [mode.std.stiffness_n_per_m[1], mode.std.damping_n_s_per_m[1], mode.std.mass_kg[1]])
     s = identified_std(mode, channel=1)
-    assert (s.k, s.c, s.M) == (50.0, 2.0, 0.02)
-    scalar = ADBParameters.from_identified(_mode(1e4, 20.0, 1.04), m=0.02, n=2, R=0.05, e=5e-4, D=1e-3,
-                                           mass_includes_balls=True)
-    assert scalar.M == pytest.approx(1.0, rel=1e-15)
-    assert identified_std(_mode(1e4, 20.0, 1.0)).k == 0.0
+    assert (s.k, s.c, s.M) == (mode.std.stiffness_n_per_m[1], mode.std.damping_n_s_per_m[1], mode.std.mass_kg[1])
+    assert 0 < s.k < 1e-3 * p.k and 0 < s.c < 1e-2 * p.c and 0 < s.M < 1e-3 * p.M
+    single = identified_mode(1.04, 1e4, 20.0)
+    scalar = ADBParameters.from_identified(single, m=0.02, n=2, R=0.05, e=5e-4, D=1e-3, mass_includes_balls=True)
+    # the identified mass holds the two 0.02 kg balls: subtracted exactly
+    assert scalar.M == single.mass_kg - 0.04
+    assert within(scalar.M, 1.0, single.std.mass_kg)
+    # a result without errors (duck-typed input): 0, not an exception
+    assert identified_std(dataclasses.replace(single, std=None)).k == 0.0
 
 
 def test_from_identified_rejects_bad_fields():
     with pytest.raises(ParameterError, match="stiffness_n_per_m"):
         ADBParameters.from_identified(SimpleNamespace(mass_kg=1.0), m=0.02, n=2, R=0.05, e=5e-4, D=1e-3)
+    # a transfer channel: k, c, m are NaN (flag not_driving_point)
+    transfer = identified_mode(np.array([1.0, 1.1]), 1e4, 20.0, driving_point=[True, False])
     with pytest.raises(ParameterError, match="finite"):
-        ADBParameters.from_identified(_mode(math.nan, 20.0, 1.0), m=0.02, n=2, R=0.05, e=5e-4, D=1e-3)
+        ADBParameters.from_identified(transfer, m=0.02, n=2, R=0.05, e=5e-4, D=1e-3, channel=1)
     with pytest.raises(ParameterError, match="channel"):
-        ADBParameters.from_identified(_mode(np.array([1e4, 2e4]), 20.0, 1.0), m=0.02, n=2, R=0.05,
-                                      e=5e-4, D=1e-3, channel=5)
+        ADBParameters.from_identified(transfer, m=0.02, n=2, R=0.05, e=5e-4, D=1e-3, channel=5)
+    single = identified_mode(1.0, 1e4, 20.0)
     with pytest.raises(ParameterError, match="^k "):
-        ADBParameters.from_identified(_mode(-1.0, 20.0, 1.0), m=0.02, n=2, R=0.05, e=5e-4, D=1e-3)
+        ADBParameters.from_identified(dataclasses.replace(single, stiffness_n_per_m=-1.0), m=0.02, n=2, R=0.05,
+                                      e=5e-4, D=1e-3)
 
 
 def test_batch_requires_common_ball_count():

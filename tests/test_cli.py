@@ -63,9 +63,10 @@ def test_usage_error_exits_2(three_mode_file):
 @pytest.mark.parametrize(
     "content, expect",
     [
-        ("", "empty"),
-        ("frequency_hz,re,im\n1,2,x\n", "line 2"),
-        ("not,a\nfrf,file\n", ""),
+        ("", "empty file (0 bytes)"),
+        ("frequency_hz,re,im\n1,2,x\n", "line 2, column 'im': 'x' is not a number"),
+        # two lines of words: both read as header text, so no data line is left
+        ("not,a\nfrf,file\n", "line 2: only a header or comments, no data lines"),
     ],
 )
 def test_bad_file_is_one_line_and_exit_1(tmp_path, content, expect):

@@ -3,6 +3,8 @@
 `modal.cli.main` is called in-process (the console script and `python -m modal` call
 the same function); `test_cli.py` covers the real subprocess.
 """
+import json
+
 import h5py
 import numpy as np
 import pytest
@@ -13,8 +15,24 @@ from modal.cli import main
 from modal.io import write_frf
 from modal.synthetic import modal_frf
 
-GOOD = "\n".join(["# format: modalbal-frf-csv 1", "# kind: receptance", "frequency_hz,re_0,im_0"]
-                 + [f"{f},{1.0 / (1 + f)},0.1" for f in range(1, 40)]) + "\n"
+# A well-posed one-mode receptance (m = 1 kg, fn = 20 Hz, zeta = 2 %: 8 lines per half-power
+# band at 0.1 Hz) that the command fits (exit 0, `test_good_files_fit`); every broken case below
+# changes one thing in it, so the failure can only come from that change.
+_F = np.round(np.arange(100, 301) * 0.1, 1)
+_H = modal_frf(_F, [20.0], [0.02], [1.0]).response
+ROWS = [(f"{f:.1f}", f"{h.real:.12e}", f"{h.imag:.12e}") for f, h in zip(_F, _H)]
+
+
+def _csv(rows=ROWS, head=("# format: modalbal-frf-csv 1", "# kind: receptance", "frequency_hz,re_0,im_0")):
+    return "\n".join(list(head) + [",".join(r) for r in rows]) + "\n"
+
+
+def _row(i, *cells):
+    """ROWS with row i replaced by ``cells``."""
+    return ROWS[:i] + [tuple(cells)] + ROWS[i + 1:]
+
+
+GOOD = _csv()
 
 
 def _uff(tmp_path):
@@ -32,37 +50,66 @@ def _func_type(lines, code):
     return out
 
 
+# name -> (content, the reason the one-line message must give). The reason is the part of the
+# message that only this breakage produces, so a reader that stops checking it fails here.
 CASES = {
-    "empty.csv": lambda tmp: "",
-    "header_only.csv": lambda tmp: "frequency_hz,re_0,im_0\n",
-    "text_in_number.csv": lambda tmp: GOOD.replace("5,", "five,", 1),
-    "nan.csv": lambda tmp: GOOD.replace("0.1\n", "nan\n", 1),
-    "inf.csv": lambda tmp: GOOD.replace("0.1\n", "inf\n", 1),
-    "duplicate.csv": lambda tmp: GOOD.replace("3,", "2,", 1),
-    "negative.csv": lambda tmp: GOOD.replace("\n1,", "\n-1,", 1),
-    "columns.csv": lambda tmp: GOOD.replace("0.1\n", "0.1,7\n", 1),
-    "unknown_kind.csv": lambda tmp: GOOD.replace("receptance", "compliance"),
-    "no_kind.csv": lambda tmp: GOOD.replace("# kind: receptance\n", ""),
-    "newer_version.csv": lambda tmp: GOOD.replace("modalbal-frf-csv 1", "modalbal-frf-csv 9"),
-    "decimal_comma.csv": lambda tmp: "f;re;im\n" + "".join(f"{f},5;{f},25;0,1\n" for f in range(1, 30)),
-    "garbage.bin": lambda tmp: bytes(range(256)) * 8,
-    "time.uff": lambda tmp: "\n".join(_func_type(_uff(tmp), 1)) + "\n",
-    "spectrum.uff": lambda tmp: "\n".join(_func_type(_uff(tmp), 2)) + "\n",
-    "truncated.uff": lambda tmp: "\n".join(_uff(tmp)[:14]) + "\n",
-    "text_field.uff": lambda tmp: "\n".join(_uff(tmp)[:12] + ["  abc  def  ghi"] + _uff(tmp)[13:]) + "\n",
-    "no_end.uff": lambda tmp: "\n".join(_uff(tmp)[:-1]) + "\n",
+    "empty.csv": (lambda tmp: "", "empty file (0 bytes)"),
+    "header_only.csv": (lambda tmp: "frequency_hz,re_0,im_0\n", "only a header or comments, no data lines"),
+    "text_in_number.csv": (lambda tmp: _csv(_row(5, "10.5", "five", ROWS[5][2])),
+                           "line 9, column 're_0': 'five' is not a number"),
+    "nan.csv": (lambda tmp: _csv(_row(5, ROWS[5][0], ROWS[5][1], "nan")),
+                "line 9, column 'im_0': value nan is not finite"),
+    "inf.csv": (lambda tmp: _csv(_row(5, ROWS[5][0], "-inf", ROWS[5][2])),
+                "line 9, column 're_0': value -inf is not finite"),
+    "duplicate.csv": (lambda tmp: _csv(_row(5, ROWS[4][0], ROWS[5][1], ROWS[5][2])),
+                      "duplicate lines (10.4 Hz)"),
+    "negative.csv": (lambda tmp: _csv(_row(0, "-10.0", ROWS[0][1], ROWS[0][2])), "negative value (-10.0)"),
+    "columns.csv": (lambda tmp: _csv(_row(5, *ROWS[5], "7")), "line 9: 4 columns; expected 3"),
+    "unknown_kind.csv": (lambda tmp: GOOD.replace("# kind: receptance", "# kind: transmissibility"),
+                         "unknown FRF kind 'transmissibility'"),
+    "no_kind.csv": (lambda tmp: GOOD.replace("# kind: receptance\n", ""), "the FRF kind cannot be determined"),
+    "newer_version.csv": (lambda tmp: GOOD.replace("modalbal-frf-csv 1", "modalbal-frf-csv 9"),
+                          "version 9 is not supported"),
+    "decimal_comma.csv": (lambda tmp: "f;re;im\n" + "".join(f"{f},5;{f},25;0,1\n" for f in range(1, 30)),
+                          "'1,5' is not a number (decimal comma? pass decimal=',')"),
+    "garbage.bin": (lambda tmp: bytes(range(256)) * 8, "binary content of no known kind"),
+    "time.uff": (lambda tmp: "\n".join(_func_type(_uff(tmp), 1)) + "\n", "expected real time samples"),
+    "spectrum.uff": (lambda tmp: "\n".join(_func_type(_uff(tmp), 2)) + "\n",
+                     "function type 2 (auto spectrum) is not an FRF"),
+    "truncated.uff": (lambda tmp: "\n".join(_uff(tmp)[:14]) + "\n", "no complete dataset"),
+    "text_field.uff": (lambda tmp: "\n".join(_uff(tmp)[:12] + ["  abc  def  ghi"] + _uff(tmp)[13:]) + "\n",
+                       "line 13, record 11, field z_axis_spec_data_type): 'abc  def' is not an integer"),
+    "no_end.uff": (lambda tmp: "\n".join(_uff(tmp)[:-1]) + "\n", "no complete dataset"),
 }
+
+
+def test_good_files_fit(tmp_path, capsys):
+    """The files every broken case starts from fit: a broken case's exit 1 comes from its breakage."""
+    (tmp_path / "good.csv").write_text(GOOD)
+    (tmp_path / "good.uff").write_text("\n".join(_uff(tmp_path)) + "\n")
+    for name in ("good.csv", "good.uff"):
+        assert main(["fit", str(tmp_path / name), "--json"]) == 0, capsys.readouterr().err
+        out = capsys.readouterr()
+        assert out.err == ""
+        doc = json.loads(out.out)
+        assert len(doc["modes"]) == 1
+        # exact data written with >= 11 significant digits: the fit recovers 20 Hz (CSV) / 40 Hz (UFF)
+        # far inside 1e-6 (observed ~1e-15); a reader that garbled the lines would not
+        fn = doc["modes"][0]["natural_frequency_hz"]
+        assert fn == pytest.approx(20.0 if name.endswith("csv") else 40.0, rel=1e-6)
 
 
 @pytest.mark.parametrize("name", sorted(CASES))
 def test_broken_file_gives_one_line_and_exit_1(tmp_path, capsys, name):
     path = tmp_path / name
-    content = CASES[name](tmp_path)
+    make, reason = CASES[name]
+    content = make(tmp_path)
     (path.write_bytes if isinstance(content, bytes) else path.write_text)(content)
     code = main(["fit", str(path)])
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 1, err
     assert len(err) == 1 and err[0].startswith("error: ") and name in err[0], err
+    assert reason in err[0], err
 
 
 def test_mat_without_the_variables(tmp_path, capsys):

@@ -40,9 +40,12 @@ def test_exact_sdof_all_methods(kind, zeta):
         assert abs(value / truth - 1) < 1e-6
     assert nls.flags == ("driving_point_assumed",)
     circle = identify(frf, "circle")[0]
-    # the mobility circle is exact for viscous damping; the angle fit recovers the pole
-    assert abs(circle.natural_frequency_hz / fn - 1) < 1e-6
-    assert abs(circle.damping_ratio / zeta - 1) < 1e-4
+    # the mobility circle is exact for viscous damping and the angle fit recovers the pole:
+    # only rounding remains, eps amplified by the band's conditioning ~1/ζ (2e-13 at ζ = 1e-3;
+    # observed <= 5.5e-14 relative, 0 on ωn); 10 eps/ζ leaves a factor 4 for other platforms' BLAS
+    rounding = 10 * np.finfo(float).eps / zeta
+    assert abs(circle.natural_frequency_hz / fn - 1) < rounding
+    assert abs(circle.damping_ratio / zeta - 1) < rounding
     frf5, *_ = sdof_case(kind, zeta, lines_per_band=5)
     hp = identify(frf5, "halfpower")[0]
     # dB interpolation + refined peak + exact inversion: ~L^-3 error, 5e-3 at L = 5 (numerics.md §1)
@@ -74,9 +77,12 @@ def test_three_separated_modes(kind):
         assert abs(mode.natural_frequency_hz / THREE_FN[r] - 1) < 1e-4
         assert abs(mode.damping_ratio / THREE_ZETA[r] - 1) < 1e-2
         assert "method_bias" in mode.flags
-        # the exact refinement is the truth here, so the errors now cover the bias
-        assert abs(mode.natural_frequency_hz - THREE_FN[r]) <= 1.01 * mode.std.natural_frequency_hz
-        assert abs(mode.damping_ratio - THREE_ZETA[r]) <= 1.01 * mode.std.damping_ratio
+        # the flag comes from ζ. Exact data: the widened error is hypot(noise part, bias) and the
+        # noise part of exact data is rounding, so it must be the actual error itself, from above
+        # and within 1 % (a noise part <= 0.14 of the bias; observed 1.0002-1.0046). "Covers the
+        # error" alone held by construction (the refinement is the truth to 1e-9); this also
+        # fails for an error that is inflated or not widened.
+        assert 1.0 <= mode.std.damping_ratio / abs(mode.damping_ratio - THREE_ZETA[r]) <= 1.01
 
 
 def test_matrix_system_multichannel_driving_and_transfer():
@@ -187,9 +193,14 @@ def test_rows_are_json_ready():
     rows = result.rows()
     assert len(rows) == 3
     text = json.dumps([{k: (str(v) if isinstance(v, complex) else v) for k, v in row.items()} for row in rows])
-    for key in ("natural_frequency_hz", "damping_ratio", "stiffness_n_per_m", "damping_n_s_per_m", "mass_kg",
-                "std", "flags", "channel", "method"):
-        assert key in text
+    # the keys of each mode at the top level of its object (the nested "std" repeats the
+    # quantity names, so a search of the text would pass with them missing from the mode)
+    quantities = ("natural_frequency_hz", "damping_ratio", "stiffness_n_per_m", "damping_n_s_per_m", "mass_kg")
+    for row, truth in zip(json.loads(text), THREE_FN):
+        assert set(quantities + ("std", "flags", "channel", "method")) <= set(row)
+        assert set(quantities) <= set(row["std"])
+        assert row["natural_frequency_hz"] == pytest.approx(truth, rel=1e-9)
+        assert all(isinstance(row[q], float) and isinstance(row["std"][q], float) for q in quantities)
 
 
 def test_bad_arguments():
@@ -212,11 +223,23 @@ def test_many_channels_every_modal_constant(method):
     frf = modal_frf(np.linspace(10, 400, 4001), THREE_FN, THREE_ZETA, A, kind="mobility")
     with pytest.warns(QualityWarning, match="method_bias"):  # exact data: bias ≫ noise error
         result = identify(frf, method)
+    # the same with 0.1 % noise, where the refinement is no longer the truth and "the errors
+    # cover the truth" can fail (on exact data it held by construction)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", QualityWarning)
+        noisy = identify(add_noise(frf, 1e-3, seed=0), method)
+    for r, mode in enumerate(noisy):
+        if "method_bias" in mode.flags:
+            z = np.abs(mode.modal_constant - A[:, r]) / mode.std.modal_constant
+            # every channel, including the 8 outside the refinement's channels: within 3 errors
+            # (P(|z| > 3) = 0.27 % for a calibrated error; observed max 1.7)
+            assert np.all(z <= 3), z.max()
+            # the neighbours' bias dominates the 0.1 % noise, so an honest error is about the
+            # error itself (|z| ~ 1): a median below 0.55 means errors >= 1.8x too wide
+            # (observed 0.92-0.96 circle, 0.71 = 1/sqrt(2) half-power, see notes/wt21b.md)
+            assert np.median(z) >= 0.55, np.median(z)
     for r, mode in enumerate(result):
         assert mode.modal_constant.shape == (40,) and np.all(np.isfinite(mode.modal_constant))
-        if "method_bias" in mode.flags:
-            # every channel's error is covered, including the 8 outside the refinement's channels
-            assert np.all(np.abs(mode.modal_constant - A[:, r]) <= 1.01 * mode.std.modal_constant)
         # a resonance-fitted |A| scales with the damping estimate (|A| = 2ζωn·|peak| for an SDOF),
         # so its error is bounded by the method's own ζ error, plus ~1e-2 from the neighbours
         zeta_error = abs(mode.damping_ratio / THREE_ZETA[r] - 1)
@@ -252,12 +275,19 @@ def test_single_mode_methods_next_to_another_mode(method):
     with pytest.warns(QualityWarning, match="method_bias"):
         result = identify(frf, method)
     assert len(result) == 2
+    w1, w2 = 100.0**2, 150.0**2
     for mode, fn in zip(result, (100.0, 150.0)):
         assert "method_bias" in mode.flags
-        # the exact refinement is the truth, so the widened errors cover the error itself
-        assert abs(mode.damping_ratio - 0.02) <= 1.01 * mode.std.damping_ratio
-        assert abs(mode.natural_frequency_hz - fn) <= 1.01 * mode.std.natural_frequency_hz
-        assert abs(mode.mass_kg - 1.0) <= 1.01 * mode.std.mass_kg + 1e-9
+        # exact data: the widened error is hypot(noise part, bias) with a noise part of rounding,
+        # so it must be the actual error from above and within 5 % (noise part <= 0.32 of the
+        # bias; observed 1.0000-1.042). Only "covers" held by construction (refinement = truth).
+        for value, truth, std in ((mode.damping_ratio, 0.02, mode.std.damping_ratio),
+                                  (mode.natural_frequency_hz, fn, mode.std.natural_frequency_hz)):
+            assert 1.0 <= std / abs(value - truth) <= 1.05, (value, truth, std)
+        # mass against the truth: the neighbour adds to the resonance at most
+        # |H_other / H_own| = 2ζ ω_r² / |ω_1² − ω_2²| (3.2 % at 100 Hz, 7.2 % at 150 Hz)
+        # to the constant the mass comes from (observed: circle 0.7 %)
+        assert abs(mode.mass_kg - 1.0) <= 2 * 0.02 * fn**2 / (w2 - w1)
 
 
 @pytest.mark.parametrize("method", ["circle", "halfpower"])

@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 from balancer import read_archive, run_scene
+from balancer.adb import stable_speed_intervals
 from balancer.scene import STAGES
 from modal import FRF
 from modal.errors import SceneError
@@ -56,6 +57,23 @@ def test_reuse_and_exact_downstream_rerun(tmp_path):
     first = run_scene(config, out=tmp_path / "a.h5")
     ran = {s for s, v in first.stages.items() if v == "ran"}
     assert ran == {"frf", "identify", "rotor", "adb_stability", "compressor"}
+    # the rotor carries the identified mode 1 (accelerance, A = 0.96 1/kg at 15.6 Hz, zeta 5 %):
+    # m = 1/A holds the two balls (mass_includes_balls), k = m wn^2, c = 2 zeta m wn; the
+    # noise (0.2 %) leaves them within 5 of their standard errors (6e-7 per value if calibrated)
+    rotor = first.results["rotor"]
+    m_identified, wn = 1 / 0.96, 2 * np.pi * 15.6
+    truth = {"M": m_identified - 2 * 0.02, "k": m_identified * wn**2, "c": 2 * 0.05 * m_identified * wn}
+    for name, value in truth.items():
+        assert abs(getattr(rotor.params, name) - value) <= 5 * getattr(rotor.std, name), (name, value)
+    mode = first.results["identify"][0]
+    assert (rotor.params.k, rotor.params.c) == (mode.stiffness_n_per_m, mode.damping_n_s_per_m)
+    assert rotor.params.M == mode.mass_kg - 2 * 0.02
+    assert (rotor.params.m, rotor.params.n, rotor.params.R, rotor.params.D, rotor.params.e) == (0.02, 2, 0.05, 0.001, 5e-4)
+    # the stage's stable interval is exactly what a direct call with those parameters gives
+    direct = stable_speed_intervals(rotor.params, 3.0 * rotor.params.natural_frequency_rad_s, grid_points=400)
+    stage = first.results["adb_stability"].intervals
+    np.testing.assert_array_equal(stage.intervals_rad_s, direct.intervals_rad_s)
+    assert stage.intervals_rad_s.shape == (1, 2) and 1.0 < stage.intervals_ratio[0, 0] < 3.0
     second = run_scene(config, out=tmp_path / "b.h5", archive=tmp_path / "a.h5")
     assert {s: v for s, v in second.stages.items() if v != "skipped"} == {s: "reused" for s in ran}
     # change the ball drag: the rotor and its stability rerun, identification and compressor do not

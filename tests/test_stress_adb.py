@@ -17,8 +17,9 @@ Properties:
   its rounding bound) a simulation started 1e-4 rad off the balanced state (a generic, not
   symmetric, perturbation of the two balls) and run
   for ``8 / |λ|`` (e^8 ≈ 3000 in amplitude) must decay (stable: the deviation ends
-  below half its start; transient non-normal growth is far below e^8) or grow
-  (unstable: the deviation exceeds twice its start at some time).  Runs that would
+  below e^-6 of its start; the generic start and non-normal transients may cost e^2) or
+  grow (unstable: the deviation exceeds e^4 times its start at some time; a generic start
+  has at least e^-4 along the unstable mode).  Runs that would
   exceed ``MAX_REVOLUTIONS`` are not clear within the budget and are skipped
   (counted).
 * **Near the boundary.**  At the refined ends of the stable speed intervals the
@@ -89,10 +90,10 @@ def check_energy(params: ADBParameters, r0: float, v0: float, direction: float, 
                           compare_without_balls=False)
     _finite_run(result)
     bound = math.sqrt(r0**2 + params.total_mass_kg * v0**2 / params.k)
+    # at every sample, so also at the end (a separate check of the last sample, as there was,
+    # is implied; E(t) <= E(0) is the whole statement the amplitudes allow: the result
+    # carries no rotor velocity from which E(t) itself could be checked to decrease)
     assert np.max(result.amplitude_m) <= bound * (1 + ENERGY_RTOL), (np.max(result.amplitude_m), bound)
-    # with damping the energy also ends below its start (unless nothing moved)
-    if params.c > 0 and bound > 0:
-        assert result.amplitude_m[-1] <= bound * (1 + ENERGY_RTOL)
 
 
 ENERGY_ARGS = (adb_parameters(), log_uniform(1e-6, 1e-2), log_uniform(1e-6, 1.0), st.floats(0.0, 2 * math.pi),
@@ -146,12 +147,18 @@ def check_verdict(params: ADBParameters, speed_ratio: float, start: tuple[float,
                           compare_without_balls=False, n_samples=801)
     _finite_run(result)
     dev = _deviation(result, balanced, params.R)
+    # linear prediction for the least stable mode over 8 / |λ|: a factor e^{±8} (2981). The
+    # start is generic, not along that mode: its share of the start and the non-normal
+    # transients of the others may cost a factor e^2 when stable (the others decay faster)
+    # and e^4 when unstable (a start with >= 1.8 % along the unstable mode); e^4 of the 1e-4 rad
+    # start stays far below the nonlinear saturation (~1 rad). Stress run (STRESS_SEED 8, 162
+    # simulated): stable end/start <= 7.9e-4 = 2.4 e^-8, unstable max/start >= 252 = e^5.5.
     if growth < 0:
         event("verdict: stable, simulated")
-        assert dev[-1] <= 0.5 * dev[0], (dev[0], dev[-1], growth)
+        assert dev[-1] <= math.exp(-6.0) * dev[0], (dev[0], dev[-1], growth)
     else:
         event("verdict: unstable, simulated")
-        assert dev.max() >= 2.0 * dev[0], (dev[0], dev.max(), growth)
+        assert dev.max() >= math.exp(4.0) * dev[0], (dev[0], dev.max(), growth)
 
 
 VERDICT_ARGS = (adb_parameters(st.just(2)), st.floats(0.3, 5.0),

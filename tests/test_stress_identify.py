@@ -30,6 +30,7 @@ that biases it has to raise ``missing_mode``.
 """
 from __future__ import annotations
 
+import functools
 import math
 import os
 import warnings
@@ -463,3 +464,169 @@ def test_channel_combination_does_not_underflow():
         value, std = _combine(np.array([0.1, 0.1]), np.array([1e-200, 1e-3]), np.array([1.0, 1.0]))
     # the inverse-variance combination is dominated by the tiny error; it must stay finite and > 0
     assert value == 0.1 and np.isfinite(std) and 0 < std < 1e-150
+
+
+# --------------------------------------------------------------------------- well-posed cases
+#: a well-posed case: 1-3 modes at overlap 0.1-0.3, 0.1-3 % noise, 4-40 lines per half-power
+#: band, ζ 3e-3 ... 0.05, peaks of comparable height (within 1:3). Here no flag may excuse
+#: an estimate, few modes may be flagged at all, and the z-scores (estimate − truth)/std
+#: across cases must have the spread of a calibrated error.
+#: Cap on the share of flagged modes. A flag from a 3-sigma test (method_bias,
+#: high_uncertainty) fires on noise alone in < 1 % of estimates; 5 % for NLS and half-power
+#: leaves room for that (observed: NLS 0 of 74 and 0 of 409, half-power 1 of 40 and 1 of 200).
+#: The circle's damping_pair_spread (damping pairs > 10 % apart, a fixed threshold, not scaled
+#: to the noise) fires on noise at 3 % and few lines: with method_bias 3 of 40 and 21 of 200
+#: (15 damping_pair_spread); capped at 15 %.
+WELL_POSED_FLAG_RATE = {"nls": 0.05, "circle": 0.15, "halfpower": 0.1}
+#: the single-mode methods are well posed on one mode only: a neighbour even at overlap 0.01
+#: bends the circle and the -3 dB points beyond their noise-driven errors at 0.1 % noise, and
+#: the refinement check rightly flags that (method_bias on 13 and 17 of 27 modes with 1-3)
+WELL_POSED_MODES = {"nls": 3, "circle": 1, "halfpower": 1}
+
+
+def z_bounds(n: int) -> tuple[float, float, float]:
+    """Bounds on the spread (standard deviation) and the mean of n z-scores of a calibrated,
+    unbiased error: 1 and 0, with the sample's own scatter ±1/sqrt(2n) and ±1/sqrt(n);
+    3 of it (n = 40 in the default run: spread 0.66-1.34, |mean| <= 0.47; n = 200 under
+    -m stress: 0.85-1.15, the issue's ±15 %, |mean| <= 0.21). Two-sided: an error 1.5x too
+    wide (spread 0.67) or too narrow fails."""
+    return 1 - 3 / math.sqrt(2 * n), 1 + 3 / math.sqrt(2 * n), 3 / math.sqrt(n)
+
+
+def well_posed_case(rng: np.random.Generator, max_modes: int = 3) -> Case:
+    """One well-posed case drawn with numpy's seeded generator (not hypothesis: its draws
+    depend on the constants of whichever modules the session imported, so a derandomised
+    hypothesis sample is not the same sample in every run, and a statistic over it moves)."""
+    n = int(rng.integers(1, max_modes + 1))
+    kind = KINDS[int(rng.integers(3))]
+    f1 = 10 ** rng.uniform(0.0, 4.0)
+    zeta = np.full(n, 10 ** rng.uniform(math.log10(3e-3), math.log10(0.05)))
+    # neighbours at overlap 0.1-0.3: separated, and near enough that the axis stays within
+    # N_MAX lines at the drawn resolution (~30 lines per band-width of spread)
+    overlap = 10 ** rng.uniform(-1.0, math.log10(0.3), n - 1)
+    fn = [f1]
+    for r in range(n - 1):
+        fn.append(fn[-1] * (1 + 2 * zeta[r] / overlap[r]))
+    fn = np.array(fn)
+    m = 10 ** rng.uniform(-2.0, 2.0)
+    # peaks of comparable height in the drawn kind (|A| ωn^(p-2) / 2ζ), within 1:3, so that
+    # every mode stands well above the noise
+    ratios = 10 ** rng.uniform(-0.5, 0.5, n - 1)
+    const = np.r_[1.0, ratios] * (fn / fn[0]) ** (2 - KIND_POWER[kind]) / m
+    noise = 10 ** rng.uniform(-3.0, math.log10(0.03))
+    lines = 10 ** rng.uniform(math.log10(4.0), math.log10(40.0))
+    bw = 2 * zeta * fn
+    f_lo, f_hi = fn[0] - 5 * bw[0], fn[-1] + 5 * bw[-1]
+    df = bw.min() / lines
+    f = f_lo + (np.arange(int((f_hi - f_lo) / df)) + rng.uniform(0.0, 0.999)) * df
+    assert f.size <= N_MAX
+    return Case(f, fn, zeta, const, kind, noise, int(rng.integers(2**31)), float(lines), True, True)
+
+
+QUANTITIES = ("natural_frequency_hz", "damping_ratio", "mass_kg", "stiffness_n_per_m")
+
+
+def _summary(case: Case) -> str:
+    return (f"kind={case.kind} fn={case.fn.tolist()} zeta={case.zeta[0]:.4g} A={case.modal_constant.real.tolist()} "
+            f"noise={case.noise:.4g} L={case.lines_per_band:.3g} lines={case.frequency_hz.size} "
+            f"noise seed {case.noise_seed}")
+
+
+def collect_well_posed(case: Case, method: str, tally: dict) -> None:
+    """Every mode found and unflagged (or counted as flagged); its z-scores collected."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", modal.ModalWarning)
+        warnings.simplefilter("error", RuntimeWarning)
+        result = identify(case.frf(), method, bands_hz=case.bands())
+    assert len(result) == case.fn.size, ("a well-posed case must be identified", _summary(case))
+    check_finite(result)
+    truth = {"natural_frequency_hz": case.fn, "damping_ratio": case.zeta, "mass_kg": case.mass,
+             "stiffness_n_per_m": case.stiffness}
+    for r, mode in enumerate(result):
+        tally["modes"] += 1
+        if serious(mode):
+            tally["flagged"].append(sorted(serious(mode)))
+        for name in QUANTITIES:
+            value, std = float(getattr(mode, name)), float(getattr(mode.std, name))
+            z = (value - truth[name][r]) / std
+            # no flag excuses a well-posed estimate: within K_SIGMA of its own error
+            assert abs(z) <= K_SIGMA, (name, value, truth[name][r], std, mode.flags, _summary(case))
+            tally[name].append(z)
+
+
+def check_well_posed_flags(tally: dict, method: str) -> None:
+    rate = len(tally["flagged"]) / tally["modes"]
+    assert rate <= WELL_POSED_FLAG_RATE[method], (rate, tally["flagged"])
+
+
+def check_well_posed_spread(tally: dict, lower: bool = True) -> None:
+    """Mean and spread of the z-scores; ``lower=False`` checks only that the errors are not
+    too small (spread <= the upper bound), the part that holds for every method today."""
+    for name in QUANTITIES:
+        z = np.asarray(tally[name])
+        low, high, mean = z_bounds(z.size)
+        assert float(np.std(z)) <= high, (name, float(np.std(z)), high, z.size)
+        if lower:
+            assert abs(float(np.mean(z))) <= mean, (name, float(np.mean(z)), mean, z.size)
+            assert low <= float(np.std(z)), (name, float(np.std(z)), low, z.size)
+
+
+#: cases per method: 40 in the default run (under 1 s per method), STRESS_EXAMPLES (200) under -m stress
+WELL_POSED_CASES = 40
+
+
+@functools.lru_cache(maxsize=None)
+def well_posed_tally(method: str, stress: bool) -> dict:
+    """Draw the well-posed cases once per method and run (the tests below share them)."""
+    tally = {"modes": 0, "flagged": [], **{name: [] for name in QUANTITIES}}
+    count = int(os.environ.get("STRESS_EXAMPLES", "200")) if stress else WELL_POSED_CASES
+    rng = np.random.default_rng([STRESS_SEED, 5] if stress else 21)
+    for _ in range(count):
+        collect_well_posed(well_posed_case(rng, WELL_POSED_MODES[method]), method, tally)
+    return tally
+
+
+#: Half-power's reported errors are too large: its frequency 1.7-2x (spread of z 0.51 in the
+#: default cases, 0.59 under -m stress; 0.64-0.67 in issue 21's 400-trial measurement), ζ, k,
+#: m 1.15-1.3x, with a mean of -0.36 (ζ) and +0.2-0.33 (k, m). The calibration part of issue 21
+#: (another branch) is to fix them; strict, so the fix makes this fail until the mark goes.
+#: (Circle here: spread 0.83-0.98, mean <= 0.16; it passes, narrowly for m under -m stress: 0.86.)
+CALIBRATION_PENDING = pytest.mark.xfail(strict=True, reason="issue 21: half-power errors too large")
+METHODS = ["nls", "circle", "halfpower"]
+SPREAD_METHODS = ["nls", "circle", pytest.param("halfpower", marks=CALIBRATION_PENDING)]
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_well_posed_cases_are_found_within_their_errors_and_unflagged(method):
+    # every estimate within K_SIGMA of its own error (no flag excuses it), <= 10 % flagged
+    check_well_posed_flags(well_posed_tally(method, False), method)
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_well_posed_errors_are_not_optimistic(method):
+    # errors too small (halved: spread ~1.0-1.9) fail here for every method, whatever the
+    # calibration work still to come
+    check_well_posed_spread(well_posed_tally(method, False), lower=False)
+
+
+@pytest.mark.parametrize("method", SPREAD_METHODS)
+def test_well_posed_errors_have_the_spread_of_the_errors(method):
+    check_well_posed_spread(well_posed_tally(method, False))
+
+
+@pytest.mark.stress
+@pytest.mark.parametrize("method", METHODS)
+def test_stress_well_posed_cases_are_found_within_their_errors_and_unflagged(method):
+    check_well_posed_flags(well_posed_tally(method, True), method)
+
+
+@pytest.mark.stress
+@pytest.mark.parametrize("method", METHODS)
+def test_stress_well_posed_errors_are_not_optimistic(method):
+    check_well_posed_spread(well_posed_tally(method, True), lower=False)
+
+
+@pytest.mark.stress
+@pytest.mark.parametrize("method", SPREAD_METHODS)
+def test_stress_well_posed_errors_have_the_spread_of_the_errors(method):
+    check_well_posed_spread(well_posed_tally(method, True))

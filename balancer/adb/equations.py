@@ -46,12 +46,24 @@ COMPLEX_STEP_H = 1e-30
 
 
 def rotating_state_size(n: int) -> int:
-    """Length of the rotating-frame state for ``n`` balls: ``4 + 2n``."""
+    """Length of the rotating-frame state for ``n`` balls: ``4 + 2n``.
+
+    Parameters
+    ----------
+    n : int
+        Number of balls.
+    """
     return 4 + 2 * n
 
 
 def fixed_state_size(n: int) -> int:
-    """Length of the fixed-frame state for ``n`` balls: ``5 + 2n`` (last entry: rotor angle)."""
+    """Length of the fixed-frame state for ``n`` balls: ``5 + 2n`` (last entry: rotor angle).
+
+    Parameters
+    ----------
+    n : int
+        Number of balls.
+    """
     return 5 + 2 * n
 
 

@@ -24,7 +24,7 @@ def add_batch_parser(sub, add_fit_options) -> argparse.ArgumentParser:
                     "1: some failed (listed); 2: bad usage.")
     batch.add_argument("inputs", nargs="+", metavar="DIR_OR_GLOB", help="folders, glob patterns or files")
     batch.add_argument("--out", required=True, metavar="RESULTS.h5",
-                       help="the archive (replaced whole at the end; per-file results go to RESULTS.h5.parts/ "
+                       help="the archive (replaced whole at the end; results go to RESULTS.h5.parts/ "
                             "meanwhile, so an interrupted run resumes)")
     batch.add_argument("--table", metavar="RESULTS.csv", help="the CSV table (default: the archive's name with .csv)")
     batch.add_argument("--json", action="store_true",
@@ -57,6 +57,9 @@ def run_batch(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
         return 2
     except ModalError as exc:
         print(f"error: {exc}", file=sys.stderr)
+        return 1
+    except OSError as exc:  # the archive, the table or the parts folder cannot be written
+        print(f"error: {exc.filename or args.out}: {exc.strerror or exc}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:
         print(f"interrupted: the files fitted so far are kept in {args.out}.parts; run the same command again "

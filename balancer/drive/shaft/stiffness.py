@@ -28,7 +28,13 @@ __all__ = [
 
 # --------------------------------------------------------------------------- stiffness
 def second_moment_of_area_m4(diameter_m: float) -> float:
-    """``I = pi d**4 / 64`` of a solid round shaft, m^4 (``diameter_m`` in m)."""
+    """``I = pi d**4 / 64`` of a solid round shaft, m^4.
+
+    Parameters
+    ----------
+    diameter_m : float
+        Shaft diameter, m (> 0).
+    """
     d = positive("diameter_m", diameter_m, "m")
     return math.pi * d**4 / 64.0
 

@@ -1,0 +1,32 @@
+"""What a run does not use is not imported (issue 19 goal 4)."""
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def _modules_after(code: str) -> dict:
+    script = (f"import sys, json\nsys.path.insert(0, {str(ROOT)!r})\n{code}\n"
+              "print(json.dumps({m: m in sys.modules for m in ('balancer.influence', 'matplotlib.figure')}))")
+    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    return json.loads(proc.stdout.strip().splitlines()[-1])
+
+
+def test_numerical_modules_do_not_import_matplotlib():
+    loaded = _modules_after("import balancer.scene.stages\nfrom balancer.adb import ADBParameters, stability_map\n"
+                            "p = ADBParameters(M=1.0, m=0.02, n=2, R=0.05, e=5e-4, k=1e4, c=20.0, D=1e-3)\n"
+                            "stability_map(p, [100.0, 200.0], 'D', [1e-3], margin=False)")
+    assert loaded["matplotlib.figure"] is False and loaded["balancer.influence"] is False
+
+
+def test_the_scene_command_line_leaves_the_influence_command_out():
+    # `run` with a missing scene file: parsed, then a one-line error; the influence command's
+    # modules (parser included) were never needed
+    code = "import balancer.cli\nassert balancer.cli.main(['run', 'no_such_scene.toml']) == 1"
+    assert _modules_after(code)["balancer.influence"] is False
+    assert _modules_after("import balancer.cli\nbalancer.cli.build_parser()")["balancer.influence"] is True
