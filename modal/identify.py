@@ -36,6 +36,8 @@ START_CHANNELS = 8
 #: half-power and circle fits: an estimate further than this many of its own standard
 #: errors from the least-squares refinement of the same modes is flagged ``method_bias``
 BIAS_LIMIT = 3.0
+#: relative precision of the refinement's poles (the stopping rule of :func:`modal.nls.fit_modes`)
+REFINEMENT_PRECISION = 1e-13
 #: half-power and circle fits: the pole comes from at most this many strongest channels;
 #: the other channels' modal constants are solved linearly with that pole
 POLE_CHANNELS = 32
@@ -796,10 +798,16 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
             pole_biased = abs(d_wn) > BIAS_LIMIT * scale_wn or abs(d_z) > BIAS_LIMIT * scale_z
             noise_cov = cov.copy()  # k, c, m take the bias exactly (see _physical), not through it
             if pole_biased:
-                # the method's own bias dominates its noise error: fold it into the errors
-                cov[:, 0, 0] += d_wn**2
-                cov[:, 1, 1] += d_z**2
-                s_wn, s_z = float(np.hypot(np.nan_to_num(s_wn), d_wn)), float(np.hypot(np.nan_to_num(s_z), d_z))
+                # the method's own bias dominates its noise error: fold it into the errors, with
+                # the error of the refinement that measures it (its standard error, and at least
+                # its stopping rule, relative step 1e-13: on exact data its actual error is that
+                # rounding, 30x its rounding-level standard error)
+                fold_wn = abs(d_wn) + np.hypot(bound_wn, REFINEMENT_PRECISION * abs(wn - d_wn))
+                fold_z = abs(d_z) + np.hypot(bound_z, REFINEMENT_PRECISION * abs(zeta - d_z))
+                cov[:, 0, 0] += fold_wn**2
+                cov[:, 1, 1] += fold_z**2
+                s_wn = float(np.hypot(np.nan_to_num(s_wn), fold_wn))
+                s_z = float(np.hypot(np.nan_to_num(s_z), fold_z))
             # modal constants against each channel's own error (the circle's come from its
             # geometry, which a neighbour bends even when the pole passes)
             with np.errstate(divide="ignore", invalid="ignore"):

@@ -101,3 +101,16 @@ def test_threshold_sensitivity_uses_the_correlation():
     assert sens.std_rad_s == pytest.approx(expected, rel=1e-12)
     with pytest.raises(modal.errors.ParameterError, match="correlation"):
         ParameterStd(k=1.0, correlation=np.eye(2))
+
+
+def test_monte_carlo_draws_carry_the_correlation():
+    from balancer.adb.montecarlo import sample_parameters
+
+    truth = ADBParameters(**ROTOR, **BALLS)
+    r = np.array([[1.0, 0.3, 0.95], [0.3, 1.0, 0.2], [0.95, 0.2, 1.0]])
+    std = ParameterStd(k=50.0, c=0.2, M=0.004, correlation=r)
+    draws = sample_parameters(truth, std, 20000, seed=4)
+    # 20000 draws: a sample correlation has standard error (1 - r²)/sqrt(N) <= 0.007 and a sample
+    # SD relative error 1/sqrt(2N) = 0.005; 0.03 and 3 % are more than 4 of those
+    np.testing.assert_allclose(np.corrcoef(draws.T), r, atol=0.03)
+    np.testing.assert_allclose(draws.std(axis=0), [50.0, 0.2, 0.004], rtol=0.03)

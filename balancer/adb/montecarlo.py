@@ -61,7 +61,8 @@ class StabilityProbability:
 
 
 def sample_parameters(params: ADBParameters, std: ParameterStd, n_samples: int, seed: int = 0) -> np.ndarray:
-    """Independent normal draws of k, c, M about ``params`` with standard errors ``std``.
+    """Normal draws of k, c, M about ``params`` with standard errors ``std``, correlated as
+    ``std.correlation`` says (independent when it is None).
 
     Draws outside the physical range (k <= 0, M <= 0, c < 0) are drawn again (from the same
     generator, so the result depends on ``seed`` only).
@@ -76,12 +77,22 @@ def sample_parameters(params: ADBParameters, std: ParameterStd, n_samples: int, 
     rng = np.random.default_rng(seed)
     centre = np.array([params.k, params.c, params.M])
     sigma = np.array([std.k, std.c, std.M])
-    out = centre + sigma * rng.standard_normal((int(n_samples), 3))
+    if std.correlation is None:
+        def draw(count):
+            return centre + sigma * rng.standard_normal((count, 3))
+    else:
+        # a square root of the correlation that tolerates its singular limit (k, M at +1)
+        values, vectors = np.linalg.eigh(std.correlation)
+        root = vectors * np.sqrt(np.clip(values, 0.0, None))
+
+        def draw(count):
+            return centre + (rng.standard_normal((count, 3)) @ root.T) * sigma
+    out = draw(int(n_samples))
     for _ in range(1000):
         bad = (out[:, 0] <= 0) | (out[:, 1] < 0) | (out[:, 2] <= 0)
         if not bad.any():
             return out
-        out[bad] = centre + sigma * rng.standard_normal((int(bad.sum()), 3))
+        out[bad] = draw(int(bad.sum()))
     raise ParameterError(f"std = {std}: the draws of k, c, M keep leaving the physical range (k > 0, c >= 0, "
                          "M > 0); expected standard errors well below the values")
 
@@ -129,9 +140,10 @@ def stability_probability(params: ADBParameters, std: ParameterStd, speeds_rad_s
     params : ADBParameters
         Nominal parameters (the identified values).
     std : ParameterStd
-        Their standard errors; the draws are independent normals (the identification gives
-        standard errors, not their correlation: k and M from one modal constant are positively
-        correlated, so independent draws overstate the spread of ``omega_n``, a cautious verdict).
+        Their standard errors and correlation (:func:`balancer.adb.identified_std` carries the
+        identification's: k and M from one modal constant are nearly +1 correlated, and
+        independent draws would overstate the spread of ``omega_n`` about 4x); the draws are
+        normal with that covariance, independent when ``std.correlation`` is None.
     speeds_rad_s : array_like, shape (S,)
         Shaft speeds (rad/s, > 0).
     n_samples : int

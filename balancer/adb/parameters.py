@@ -411,6 +411,18 @@ def identified_correlation(mode: Any, channel: int | None = 0) -> np.ndarray | N
 
     Read from the mode's ``kcm_correlation`` (rows k, c, m; shape (3, 3) or one per
     channel); None when it has none or it is not finite (a transfer channel).
+
+    Parameters
+    ----------
+    mode : object
+        Identified mode (:class:`modal.ModeResult` or any object with ``kcm_correlation``).
+    channel : int or None
+        Channel index when the correlation is given per channel.
+
+    Returns
+    -------
+    ndarray, shape (3, 3), or None
+        Correlation of the errors of (k, c, M), dimensionless.
     """
     r = getattr(mode, "kcm_correlation", None)
     if r is None:
