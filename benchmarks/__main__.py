@@ -4,11 +4,15 @@ Usage::
 
     python -m benchmarks [--quick] [--runs N] [--trials N] [--only NAME ...] [--out PATH]
 
-Runs, in order: identification against the Cramér–Rao bound over damping, noise
+Runs, in order: the five speed ratios of issue 19 (``bench_speed``: SDOF identify
+against a bare least-squares fit, 1000 channels against sdypy-EMA, the stability map
+against numpy's eigenvalues, the demo scene against the import floor, a 100 000-line
+noisy FRF against a minute), identification against the Cramér–Rao bound over damping, noise
 and resolution (``bench_identify``), 1 and 1000 channels, file reading
 (``bench_io``), the counterweight optimiser against brute-force grids
 (``bench_crank``), the ball-balancer stability map and simulations against plain
-``solve_ivp`` (``bench_adb``), and the demo scene end to end (``python -m
+``solve_ivp`` (``bench_adb``), batches of files on Dask against one process
+looping (``bench_batch``), and the demo scene end to end (``python -m
 balancer run`` as a subprocess).  sdypy-EMA, when importable, is run side by side
 on the same FRFs (optional; never a dependency).
 
@@ -448,14 +452,28 @@ def stress_summary() -> str:
     return f"From docs/stress.md (run with `.venv/bin/python -m pytest -m stress`):\n\n{section}"
 
 
+# --------------------------------------------------------------------------- speed ratios
+def speed_section(runs: int, quick: bool) -> str:
+    """The five ratios of issue 19 (``benchmarks.bench_speed``), also printed to stdout."""
+    from benchmarks import bench_speed
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        results = bench_speed.run(sorted(bench_speed.GOALS), 3 if quick else runs, 60.0 if quick else 180.0)
+    text = bench_speed.table(results)
+    print(machine_section() + "\n\n" + text, flush=True)
+    return ("`python -m benchmarks.bench_speed` (each ratio measured in this run; goal 2's peer is the optional "
+            "`bench` extra):\n\n" + text)
+
+
 # --------------------------------------------------------------------------- main
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m benchmarks", description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="small sizes (a smoke run of a minute or two)")
     parser.add_argument("--runs", type=int, default=5, help="repetitions for every median (default 5)")
     parser.add_argument("--trials", type=int, default=50, help="noise trials per SDOF grid cell (default 50)")
-    parser.add_argument("--only", nargs="+", choices=["identify", "global", "estimate", "io", "crank", "adb",
-                                                      "influence", "demo"],
+    parser.add_argument("--only", nargs="+", choices=["speed", "identify", "global", "estimate", "io", "crank", "adb",
+                                                      "influence", "batch", "demo"],
                         help="run only these sections")
     parser.add_argument("--out", type=Path, default=HERE / "REPORT.md", help="report file (default benchmarks/REPORT.md)")
     parser.add_argument("--refresh-stress", action="store_true",
@@ -468,7 +486,8 @@ def main(argv: list[str] | None = None) -> int:
         args.out.write_text(head + "\n## Stress run\n\n" + stress_summary() + "\n", encoding="utf-8")
         print(f"[benchmarks] refreshed the stress section of {args.out}", file=sys.stderr)
         return 0
-    wanted = set(args.only or ["identify", "global", "estimate", "io", "crank", "adb", "influence", "demo"])
+    wanted = set(args.only or ["speed", "identify", "global", "estimate", "io", "crank", "adb", "influence", "batch",
+                               "demo"])
     runs = max(1, args.runs)
     started = time.perf_counter()
     plots: list[str] = []
@@ -486,6 +505,8 @@ def main(argv: list[str] | None = None) -> int:
             status.append(f"{key}: FAILED")
         sections.append((title, body))
 
+    if "speed" in wanted:
+        section("Speed against the floor: the five ratios of issue 19", lambda: speed_section(runs, args.quick), "bench_speed")
     if "identify" in wanted:
         section("Identification: methods against the Cramér–Rao bound, 1 and 1000 channels",
                 lambda: identify_section(5 if args.quick else args.trials, runs, args.quick, plots), "bench_identify")
@@ -520,6 +541,10 @@ def main(argv: list[str] | None = None) -> int:
                              run_module("bench_adb", ["--quick"] if args.quick else [])))
         else:
             sections.append(("Ball balancer", "benchmarks/bench_adb.py is not present; skipped."))
+    if "batch" in wanted:
+        batch_args = ["--runs", str(min(runs, 3))] + (["--files", "60"] if args.quick else [])
+        sections.append(("Batches of files on Dask (modal batch): files per second and workers",
+                         run_module("bench_batch", batch_args)))
     if "demo" in wanted:
         section("Demo scene end to end", lambda: demo_section(min(runs, 3) if args.quick else runs, plots), "demo")
 

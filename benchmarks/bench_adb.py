@@ -1,6 +1,7 @@
 """ADB simulator benchmarks: ``python -m benchmarks.bench_adb [--quick]``.
 
-1. 200 x 200 stability map (speed ratio 0.3-4 x drag 1e-6-0.1 N m s), batched eigenvalues.
+1. 200 x 200 stability map (speed ratio 0.3-4 x drag 1e-6-0.1 N m s): Routh verdicts
+   (``margin=False``) and batched eigenvalues.
 2. 1000 parameter sets for 1 s of rotor time: one stacked ``solve_ivp`` against a loop of
    plain ``solve_ivp`` calls (a straightforward RHS: build the (n+2)x(n+2) mass matrix and
    call ``np.linalg.solve``), errors against a tight reference, worst member.
@@ -81,8 +82,11 @@ def bench_map(repeats: int) -> None:
     drags = np.geomspace(1e-6, 0.1, 200)
     print("\n1. Stability map, 200 x 200 (speed ratio 0.3-4 x D 1e-6-0.1 N m s), n = 2")
     print(f"{'variant':<44}{'median (s)':>12}{'stable':>9}{'marginal':>10}{'unstable':>10}")
-    for label, cap in (("screened condition numbers (default)", 1e8), ("condition number at every point", None)):
-        elapsed, result = median_time(lambda: stability_map(S1, speeds, "D", drags, condition_cap=cap), repeats)
+    for label, cap, margin in (("Routh verdicts, no margin (margin=False)", 1e8, False),
+                               ("screened condition numbers (default)", 1e8, True),
+                               ("condition number at every point", None, True)):
+        elapsed, result = median_time(lambda: stability_map(S1, speeds, "D", drags, condition_cap=cap, margin=margin),
+                                      repeats)
         counts = result.class_counts
         print(f"{label:<44}{elapsed:>12.3f}{counts['stable']:>9}{counts['marginal']:>10}{counts['unstable']:>10}")
 

@@ -14,12 +14,44 @@ import warnings
 from pathlib import Path
 
 
-from .cli_time import add_time_options, frf_from_time, save_time_plots, wants_time
+from .cli_time import add_time_options, frf_from_time, save_time_plots
 from .errors import ModalError
 from .frf import FRF_KINDS
 from .report import jsonable
 
 __all__ = ["main", "build_parser"]
+
+
+def add_fit_options(parser: argparse.ArgumentParser) -> None:
+    """The options that say how a file is read and fitted (``modal fit`` and ``modal batch``;
+    :class:`modal.fitting.FitOptions` holds them)."""
+    parser.add_argument("--method", choices=["auto", "nls", "circle", "halfpower", "global", "all"], default="auto",
+                        help="identification method (default: auto = global for poly-reference or many-mode data, "
+                             "else nls, the band-wise least-squares refinement; the output says which ran; global: "
+                             "poly-reference LSCF with a stabilisation diagram and a joint refinement of all modes, "
+                             "for many modes, channels and references; all: the three band-wise methods)")
+    parser.add_argument("--modes-hz", dest="modes_hz", type=float, nargs="+", metavar="HZ",
+                        help="global: keep the modes nearest these frequencies (Hz) instead of the automatic choice")
+    parser.add_argument("--order", type=int, help="global: use this model order's poles instead of the stabilisation")
+    parser.add_argument("--max-order", dest="max_order", type=int, help="global: highest order of the sweep")
+    parser.add_argument("--band", nargs=2, type=float, action="append", metavar=("FMIN", "FMAX"),
+                        help="fitting band of one mode in Hz (repeat for several modes); default: automatic")
+    parser.add_argument("--kind", choices=FRF_KINDS, help="FRF kind when the file does not say")
+    parser.add_argument("--driving-point", dest="driving_point", nargs="+", metavar="CHANNEL",
+                        help="the channel(s) measured at the excitation point (0-based index or response point id); "
+                             "k, c, m are given for these only (default: from the point ids in the file, a single "
+                             "channel without ids is assumed to be one)")
+    parser.add_argument("--frequency-axis", dest="frequency_axis", choices=["hz", "khz", "rad/s", "cpm", "rpm"],
+                        help="unit of the file's frequency column when it does not say")
+    parser.add_argument("--frequency-step", dest="frequency_step", type=float, metavar="HZ",
+                        help="line spacing (Hz) for files without a frequency column")
+    parser.add_argument("--frequency-start", dest="frequency_start", type=float, metavar="HZ",
+                        help="first line (Hz) for files without a frequency column (default 0)")
+    parser.add_argument("--layout", help="CSV layout when the header does not say (re_im, mag_phase_deg, db_phase_deg, ...)")
+    parser.add_argument("--delimiter", help="CSV delimiter")
+    parser.add_argument("--decimal", help="CSV decimal mark, e.g. ','")
+    parser.add_argument("--dataset", type=int, help="UFF dataset number (1-based) when the file holds several axes")
+    add_time_options(parser)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -29,43 +61,17 @@ def build_parser() -> argparse.ArgumentParser:
                          description="Identify natural frequency, damping, modal constant and k, c, m of every mode.")
     fit.add_argument("path", nargs="+", help="FRF file(s) (UFF 58/58b, CSV, MAT, HDF5); several files on one "
                      "frequency axis become one multi-channel FRF")
-    fit.add_argument("--method", choices=["auto", "nls", "circle", "halfpower", "global", "all"], default="auto",
-                     help="identification method (default: auto = global for poly-reference or many-mode data, "
-                          "else nls, the band-wise least-squares refinement; the output says which ran; global: "
-                          "poly-reference LSCF with a stabilisation diagram and a joint refinement of all modes, "
-                          "for many modes, channels and references; all: the three band-wise methods)")
-    fit.add_argument("--modes-hz", dest="modes_hz", type=float, nargs="+", metavar="HZ",
-                     help="global: keep the modes nearest these frequencies (Hz) instead of the automatic choice")
-    fit.add_argument("--order", type=int, help="global: use this model order's poles instead of the stabilisation")
-    fit.add_argument("--max-order", dest="max_order", type=int, help="global: highest order of the sweep")
+    add_fit_options(fit)
     fit.add_argument("--stabilisation-plot", dest="stabilisation_plot", metavar="OUT.png",
                      help="global: write the stabilisation diagram over the summed FRF")
     fit.add_argument("--export-uff", dest="export_uff", metavar="OUT.uff",
                      help="write the mode shapes (UFF 55) and the synthesised FRFs (UFF 58) of the first method")
-    fit.add_argument("--band", nargs=2, type=float, action="append", metavar=("FMIN", "FMAX"),
-                     help="fitting band of one mode in Hz (repeat for several modes); default: automatic")
-    fit.add_argument("--kind", choices=FRF_KINDS, help="FRF kind when the file does not say")
-    fit.add_argument("--driving-point", dest="driving_point", nargs="+", metavar="CHANNEL",
-                     help="the channel(s) measured at the excitation point (0-based index or response point id); "
-                          "k, c, m are given for these only (default: from the point ids in the file, a single "
-                          "channel without ids is assumed to be one)")
-    fit.add_argument("--frequency-axis", dest="frequency_axis", choices=["hz", "khz", "rad/s", "cpm", "rpm"],
-                     help="unit of the file's frequency column when it does not say")
-    fit.add_argument("--frequency-step", dest="frequency_step", type=float, metavar="HZ",
-                     help="line spacing (Hz) for files without a frequency column")
-    fit.add_argument("--frequency-start", dest="frequency_start", type=float, metavar="HZ",
-                     help="first line (Hz) for files without a frequency column (default 0)")
-    fit.add_argument("--layout", help="CSV layout when the header does not say (re_im, mag_phase_deg, db_phase_deg, ...)")
-    fit.add_argument("--delimiter", help="CSV delimiter")
-    fit.add_argument("--decimal", help="CSV decimal mark, e.g. ','")
-    fit.add_argument("--dataset", type=int, help="UFF dataset number (1-based) when the file holds several axes")
     fit.add_argument("--json", action="store_true", help="print one JSON document on stdout")
     fit.add_argument("--plot", metavar="OUT.png", help="write a figure of the fit (every method's model over the data)")
     fit.add_argument("--channel", type=int, metavar="N",
                      help="--plot: draw only channel N (0-based); default every channel (the RMS over channels "
                           "above 8)")
     fit.add_argument("--archive", metavar="OUT.h5", help="write the FRF and results to an HDF5 archive")
-    add_time_options(fit)
     frf = sub.add_parser("frf", help="estimate FRFs from a time record (force and responses)",
                          description="Estimate FRFs with coherence and noise per line from a time file "
                                      "(UFF 58/58b function type 1, CSV with a time column, MAT, HDF5).")
@@ -77,6 +83,9 @@ def build_parser() -> argparse.ArgumentParser:
     frf.add_argument("--plot", metavar="OUT.png", help="write the FRFs with coherence and error band "
                      "(and OUT_hits.png with the hits for --impact)")
     add_time_options(frf)
+    from .batch.cli import add_batch_parser
+
+    add_batch_parser(sub, add_fit_options)
     return parser
 
 
@@ -85,29 +94,13 @@ def _showwarning(message, category, filename, lineno, file=None, line=None):
 
 
 def _fit(args) -> int:
-    from .identify import identify
-    from .io import read_frf
+    from .fitting import FitOptions, fit_path
 
-    names = ("kind", "frequency_axis", "frequency_step", "frequency_start", "layout", "delimiter", "decimal", "dataset")
-    hints = {k: getattr(args, k) for k in names if getattr(args, k) is not None}
-    time_data = None
-    if len(args.path) == 1 and wants_time(args, args.path[0]):
-        time_data = frf_from_time(args.path[0], args)
-        frf = time_data[0]
-        _report_estimate(frf)
-    else:
-        frf = read_frf(args.path[0] if len(args.path) == 1 else args.path, **hints)
+    fitted = fit_path(args.path if len(args.path) > 1 else args.path[0], FitOptions.from_args(args),
+                      report_estimate=_report_estimate)
+    frf, results = fitted.frf, list(fitted.results)
+    time_data = None if fitted.time_data is None else (frf, *fitted.time_data)
     label = args.path[0] if len(args.path) == 1 else f"{args.path[0]} (+{len(args.path) - 1} files)"
-    methods = ["nls", "circle", "halfpower"] if args.method == "all" else [args.method]
-    options = {k: getattr(args, k) for k in ("modes_hz", "order", "max_order") if getattr(args, k) is not None}
-    if options and methods == ["auto"]:
-        methods = ["global"]  # options of the global method choose it
-    if options and methods != ["global"]:
-        raise ModalError(f"--{next(iter(options)).replace('_', '-')} applies to --method global only")
-    driving = _driving_channels(frf, args.driving_point) if args.driving_point else None
-    results = [identify(frf, method, bands_hz=args.band, driving_point=driving,
-                        **(options if method == "global" else {}))
-               for method in methods]
     methods = [r.method for r in results]  # what ran ("auto" chooses)
     points = None
     if frf.response_points is not None:
@@ -164,26 +157,6 @@ def _fit(args) -> int:
     return 0
 
 
-def _driving_channels(frf, names: list[str]):
-    """Boolean mask over channels from --driving-point values (indexes or response point ids)."""
-    import numpy as np
-
-    mask = np.zeros(frf.n_channels, bool)
-    points = list(frf.response_points or [])
-    for name in names:
-        if name.lstrip("-").isdigit():
-            index = int(name)
-            if not 0 <= index < frf.n_channels:
-                raise ModalError(f"--driving-point {name}: no such channel; expected 0..{frf.n_channels - 1}")
-        elif name in points:
-            index = points.index(name)
-        else:
-            raise ModalError(f"--driving-point {name}: no channel has that response point; expected a channel index "
-                             f"0..{frf.n_channels - 1}" + (f" or one of {', '.join(points)}" if points else ""))
-        mask[index] = True
-    return mask
-
-
 def _report_estimate(frf) -> None:
     """One line on stderr: what the estimate averaged and what it rejected."""
     print(f"{frf.source}: {frf.estimator} estimate, {frf.averages} average(s), window {frf.window}"
@@ -220,6 +193,10 @@ def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)  # exits with 2 on a usage error
     warnings.showwarning = _showwarning
+    if args.command == "batch":
+        from .batch.cli import run_batch
+
+        return run_batch(args, parser)
     try:
         if args.command == "fit":
             return _fit(args)

@@ -116,6 +116,8 @@ def archives(tmp_path_factory):
         "fit_all.h5": ("modal", "fit", *beam, "--method", "all", "--plot", out / "beam.png",
                        "--archive", out / "fit_all.h5"),
         "fit_global.h5": ("modal", "fit", *beam, "--method", "global", "--archive", out / "fit_global.h5"),
+        # one group per file, copied from per-file parts (issue 18)
+        "batch.h5": ("modal", "batch", *beam, "--method", "all", "--workers", "1", "--out", out / "batch.h5"),
         "estimate.h5": ("modal", "frf", uff, "--excitation", "4", "--out", out / "estimate.h5"),
         "demo.h5": ("balancer", "run", ROOT / "data" / "synthetic" / "demo_scene.toml", "--out", out / "demo.h5",
                     "--plots", out / "demo_plots"),
@@ -153,7 +155,7 @@ def test_every_number_in_every_archive_has_units(archives):
     import h5py
 
     missing, files = [], sorted(archives.glob("*.h5"))
-    assert len(files) == 5
+    assert len(files) == 6
     for path in files:
         with h5py.File(path, "r") as f:
             def visit(name, node, path=path):
@@ -167,6 +169,9 @@ def test_every_number_in_every_archive_has_units(archives):
         assert f["identify/modes/0/band_hz/0"].attrs["units"] == "Hz"
         assert f["rotor/params/k"].attrs["units"] == "N/m" and f["rotor/params/M"].attrs["units"] == "kg"
         assert f["identify/modes/0/damping_ratio"].attrs["units"] == "1"
+    with h5py.File(archives / "batch.h5", "r") as f:
+        assert len(f["files"]) == 3 and f["files/0/results/0/modes/0/natural_frequency_hz"].attrs["units"] == "Hz"
+        assert f["batch/wall_time_s"].attrs["units"] == "s" and f["files/2/n_lines"].attrs["units"] == "1"
 
 
 def test_archive_without_frf_says_what_it_holds(tmp_path):

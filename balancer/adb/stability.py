@@ -60,6 +60,13 @@ def _balanced_companion(members: Sequence[ADBParameters], speeds: np.ndarray, an
     mu, zeta, beta = (np.broadcast_to(x, shape).reshape(-1) for x in (mu, zeta, beta))
     Om = Om.reshape(-1)
     phi = np.repeat(np.array(angles, dtype=float), speeds.shape[0], axis=0)  # (B, n)
+    return _companion_arrays(mu, zeta, beta, Om, phi)
+
+
+def _companion_arrays(mu: np.ndarray, zeta: np.ndarray, beta: np.ndarray, Om: np.ndarray, phi: np.ndarray) -> np.ndarray:
+    """:func:`_balanced_companion` from per-member arrays ``(B,)`` and ball angles ``(B, n)``."""
+    n = phi.shape[1]
+    size = n + 2
     s, c = np.sin(phi), np.cos(phi)
     B = Om.shape[0]
     M0 = np.zeros((B, size, size))
@@ -327,8 +334,17 @@ _MAP_FIELDS = ("M", "m", "n", "R", "e", "k", "c", "D")
 
 
 def stability_map(params: ADBParameters, speeds_rad_s, parameter: str, values, *, ball_angles_rad=None,
-                  condition_cap: float | None = 1e8) -> StabilityMap:
-    """Balanced-state stability over ``speeds x values`` as batched eigenvalue problems.
+                  condition_cap: float | None = 1e8, margin: bool = True) -> StabilityMap:
+    """Balanced-state stability over ``speeds x values``.
+
+    With ``margin=True`` (default) every point is a batched eigenvalue problem and the
+    growth rate is returned everywhere.  With ``margin=False`` the verdict comes from the
+    closed-form characteristic polynomial and a vectorised Routh test
+    (:mod:`balancer.adb.verdict`, about 10x faster than the eigenvalues); only the points
+    whose growth rate may lie within the eigenvalue path's screening band of zero (or
+    whose Routh array is not clear of rounding) go through the eigenvalue path, which
+    keeps its marginal class there.  The verdicts are the same as with ``margin=True``
+    wherever the growth rate is clear of that band (tested).
 
     Parameters
     ----------
@@ -344,7 +360,12 @@ def stability_map(params: ADBParameters, speeds_rad_s, parameter: str, values, *
         Balanced member (only with a fixed ``n``); default the symmetric member of each set.
     condition_cap : float or None
         Screening cap on the critical eigenvalue's condition number (see
-        :func:`~balancer.adb.linear.eigen_analysis`); None computes every condition number.
+        :func:`~balancer.adb.linear.eigen_analysis`); None computes every condition number
+        (and then ``margin=False`` has no effect: every point is an eigenvalue problem).
+    margin : bool
+        Whether to compute the growth rate (largest real part) at every point.  False:
+        ``max_real_part_per_s``, ``rounding_bound_per_s`` and ``growth_rate_nondimensional``
+        are NaN except at the points resolved by the eigenvalue path (near the boundary).
 
     Returns
     -------
@@ -367,17 +388,54 @@ def stability_map(params: ADBParameters, speeds_rad_s, parameter: str, values, *
     for count, rows in by_count.items():
         group = [members[i] for i in rows]
         angles = [balanced_state(p, ball_angles_rad)[2:2 + count] for p in group]
+        ratio[rows] = speeds[None, :] / np.array([p.natural_frequency_rad_s for p in group])[:, None]
+        if not margin and condition_cap is not None and count >= 2:
+            _routh_rows(group, rows, angles, speeds, ratio[rows], condition_cap, growth, bound, nondim, codes)
+            continue
         analysis = _analyse_balanced(group, speeds, angles, condition_cap)
         growth[rows] = analysis.max_real_part_per_s.reshape(len(rows), -1)
         bound[rows] = analysis.rounding_bound_per_s.reshape(len(rows), -1)
         nondim[rows] = analysis.growth_rate_nondimensional.reshape(len(rows), -1)
         codes[rows] = analysis.stability_class.reshape(len(rows), -1)
-        ratio[rows] = speeds[None, :] / np.array([p.natural_frequency_rad_s for p in group])[:, None]
     return StabilityMap(
         parameter=parameter, values=values, speeds_rad_s=speeds, speed_ratio=ratio,
         max_real_part_per_s=growth, rounding_bound_per_s=bound,
         growth_rate_nondimensional=nondim, stability_class=codes,
     )
+
+
+def _routh_rows(group, rows, angles, speeds, ratio, condition_cap, growth, bound, nondim, codes) -> None:
+    """Fill one ball count's rows of a map from Routh verdicts; eigenvalues only where unresolved."""
+    from .verdict import UNRESOLVED, balanced_verdicts
+
+    column = np.ones((len(group), 1))
+    rho2 = np.array([abs(np.sum(np.exp(2j * a))) ** 2 for a in angles])[:, None] * column
+    mu, zeta, beta = (np.array([getattr(p, name) for p in group])[:, None] * column
+                      for name in ("mass_ratio", "damping_ratio", "drag_ratio"))
+    n = group[0].n
+    verdict = balanced_verdicts(mu, zeta, beta, ratio, rho2, n, condition_cap)
+    codes[rows] = verdict
+    for name in (growth, bound, nondim):
+        name[rows] = np.nan
+    local, cols = np.nonzero(verdict == UNRESOLVED)
+    if local.size:
+        companion = _companion_arrays(mu[local, 0], zeta[local, 0], beta[local, 0], ratio[local, cols],
+                                      np.array(angles, dtype=float)[local])
+        # again with the band from the exact norm instead of its bound
+        again = balanced_verdicts(mu[local, 0], zeta[local, 0], beta[local, 0], ratio[local, cols], rho2[local, 0],
+                                  n, condition_cap, norm=np.linalg.norm(companion, axis=(-2, -1)))
+        codes[np.asarray(rows)[local], cols] = again
+        keep = again == UNRESOLVED
+        local, cols, companion = local[keep], cols[keep], companion[keep]
+    if local.size:  # one batched eigenvalue problem for every point still unresolved
+        wn = np.array([p.natural_frequency_rad_s for p in group])[local]
+        analysis = eigen_analysis_nondimensional(companion, wn, n_zero_to_drop=max(n - 2, 0),
+                                                 condition_cap=condition_cap)
+        at = (np.asarray(rows)[local], cols)
+        growth[at] = analysis.max_real_part_per_s
+        bound[at] = analysis.rounding_bound_per_s
+        nondim[at] = analysis.growth_rate_nondimensional
+        codes[at] = analysis.stability_class
 
 
 # --------------------------------------------------------------------------- Routh-Hurwitz

@@ -1,0 +1,313 @@
+"""The five speed ratios of issue 19, measured side by side in one run.
+
+Run ``python -m benchmarks.bench_speed [--runs N] [--quick] [--only 1 2 3 4 5] [--timeout S]``.
+
+1. One SDOF ``identify(frf, "nls")`` on 61 lines against a bare
+   ``scipy.optimize.least_squares`` Levenberg–Marquardt fit of the same model
+   (one mode ``A / (wn^2 - w^2 + 2 i zeta wn w)`` plus a complex offset) on the same
+   data, started from a peak pick.  Goal: ratio <= 2.
+2. 1000 channels x 3 modes x 2001 lines (accelerance, 1 % noise): sdypy-EMA's LSCF
+   (order 30) + pole selection + LSFD against ``identify(frf, "nls")``.  sdypy-EMA is the
+   optional ``bench`` extra (``pip install -e '.[bench]'``); without it the ratio is
+   reported as skipped.  Goal: sdypy-EMA time / modalbal time >= 30.
+3. 200 x 200 ball-balancer stability map (``stability_map(..., margin=False)``, the
+   verdict path) against ``numpy.linalg.eigvals`` of the map's 40 000 8x8 first-order
+   matrices.  Goal: ratio <= 0.1.  The eigenvalue map (``margin=True``, the default)
+   is shown too.
+4. The bundled demo scene (``python -m balancer run data/synthetic/demo_scene.toml``) as a
+   subprocess against the import floor (a subprocess that only imports numpy, scipy,
+   h5py, matplotlib, modal and balancer), runs interleaved.  Goal: ratio <= 2.
+5. ``identify`` of a 100 000-line noisy FRF (four modes, accelerance, noise rising
+   100-fold above the hammer's band as in a hammer-test H1 estimate) in a subprocess with
+   a time limit.  Goal: well under a minute (the ratio is against 60 s).
+
+Every timing is the median of ``--runs`` repetitions with the [min–max] spread; the
+machine and the versions are printed first.
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import subprocess
+import sys
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent
+GOALS = {1: ("SDOF identify / bare least_squares LM", "<= 2"),
+         2: ("sdypy-EMA / modalbal, 1000 channels", ">= 30"),
+         3: ("stability map / numpy eigvals, 40 000 8x8", "<= 0.1"),
+         4: ("demo scene / import floor", "<= 2"),
+         5: ("100 000-line noisy FRF identify / 60 s", "well under 1")}
+
+
+def _median(samples: list[float]) -> float:
+    return statistics.median(samples) if samples else float("nan")
+
+
+def _spread(samples: list[float], scale: float = 1.0, unit: str = "s") -> str:
+    if not samples:
+        return "n/a"
+    return (f"{_median(samples) * scale:.4g} [{min(samples) * scale:.4g}–{max(samples) * scale:.4g}] {unit}")
+
+
+def _time(function, runs: int) -> tuple[list[float], object]:
+    samples, value = [], None
+    for _ in range(runs):
+        start = time.perf_counter()
+        value = function()
+        samples.append(time.perf_counter() - start)
+    return samples, value
+
+
+# --------------------------------------------------------------------------- goal 1
+def sdof_case():
+    """The 61-line SDOF receptance of the issue (fn = 100 Hz, zeta = 0.01, 1 % noise, L = 10)."""
+    from modal.synthetic import add_noise, modal_frf
+
+    fn, zeta = 100.0, 0.01
+    bw = 2 * zeta * fn
+    f = np.arange(fn - 3 * bw, fn + 3 * bw + bw / 20, bw / 10)
+    return add_noise(modal_frf(f, [fn], [zeta], [1.0]), 0.01, seed=1), (float(f[0]), float(f[-1]))
+
+
+def bare_least_squares(frequency_hz: np.ndarray, response: np.ndarray):
+    """The same one-mode model fitted by a bare ``least_squares(method="lm")`` from a peak pick."""
+    from scipy.optimize import least_squares
+
+    w = 2 * np.pi * frequency_hz
+    peak = int(np.argmax(np.abs(response)))
+    wn0 = w[peak]
+    above = np.abs(response) >= np.abs(response[peak]) / np.sqrt(2)
+    zeta0 = max(above.sum() * (w[1] - w[0]) / (2 * wn0), 1e-4)
+    a0 = response[peak] * 2j * zeta0 * wn0 ** 2
+
+    def residual(x):
+        model = (x[2] + 1j * x[3]) / (x[0] ** 2 - w ** 2 + 2j * x[1] * x[0] * w) + (x[4] + 1j * x[5])
+        r = model - response
+        return np.concatenate([r.real, r.imag])
+
+    return least_squares(residual, [wn0, zeta0, a0.real, a0.imag, 0.0, 0.0], method="lm")
+
+
+def goal1(runs: int) -> dict:
+    from modal import identify
+
+    frf, band = sdof_case()
+    f, h = frf.frequency_hz, np.asarray(frf.response).reshape(-1)
+    batch = 50
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ours, result = _time(lambda: [identify(frf, "nls", bands_hz=[band]) for _ in range(batch)], runs)
+    bare, fit = _time(lambda: [bare_least_squares(f, h) for _ in range(batch)], runs)
+    ours = [t / batch for t in ours]
+    bare = [t / batch for t in bare]
+    zeta_ours = result[-1][0].damping_ratio
+    zeta_bare = fit[-1].x[1]
+    return {"ratio": _median(ours) / _median(bare),
+            "text": (f"{f.size} lines: identify(frf, 'nls') {_spread(ours, 1e3, 'ms')}, bare least_squares LM "
+                     f"{_spread(bare, 1e3, 'ms')}; zeta {zeta_ours:.5f} vs {zeta_bare:.5f} (truth 0.01)")}
+
+
+# --------------------------------------------------------------------------- goal 2
+def thousand_channels():
+    from modal.synthetic import add_noise, modal_frf
+
+    rng = np.random.default_rng(1)
+    fn = np.array([50.0, 120.0, 300.0])
+    zeta = np.array([0.01, 0.02, 0.03])
+    const = rng.standard_normal((1000, 3)) + 0.05j * rng.standard_normal((1000, 3))
+    f = np.linspace(0, 400, 2001)
+    return add_noise(modal_frf(f, fn, zeta, const, kind="accelerance"), 0.01, seed=2), fn, zeta
+
+
+def goal2(runs: int) -> dict:
+    import contextlib
+    import io
+
+    from modal import identify
+
+    frf, fn, zeta = thousand_channels()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ours, result = _time(lambda: identify(frf, "nls"), runs)
+    fe = max(abs(m.natural_frequency_hz / fn[i] - 1) for i, m in enumerate(result.modes[:3]))
+    ze = max(abs(m.damping_ratio / zeta[i] - 1) for i, m in enumerate(result.modes[:3]))
+    text = f"modalbal identify(frf, 'nls') {_spread(ours)} (max fn err {fe:.1e}, max zeta err {ze:.1e})"
+    try:
+        import sdypy.EMA as ema
+    except Exception:  # noqa: BLE001 - optional peer
+        return {"ratio": None, "text": text + "; sdypy-EMA not installed (optional `bench` extra): skipped"}
+
+    h = np.atleast_2d(frf.response)
+
+    def peer():
+        model = ema.Model(h, frf.frequency_hz, lower=10, upper=390, pol_order_high=30, frf_form="accelerance")
+        with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()), \
+                warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            model.get_poles(show_progress=False)
+            model.select_closest_poles(list(fn))
+            model.get_constants(whose_poles="own", FRF_ind="all")
+        return model
+
+    theirs, model = _time(peer, max(1, min(runs, 3)))
+    nat, xi = np.asarray(model.nat_freq, float), np.asarray(model.nat_xi, float)
+    pfe = max(abs(nat[np.argmin(abs(nat - f0))] / f0 - 1) for f0 in fn)
+    pze = max(abs(xi[np.argmin(abs(nat - f0))] / z0 - 1) for f0, z0 in zip(fn, zeta))
+    return {"ratio": _median(theirs) / _median(ours),
+            "text": text + f"; sdypy-EMA {ema.__version__} LSCF + LSFD {_spread(theirs)} (max fn err {pfe:.1e}, "
+                           f"max zeta err {pze:.1e})"}
+
+
+# --------------------------------------------------------------------------- goal 3
+def goal3(runs: int) -> dict:
+    import inspect
+
+    from balancer.adb import ADBParameters, balanced_state, stability_map
+    from balancer.adb.stability import _balanced_companion
+
+    s1 = ADBParameters(M=1.0, m=0.02, n=2, R=0.05, e=0.5e-3, k=1e4, c=20.0, D=1e-3)
+    speeds = np.linspace(0.3, 4.0, 200) * s1.natural_frequency_rad_s
+    drags = np.geomspace(1e-6, 0.1, 200)
+    members = [s1.replace(D=float(d)) for d in drags]
+    matrices = _balanced_companion(members, speeds, [balanced_state(p)[2:4] for p in members])
+    fast_available = "margin" in inspect.signature(stability_map).parameters
+    eig_s, verdict_s, full_s = [], [], []
+    fast = full = None
+    for _ in range(runs):  # interleaved, so that load changes hit all three alike
+        eig_s += _time(lambda: np.linalg.eigvals(matrices), 1)[0]
+        if fast_available:
+            t, fast = _time(lambda: stability_map(s1, speeds, "D", drags, margin=False), 1)
+            verdict_s += t
+        t, full = _time(lambda: stability_map(s1, speeds, "D", drags), 1)
+        full_s += t
+    text = (f"numpy eigvals of the map's {matrices.shape[0]} {matrices.shape[1]}x{matrices.shape[2]} matrices "
+            f"{_spread(eig_s, 1e3, 'ms')}; eigenvalue map (margin=True) {_spread(full_s, 1e3, 'ms')} "
+            f"= {_median(full_s) / _median(eig_s):.3g}x")
+    if not fast_available:
+        return {"ratio": _median(full_s) / _median(eig_s), "text": text + "; no margin=False option (before): "
+                "the ratio is the eigenvalue map's"}
+    same = int(np.sum(fast.stability_class == full.stability_class))
+    left = int(np.sum(np.isfinite(fast.max_real_part_per_s)))
+    return {"ratio": _median(verdict_s) / _median(eig_s),
+            "text": text + f"; verdict map (margin=False) {_spread(verdict_s, 1e3, 'ms')}, same class at "
+                           f"{same}/{full.stability_class.size} points, {left} points left to the eigenvalue path"}
+
+
+# --------------------------------------------------------------------------- goal 4
+FLOOR = "import numpy, scipy, h5py, matplotlib, modal, balancer"
+
+
+def goal4(runs: int) -> dict:
+    scene = ROOT / "data" / "synthetic" / "demo_scene.toml"
+    env = {**os.environ, "MPLBACKEND": "Agg"}
+    floor, demo = [], []
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as folder:
+        for run in range(runs):
+            start = time.perf_counter()
+            subprocess.run([sys.executable, "-c", FLOOR], cwd=ROOT, env=env, check=True, capture_output=True)
+            floor.append(time.perf_counter() - start)
+            start = time.perf_counter()
+            proc = subprocess.run([sys.executable, "-m", "balancer", "run", str(scene), "--out",
+                                   str(Path(folder) / f"demo{run}.h5")], cwd=ROOT, env=env, capture_output=True,
+                                  text=True)
+            demo.append(time.perf_counter() - start)
+            if proc.returncode != 0:
+                raise RuntimeError(f"demo failed: {proc.stderr[-500:]}")
+    return {"ratio": _median(demo) / _median(floor),
+            "text": f"demo {_spread(demo)}, import floor (`python -c \"{FLOOR}\"`) {_spread(floor)}"}
+
+
+# --------------------------------------------------------------------------- goal 5
+def noisy_long_frf(lines: int = 100_000, seed: int = 5):
+    """A long hammer-test-like accelerance: four modes, noise 1 % in band rising 100x above it."""
+    from modal.frf import FRF
+    from modal.synthetic import modal_frf
+
+    f = np.linspace(0.0, 5000.0, lines)
+    clean = modal_frf(f, [180.0, 730.0, 1450.0, 2600.0], [0.02, 0.01, 0.015, 0.01],
+                      [1.0, 0.6, 0.8 + 0.1j, 0.5], kind="accelerance")
+    h = np.asarray(clean.response).reshape(-1)
+    band_edge = 3000.0  # the hammer's band: the force spectrum falls away above it
+    level = 0.01 * np.median(np.abs(h)) * np.where(f < band_edge, 1.0, 100.0 ** np.clip((f - band_edge) / 1000.0, 0, 1))
+    rng = np.random.default_rng(seed)
+    noisy = h + level * (rng.standard_normal(lines) + 1j * rng.standard_normal(lines)) / np.sqrt(2)
+    return FRF(frequency_hz=f, response=noisy, kind="accelerance")
+
+
+_GOAL5_CHILD = """
+import sys, time, warnings
+sys.path.insert(0, {root!r})
+from benchmarks.bench_speed import noisy_long_frf
+import modal
+frf = noisy_long_frf()
+warnings.simplefilter("ignore")
+start = time.perf_counter()
+result = modal.identify(frf)
+print(time.perf_counter() - start, len(result.modes), " ".join(f"{{m.natural_frequency_hz:.1f}}" for m in result.modes))
+"""
+
+
+def goal5(runs: int, timeout: float) -> dict:
+    samples, found = [], ""
+    for _ in range(max(1, min(runs, 2))):
+        try:
+            proc = subprocess.run([sys.executable, "-c", _GOAL5_CHILD.format(root=str(ROOT))], cwd=ROOT,
+                                  capture_output=True, text=True, timeout=timeout)
+        except subprocess.TimeoutExpired:
+            return {"ratio": None, "text": f"did not finish within the {timeout:.0f} s limit (ratio > {timeout / 60:.2g})"}
+        if proc.returncode != 0:
+            return {"ratio": None, "text": f"failed: {proc.stderr.strip()[-300:]}"}
+        seconds, count, *freqs = proc.stdout.split()
+        samples.append(float(seconds))
+        found = f"{count} modes at {', '.join(freqs[:8])} Hz (truth 180, 730, 1450, 2600)"
+    return {"ratio": _median(samples) / 60.0, "text": f"identify {_spread(samples)}; {found}"}
+
+
+# --------------------------------------------------------------------------- main
+def run(goals, runs: int, timeout: float) -> dict[int, dict]:
+    makers = {1: lambda: goal1(runs), 2: lambda: goal2(runs), 3: lambda: goal3(runs), 4: lambda: goal4(runs),
+              5: lambda: goal5(runs, timeout)}
+    out = {}
+    for goal in goals:
+        print(f"[bench_speed] goal {goal} ...", file=sys.stderr, flush=True)
+        try:
+            out[goal] = makers[goal]()
+        except Exception as exc:  # noqa: BLE001 - reported in the table
+            out[goal] = {"ratio": None, "text": f"failed: {type(exc).__name__}: {exc}"}
+    return out
+
+
+def table(results: dict[int, dict]) -> str:
+    lines = ["| goal | ratio | target | measured |", "|---|---|---|---|"]
+    for goal, res in results.items():
+        name, target = GOALS[goal]
+        ratio = "skipped" if res["ratio"] is None else f"{res['ratio']:.3g}"
+        lines.append(f"| {goal}. {name} | {ratio} | {target} | {res['text']} |")
+    return "\n".join(lines)
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--runs", type=int, default=5, help="repetitions per median (default 5)")
+    parser.add_argument("--quick", action="store_true", help="3 runs")
+    parser.add_argument("--only", type=int, nargs="+", choices=sorted(GOALS), help="only these goals")
+    parser.add_argument("--timeout", type=float, default=180.0, help="time limit of goal 5, s (default 180)")
+    args = parser.parse_args(argv)
+    from benchmarks.__main__ import machine_section
+
+    runs = 3 if args.quick else max(1, args.runs)
+    print(machine_section())
+    print()
+    print(table(run(args.only or sorted(GOALS), runs, args.timeout)))
+
+
+if __name__ == "__main__":
+    main()

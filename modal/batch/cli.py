@@ -1,0 +1,74 @@
+"""``python -m modal batch DIR_OR_GLOB... --out RESULTS.h5``: the command line of :mod:`modal.batch`.
+
+Exit codes: 0 every file fitted, 1 some failed (the archive holds the others), 2 bad usage.
+stdout: one summary line, or one JSON document with ``--json``; stderr: the failures, one line
+each, and a progress bar when stderr is a terminal.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+
+__all__ = ["add_batch_parser", "run_batch"]
+
+
+def add_batch_parser(sub, add_fit_options) -> argparse.ArgumentParser:
+    """The ``batch`` subcommand (with every fit option of ``modal fit``)."""
+    batch = sub.add_parser(
+        "batch", help="fit many FRF files (locally or on a Dask cluster) into one archive and one table",
+        description="Fit every FRF file found (folders are searched recursively for UFF, CSV, MAT and HDF5 files) "
+                    "with the options of 'modal fit', on an embedded Dask cluster or an existing one; write one "
+                    "archive (a group per file) and one CSV table (a row per file, mode and channel). A rerun "
+                    "with the same options reuses the results of unchanged files. Exit 0: every file fitted; "
+                    "1: some failed (listed); 2: bad usage.")
+    batch.add_argument("inputs", nargs="+", metavar="DIR_OR_GLOB", help="folders, glob patterns or files")
+    batch.add_argument("--out", required=True, metavar="RESULTS.h5",
+                       help="the archive (replaced whole at the end; per-file results go to RESULTS.h5.parts/ "
+                            "meanwhile, so an interrupted run resumes)")
+    batch.add_argument("--table", metavar="RESULTS.csv", help="the CSV table (default: the archive's name with .csv)")
+    batch.add_argument("--json", action="store_true",
+                       help="print one JSON document: files, fitted, reused, failed, archive, table, wall_time_s")
+    batch.add_argument("--scheduler", metavar="tcp://HOST:PORT",
+                       help="address of a running Dask scheduler (workers need this package installed and the "
+                            "files at the same paths); default: a local cluster")
+    batch.add_argument("--workers", type=int, metavar="N", help="local cluster: worker processes (default: the cores)")
+    add_fit_options(batch)
+    return batch
+
+
+def run_batch(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
+    """Run ``modal batch``; returns the exit code."""
+    from ..errors import ModalError, ParameterError
+    from ..fitting import FitOptions
+    from ..report import jsonable
+    from .run import fit_files
+
+    if args.scheduler and args.workers is not None:
+        parser.error("--workers applies to the local cluster; the cluster at --scheduler has its own workers")
+    if args.workers is not None and args.workers < 1:
+        parser.error(f"--workers {args.workers}: expected 1 or more")
+    try:
+        options = FitOptions.from_args(args)
+        result = fit_files(args.inputs, client=args.scheduler, out=args.out, table=args.table, workers=args.workers,
+                           progress=sys.stderr.isatty(), **{k: v for k, v in vars(options).items()})
+    except ParameterError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    except ModalError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        print(f"interrupted: the files fitted so far are kept in {args.out}.parts; run the same command again "
+              "to finish", file=sys.stderr)
+        return 130
+    for item in result.failed:
+        print(f"failed: {item['file']}: {item['error']}", file=sys.stderr)
+    if args.json:
+        json.dump(jsonable(result.summary()), sys.stdout, indent=1, allow_nan=False)
+        sys.stdout.write("\n")
+    else:
+        print(f"{len(result.outcomes)} files: {result.fitted} fitted, {result.reused} reused, "
+              f"{len(result.failed)} failed in {result.wall_time_s:.1f} s; archive {result.archive}, "
+              f"table {result.table}")
+    return 1 if result.failed else 0

@@ -1,0 +1,232 @@
+"""Many files, one fit each, on Dask: the order of work of :func:`iter_fit` and :func:`fit_files`."""
+from __future__ import annotations
+
+import dataclasses
+import os
+import time
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from ..errors import ParameterError
+from ..fitting import FitOptions
+from .discover import file_sha256, find_files
+from .records import BatchInfo, Entry, FileFit, Outcome, one_line
+from .store import PartStore, entry_of, parse_table, parts_folder, write_batch_archive, write_table
+
+__all__ = ["BatchResult", "iter_fit", "fit_files", "default_table"]
+
+
+def default_table(archive: str | os.PathLike) -> Path:
+    """The table beside the archive: ``RESULTS.h5`` → ``RESULTS.csv``."""
+    return Path(archive).with_suffix(".csv")
+
+
+@dataclass(frozen=True)
+class BatchResult:
+    """What :func:`fit_files` returns: every file's outcome, in file order.
+
+    Attributes
+    ----------
+    outcomes : tuple of Outcome
+    archive, table : str or None
+        Paths written (None without ``out``).
+    wall_time_s : float
+        Wall time of the run, s.
+    """
+
+    outcomes: tuple[Outcome, ...]
+    archive: str | None
+    table: str | None
+    wall_time_s: float
+
+    @property
+    def fitted(self) -> int:
+        """Files fitted in this run."""
+        return sum(o.status == "fitted" for o in self.outcomes)
+
+    @property
+    def reused(self) -> int:
+        """Files whose result an earlier run had (same content hash and settings)."""
+        return sum(o.status == "reused" for o in self.outcomes)
+
+    @property
+    def failed(self) -> list[dict[str, str]]:
+        """``[{"file", "error"}]`` for every file that could not be fitted."""
+        return [{"file": o.file, "error": o.error} for o in self.outcomes if o.status == "failed"]
+
+    def rows(self) -> list[dict]:
+        """The table: one dict per file, method, mode and channel (``pandas.DataFrame(result.rows())``)."""
+        return [row for o in self.outcomes for row in o.rows]
+
+    def summary(self) -> dict[str, Any]:
+        """The ``--json`` document: files, fitted, reused, failed, archive, table, wall_time_s."""
+        return {"files": len(self.outcomes), "fitted": self.fitted, "reused": self.reused, "failed": self.failed,
+                "archive": self.archive, "table": self.table, "wall_time_s": self.wall_time_s}
+
+
+def _progress(total: int, enabled: bool):
+    from tqdm import tqdm
+
+    return tqdm(total=total, unit="file", disable=not enabled, leave=False, dynamic_ncols=True)
+
+
+def iter_fit(paths: str | os.PathLike | Sequence[str | os.PathLike], *, client: Any = None,
+             out: str | os.PathLike | None = None, table: str | os.PathLike | None = None,
+             workers: int | None = None, progress: bool = False, **fit_options: Any) -> Iterator[Outcome]:
+    """Fit every FRF file, yielding each file's :class:`Outcome` as it is done.
+
+    Parameters
+    ----------
+    paths : path-like or sequence of path-likes
+        Folders (searched recursively), glob patterns or files (:func:`modal.batch.find_files`).
+    client : distributed.Client or str, optional
+        A Dask client, or a scheduler address ``tcp://HOST:PORT``; default an embedded local
+        cluster of ``workers`` processes, started only when some file needs fitting.
+    out : path-like, optional
+        Batch archive; with it, results of an earlier run with the same file content and options
+        are reused, each fitted file is saved at once (``<out>.parts/``), and the archive and the
+        table are written when the iteration ends. Without it nothing is written.
+    table : path-like, optional
+        CSV table (default ``out`` with suffix ``.csv``).
+    workers : int, optional
+        Workers of the local cluster (default: the cores).
+    progress : bool
+        Show a progress bar on stderr.
+    **fit_options
+        The options of ``modal fit`` under their Python names (:class:`modal.fitting.FitOptions`):
+        ``method``, ``bands_hz``, ``kind``, ``driving_point``, ``modes_hz``, ...
+
+    Yields
+    ------
+    Outcome
+        Reused files first, then fitted or failed files in the order they finish.
+
+    Raises
+    ------
+    ParameterError
+        Unknown or contradictory options, no file found, a missing output folder.
+    """
+    options = FitOptions.from_kwargs(**fit_options)
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
+        raise ParameterError(f"workers must be a whole number >= 1, got {workers!r}")
+    if out is not None:
+        out = Path(out)
+        table = Path(table) if table is not None else default_table(out)
+        for target, name in ((out, "out"), (table, "table")):
+            if not target.parent.is_dir() and str(target.parent):
+                raise ParameterError(f"--{name} {target}: folder {target.parent} does not exist")
+    elif table is not None:
+        raise ParameterError("table needs out (the archive that makes a run resumable)")
+    exclude = [] if out is None else [out, table, parts_folder(out)]
+    files = find_files(paths, exclude=exclude)
+    if not files:
+        shown = paths if isinstance(paths, (str, os.PathLike)) else ", ".join(map(str, paths))
+        raise ParameterError(f"no FRF file found in {shown}; expected folders, glob patterns or files "
+                             "(UFF, CSV, MAT, HDF5)")
+    return _run(files, options, client, out, table, workers, progress)
+
+
+def _outcome(entry: Entry, status: str) -> Outcome:
+    return Outcome(entry.source, status, entry.error, parse_table(entry.source, entry.table), entry.fit)
+
+
+def _run(files: list[str], options: FitOptions, client, out, table, workers, progress) -> Iterator[Outcome]:
+    start = time.perf_counter()
+    settings, settings_hash = options.settings_json(), options.settings_hash()
+    store = PartStore(out) if out is not None else None
+    hashes: dict[str, str] = {}
+    done: dict[str, Entry] = {}
+    statuses: dict[str, str] = {}
+    pending: list[str] = []
+    for path in files:
+        try:
+            hashes[path] = file_sha256(path)
+        except OSError as exc:
+            done[path] = entry_of(FileFit(source=path, sha256="", settings=settings, settings_hash=settings_hash,
+                                          error=one_line(exc), retry=True))
+            statuses[path] = "failed"
+    known = store.index(settings_hash, set(hashes.values())) if store is not None else {}
+    bar = _progress(len(files), progress)
+    try:
+        for path in files:
+            if path in done:
+                bar.update()
+                yield _outcome(done[path], "failed")
+            elif hashes[path] in known:
+                entry = dataclasses.replace(known[hashes[path]], source=path)
+                done[path], statuses[path] = entry, "failed" if entry.error else "reused"
+                bar.update()
+                yield _outcome(entry, statuses[path])
+            else:
+                pending.append(path)
+        if pending:
+            yield from _fit_pending(pending, options, hashes, client, workers, store, done, statuses, bar)
+    finally:
+        bar.close()
+    if out is not None:
+        entries = [done[p] for p in files]
+        failed = [e for e in entries if e.error]
+        info = BatchInfo(settings=settings, settings_hash=settings_hash, n_files=len(files),
+                         n_fitted=sum(s == "fitted" for s in statuses.values()),
+                         n_reused=sum(s == "reused" for s in statuses.values()), n_failed=len(failed),
+                         failed_files=tuple(e.source for e in failed), failed_errors=tuple(e.error for e in failed),
+                         wall_time_s=time.perf_counter() - start)
+        write_batch_archive(out, info, entries)
+        write_table(table, entries)
+        store.clear()
+
+
+def _fit_pending(pending, options, hashes, client, workers, store, done, statuses, bar) -> Iterator[Outcome]:
+    from distributed import as_completed
+
+    from .cluster import open_client
+    from .task import fit_and_store
+
+    archive = None if store is None else str(store.archive.resolve())
+    with open_client(client, workers) as dask:
+        futures = {dask.submit(fit_and_store, path, options, hashes[path], archive, pure=False): path
+                   for path in pending}
+        for future in as_completed(futures, loop=dask.loop):
+            path = futures[future]
+            try:
+                entry = future.result()
+            except Exception as exc:  # noqa: BLE001 - a lost worker (KilledWorker) or a cancelled task: data
+                entry = entry_of(FileFit(source=path, sha256=hashes[path], settings=options.settings_json(),
+                                         settings_hash=options.settings_hash(), error=one_line(exc), retry=True))
+            future.release()
+            if store is not None and entry.location is None and not entry.retry:
+                entry = store.save(entry.fit)  # the worker could not write the part: the client does
+            if entry.source != path:
+                entry = dataclasses.replace(entry, source=path)
+            done[path], statuses[path] = entry, "failed" if entry.error else "fitted"
+            bar.update()
+            yield _outcome(entry, statuses[path])
+
+
+def fit_files(paths: str | os.PathLike | Sequence[str | os.PathLike], *, client: Any = None,
+              out: str | os.PathLike | None = None, table: str | os.PathLike | None = None,
+              workers: int | None = None, progress: bool = False, **fit_options: Any) -> BatchResult:
+    """Fit every FRF file and return all outcomes (the Python side of ``modal batch``).
+
+    Parameters are those of :func:`iter_fit`.
+
+    Returns
+    -------
+    BatchResult
+        ``result.rows()`` is the table, ``result.failed`` the failures, ``result.summary()`` the
+        ``--json`` document.
+
+    Examples
+    --------
+    >>> result = fit_files("survey/", out="survey.h5", kind="accelerance")   # doctest: +SKIP
+    >>> result.fitted, result.reused, result.failed                          # doctest: +SKIP
+    """
+    start = time.perf_counter()
+    outcomes = {o.file: o for o in iter_fit(paths, client=client, out=out, table=table, workers=workers,
+                                            progress=progress, **fit_options)}
+    ordered = tuple(outcomes[p] for p in sorted(outcomes))
+    table_path = None if out is None else str(Path(table) if table is not None else default_table(out))
+    return BatchResult(outcomes=ordered, archive=None if out is None else str(out), table=table_path,
+                       wall_time_s=time.perf_counter() - start)

@@ -1,0 +1,226 @@
+"""Where a batch keeps its results: per-file parts while it runs, one archive and one table at the end.
+
+Crash safety: each fitted file is written at once to its own small archive in the parts folder
+``<archive>.parts/`` by the worker that fitted it (atomically: temporary file, checked, renamed),
+so an interrupted run (Ctrl-C, kill -9, a lost worker or client) loses at most the files in
+flight. The archive itself is only ever replaced whole (temporary file, checked, renamed; see
+:func:`modal.io._atomic.atomic_path`): its groups are copied from the parts and from the previous
+archive (HDF5 object copies, no decoding), then the parts folder is removed. A rerun reuses a
+file's result from either place when its content hash and the settings hash are unchanged.
+"""
+from __future__ import annotations
+
+import csv
+import io
+import math
+import os
+import shutil
+from collections.abc import Sequence
+from pathlib import Path
+
+import h5py
+
+from ..archive import write_archive, write_node
+from ..errors import ArchiveError
+from ..io._atomic import atomic_path
+from ..io.hdf5 import check_schema, write_root_attrs
+from .records import BatchInfo, Entry, FileFit
+
+__all__ = ["PartStore", "TABLE_COLUMNS", "table_text", "parse_table", "write_table", "write_batch_archive",
+           "parts_folder"]
+
+#: Columns of the batch table (one row per file, method, mode and channel).
+TABLE_COLUMNS = ("file", "method", "mode", "channel", "natural_frequency_hz", "std_natural_frequency_hz",
+                 "damping_ratio", "std_damping_ratio", "stiffness_n_per_m", "std_stiffness_n_per_m",
+                 "damping_n_s_per_m", "std_damping_n_s_per_m", "mass_kg", "std_mass_kg", "flags")
+_STD_NAMES = ("natural_frequency_hz", "damping_ratio", "stiffness_n_per_m", "damping_n_s_per_m", "mass_kg")
+_INTEGER = ("mode", "channel")
+_TEXT = ("file", "method", "flags")
+
+
+def parts_folder(archive: str | os.PathLike) -> Path:
+    """The folder beside the archive that holds per-file results while a batch runs."""
+    archive = Path(archive)
+    return archive.with_name(archive.name + ".parts")
+
+
+def _cell(value) -> str:
+    if isinstance(value, float):
+        return repr(value) if math.isfinite(value) else ""
+    return str(value)
+
+
+def table_text(results) -> str:
+    """The batch table's rows of one file as CSV lines without the ``file`` column (numbers at full
+    precision, empty where not defined)."""
+    buffer = io.StringIO()
+    writer = csv.writer(buffer, lineterminator="\n")
+    for result in results:
+        for row in result.rows():
+            cells = [row["method"], row["mode"], row["channel"]]
+            for name in _STD_NAMES:
+                cells += [float(row[name]), float(row["std"][name])]
+            cells.append(" ".join(row["flags"]))
+            writer.writerow([_cell(c) for c in cells])
+    return buffer.getvalue()
+
+
+def parse_table(source: str, text: str) -> tuple[dict, ...]:
+    """Rows (dicts over :data:`TABLE_COLUMNS`) from :func:`table_text` (NaN for empty numbers)."""
+    rows = []
+    for cells in csv.reader(io.StringIO(text)):
+        row: dict = {"file": source}
+        for name, cell in zip(TABLE_COLUMNS[1:], cells):
+            if name in _TEXT:
+                row[name] = cell
+            elif name in _INTEGER:
+                row[name] = int(cell)
+            else:
+                row[name] = float(cell) if cell else float("nan")
+        rows.append(row)
+    return tuple(rows)
+
+
+def write_table(path: str | os.PathLike, entries: Sequence[Entry]) -> Path:
+    """The batch table as CSV (columns :data:`TABLE_COLUMNS`), written atomically."""
+    path = Path(path)
+    with atomic_path(path) as tmp:
+        with open(tmp, "w", newline="", encoding="utf-8") as fh:
+            writer = csv.writer(fh, lineterminator="\n")
+            writer.writerow(TABLE_COLUMNS)
+            for entry in entries:
+                for cells in csv.reader(io.StringIO(entry.table)):
+                    writer.writerow([entry.source, *cells])
+    return path
+
+
+def _text(node) -> str | None:
+    if not isinstance(node, h5py.Dataset):
+        return None
+    value = node[()]
+    return value.decode() if isinstance(value, bytes) else str(value)
+
+
+def _entry(node, location: tuple[str, str]) -> Entry | None:
+    try:
+        return Entry(source=_text(node["source"]), sha256=_text(node["sha256"]), error=_text(node["error"]),
+                     retry=bool(node["retry"][()]), table=_text(node["table"]), location=location)
+    except KeyError:
+        return None
+
+
+class PartStore:
+    """Per-file results of one batch archive: the parts folder and the previous archive, keyed by
+    (content hash, settings hash).
+
+    Parameters
+    ----------
+    archive : path-like
+        The batch archive (need not exist yet).
+    """
+
+    def __init__(self, archive: str | os.PathLike):
+        self.archive = Path(archive)
+        self.folder = parts_folder(self.archive)
+
+    def part(self, sha256: str, settings_hash: str) -> Path:
+        """The part file of a content hash under a settings hash."""
+        return self.folder / f"{sha256}-{settings_hash[:16]}.h5"
+
+    def index(self, settings_hash: str, wanted: set[str]) -> dict[str, Entry]:
+        """Earlier results for these content hashes under these settings (parts first, then the
+        previous archive), without reading them whole; results a rerun tries again (``retry``) are
+        left out, and so are unreadable parts and archives (those files are fitted again)."""
+        found: dict[str, Entry] = {}
+        if self.folder.is_dir():
+            for sha in wanted:
+                part = self.part(sha, settings_hash)
+                if part.is_file():
+                    try:
+                        with h5py.File(part, "r") as f:
+                            entry = _entry(f["fit"], (str(part), "fit"))
+                            same = _text(f["fit"].get("settings_hash")) == settings_hash
+                    except (OSError, KeyError):
+                        continue
+                    if entry is not None and same and entry.sha256 == sha and not entry.retry:
+                        found[sha] = entry
+        missing = wanted - set(found)
+        if missing and self.archive.is_file():
+            try:
+                with h5py.File(self.archive, "r") as f:
+                    group = f.get("files")
+                    for name in group.keys() if isinstance(group, h5py.Group) else ():
+                        node = group[name]
+                        sha = _text(node.get("sha256"))
+                        if sha in missing and _text(node.get("settings_hash")) == settings_hash:
+                            entry = _entry(node, (str(self.archive), node.name))
+                            if entry is not None and not entry.retry:
+                                found[sha] = entry
+                                missing.discard(sha)
+            except OSError:
+                pass
+        return found
+
+    def save(self, fit: FileFit) -> Entry:
+        """Write one file's result to the parts folder, atomically; the entry that points at it."""
+        self.folder.mkdir(exist_ok=True)
+        part = self.part(fit.sha256, fit.settings_hash)
+        write_archive(part, {"fit": fit})
+        return Entry(source=fit.source, sha256=fit.sha256, error=fit.error, retry=fit.retry, table=fit.table,
+                     location=(str(part), "fit"))
+
+    def clear(self) -> None:
+        """Remove the parts folder (once the archive holds everything)."""
+        shutil.rmtree(self.folder, ignore_errors=True)
+
+
+def write_batch_archive(path: str | os.PathLike, info: BatchInfo, entries: Sequence[Entry]) -> Path:
+    """The batch archive, written whole and atomically: ``/batch`` (:class:`BatchInfo`) and
+    ``/files/<i>`` (one :class:`FileFit` per file, in the order given), read back by
+    :func:`modal.archive.read_archive` as ``archive["batch"]`` and the list ``archive["files"]``.
+
+    Stored results are copied as HDF5 objects from their part file or the previous archive (which may
+    be ``path`` itself: it is replaced only after the new file is complete and checked); a reused
+    result of a file found under another path gets that path as ``source``.
+    """
+    path = Path(path)
+
+    def verify(tmp: Path) -> None:
+        with h5py.File(tmp, "r") as f:
+            check_schema(f, str(path), error=ArchiveError)
+            if "batch" not in f or len(f["files"]) != len(entries):
+                raise ArchiveError(f"{path}: verification after writing found {len(f.get('files', {}))} of "
+                                   f"{len(entries)} file groups")
+
+    sources: dict[str, h5py.File] = {}
+    try:
+        with atomic_path(path, verify=verify) as tmp:
+            with h5py.File(tmp, "w", track_order=True) as f:
+                write_root_attrs(f)
+                write_node(f, "batch", info)
+                files = f.create_group("files")
+                files.attrs["__type__"] = "list"
+                files.attrs["__len__"] = len(entries)
+                for i, entry in enumerate(entries):
+                    if entry.location is None:
+                        write_node(files, str(i), entry.fit)
+                        continue
+                    name, node = entry.location
+                    if name not in sources:
+                        sources[name] = h5py.File(name, "r")
+                    sources[name].copy(sources[name][node], files, name=str(i))
+                    group = files[str(i)]
+                    if _text(group["source"]) != entry.source:
+                        del group["source"]
+                        write_node(group, "source", entry.source)
+    finally:
+        for handle in sources.values():
+            handle.close()
+    return path
+
+
+def entry_of(fit: FileFit) -> Entry:
+    """An entry holding the fit itself (not stored in a part)."""
+    return Entry(source=fit.source, sha256=fit.sha256, error=fit.error, retry=fit.retry, table=fit.table, fit=fit)
+
+

@@ -1,0 +1,222 @@
+"""Fit one FRF file (or several files on one axis) with the options of ``modal fit``.
+
+The one place where a path and the command line's fit options become FRF + identification
+results: :mod:`modal.cli` (``modal fit``) and :mod:`modal.batch` (``modal batch``, on Dask
+workers) both call :func:`fit_path`, so a file gives the same numbers either way.
+"""
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+import os
+from collections.abc import Sequence
+from dataclasses import dataclass
+from types import SimpleNamespace
+from typing import Any
+
+from .errors import ModalError, ParameterError
+
+__all__ = ["FitOptions", "FitOutput", "fit_path", "READ_HINTS", "GLOBAL_OPTIONS"]
+
+#: read_frf hints that the command line exposes (same names as options)
+READ_HINTS = ("kind", "frequency_axis", "frequency_step", "frequency_start", "layout", "delimiter", "decimal", "dataset")
+#: options of method "global" only
+GLOBAL_OPTIONS = ("modes_hz", "order", "max_order")
+_METHODS = ("auto", "nls", "circle", "halfpower", "global", "all")
+
+
+@dataclass(frozen=True)
+class FitOptions:
+    """What ``modal fit`` does with a file, as plain values (picklable, hashable into a settings key).
+
+    Attributes
+    ----------
+    method : str
+        ``"auto"`` (default), ``"nls"``, ``"circle"``, ``"halfpower"``, ``"global"`` or ``"all"``
+        (the three band-wise methods).
+    bands_hz : tuple of (float, float), optional
+        One fitting band per mode, Hz (``--band``).
+    modes_hz, order, max_order
+        Options of method ``"global"`` (choosing it under ``"auto"``).
+    driving_point : tuple of str, optional
+        Driving-point channels: 0-based indexes or response point ids.
+    kind, frequency_axis, frequency_step, frequency_start, layout, delimiter, decimal, dataset
+        Read hints (:func:`modal.read_frf`); ``frequency_step`` and ``frequency_start`` in Hz.
+    excitation, response, impact, estimator, window, exponential_decay_s, segment_length, overlap
+        Time-data options: a time file is turned into FRFs first (:mod:`modal.cli_time`).
+    """
+
+    method: str = "auto"
+    bands_hz: tuple[tuple[float, float], ...] | None = None
+    modes_hz: tuple[float, ...] | None = None
+    order: int | None = None
+    max_order: int | None = None
+    driving_point: tuple[str, ...] | None = None
+    kind: str | None = None
+    frequency_axis: str | None = None
+    frequency_step: float | None = None
+    frequency_start: float | None = None
+    layout: str | None = None
+    delimiter: str | None = None
+    decimal: str | None = None
+    dataset: int | None = None
+    excitation: str | None = None
+    response: tuple[str, ...] | None = None
+    impact: bool = False
+    estimator: str | None = None
+    window: str | None = None
+    exponential_decay_s: float | None = None
+    segment_length: int | None = None
+    overlap: float | None = None
+
+    def __post_init__(self) -> None:
+        if self.method not in _METHODS:
+            raise ParameterError(f"method must be one of {', '.join(_METHODS)}, got {self.method!r}")
+        given = [name for name in GLOBAL_OPTIONS if getattr(self, name) is not None]
+        if given and self.method not in ("auto", "global"):
+            raise ParameterError(f"--{given[0].replace('_', '-')} applies to --method global only")
+        for name in ("bands_hz", "modes_hz", "driving_point", "response"):  # lists in, tuples kept (hashable)
+            value = getattr(self, name)
+            if value is not None and not isinstance(value, tuple):
+                object.__setattr__(self, name, tuple(tuple(v) if name == "bands_hz" else v for v in value))
+        if self.bands_hz is not None:
+            object.__setattr__(self, "bands_hz", tuple((float(a), float(b)) for a, b in self.bands_hz))
+
+    @classmethod
+    def from_args(cls, args: Any) -> "FitOptions":
+        """From an ``argparse`` namespace of ``modal fit`` / ``modal batch`` (``--band`` → ``bands_hz``)."""
+        values = {f.name: getattr(args, f.name, None) for f in dataclasses.fields(cls) if f.name != "bands_hz"}
+        values["bands_hz"] = getattr(args, "band", None)
+        values["impact"] = bool(values["impact"])
+        values["method"] = values["method"] or "auto"
+        return cls(**values)
+
+    @classmethod
+    def from_kwargs(cls, **options: Any) -> "FitOptions":
+        """From keyword arguments named as the attributes; an unknown name is a :class:`ParameterError`."""
+        names = {f.name for f in dataclasses.fields(cls)}
+        unknown = sorted(set(options) - names)
+        if unknown:
+            raise ParameterError(f"unknown fit option(s) {', '.join(unknown)}; expected some of {', '.join(sorted(names))}")
+        return cls(**options)
+
+    def settings(self) -> dict[str, Any]:
+        """The options that were given (not None / False), JSON-ready."""
+        out = {}
+        for f in dataclasses.fields(self):
+            value = getattr(self, f.name)
+            if value is None or value is False:
+                continue
+            out[f.name] = [list(v) if isinstance(v, tuple) else v for v in value] if isinstance(value, tuple) else value
+        return out
+
+    def settings_json(self) -> str:
+        """Canonical JSON of :meth:`settings` with the toolkit version (what a result depends on)."""
+        from . import __version__
+
+        return json.dumps({"options": self.settings(), "modalbal": __version__}, sort_keys=True)
+
+    def settings_hash(self) -> str:
+        """SHA-256 (hex) of :meth:`settings_json`."""
+        return hashlib.sha256(self.settings_json().encode()).hexdigest()
+
+    def hints(self) -> dict[str, Any]:
+        """The read hints that were given."""
+        return {k: getattr(self, k) for k in READ_HINTS if getattr(self, k) is not None}
+
+    def namespace(self) -> SimpleNamespace:
+        """The options as the attribute names of the command line (for :mod:`modal.cli_time`)."""
+        values = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
+        values["response"] = list(self.response) if self.response is not None else None
+        values["band"] = self.bands_hz
+        return SimpleNamespace(**values)
+
+
+@dataclass(frozen=True)
+class FitOutput:
+    """What :func:`fit_path` returns.
+
+    Attributes
+    ----------
+    frf : FRF
+        The FRF that was fitted (an :class:`~modal.estimate.EstimatedFRF` from time data).
+    results : tuple of IdentificationResult
+        One per method that ran (``result.method`` says which ``"auto"`` chose).
+    time_data : tuple or None
+        ``(record, inputs, outputs)`` when the file held time data, for plots.
+    """
+
+    frf: Any
+    results: tuple
+    time_data: tuple | None = None
+
+
+def fit_path(path: str | os.PathLike | Sequence[str | os.PathLike], options: FitOptions,
+             report_estimate=None) -> FitOutput:
+    """Read an FRF (or time) file and identify its modes, as ``modal fit`` does.
+
+    Parameters
+    ----------
+    path : path-like or sequence of path-likes
+        One file, or several on one frequency axis (one multi-channel FRF).
+    options : FitOptions
+    report_estimate : callable, optional
+        Called with the estimate when the file held time data (the command line prints a line).
+
+    Returns
+    -------
+    FitOutput
+
+    Raises
+    ------
+    ModalError
+        Unreadable file or failed identification (the message names the file).
+    """
+    from .cli_time import frf_from_time, wants_time
+    from .identify import identify
+    from .io import read_frf
+
+    paths = [path] if isinstance(path, (str, os.PathLike)) else list(path)
+    args = options.namespace()
+    time_data = None
+    if len(paths) == 1 and wants_time(args, paths[0]):
+        frf, *record = frf_from_time(paths[0], args)
+        time_data = tuple(record)
+        if report_estimate is not None:
+            report_estimate(frf)
+    else:
+        frf = read_frf(paths[0] if len(paths) == 1 else paths, **options.hints())
+    methods = ["nls", "circle", "halfpower"] if options.method == "all" else [options.method]
+    global_options = {k: getattr(options, k) for k in GLOBAL_OPTIONS if getattr(options, k) is not None}
+    if global_options and methods == ["auto"]:
+        methods = ["global"]  # options of the global method choose it
+    if global_options:
+        global_options = {k: list(v) if isinstance(v, tuple) else v for k, v in global_options.items()}
+    driving = driving_channels(frf, options.driving_point) if options.driving_point else None
+    bands = [list(b) for b in options.bands_hz] if options.bands_hz is not None else None
+    results = tuple(identify(frf, method, bands_hz=bands, driving_point=driving,
+                             **(global_options if method == "global" else {}))
+                    for method in methods)
+    return FitOutput(frf=frf, results=results, time_data=time_data)
+
+
+def driving_channels(frf, names: Sequence[str]):
+    """Boolean mask over channels from ``--driving-point`` values (indexes or response point ids)."""
+    import numpy as np
+
+    mask = np.zeros(frf.n_channels, bool)
+    points = list(frf.response_points or [])
+    for name in names:
+        name = str(name)
+        if name.lstrip("-").isdigit():
+            index = int(name)
+            if not 0 <= index < frf.n_channels:
+                raise ModalError(f"--driving-point {name}: no such channel; expected 0..{frf.n_channels - 1}")
+        elif name in points:
+            index = points.index(name)
+        else:
+            raise ModalError(f"--driving-point {name}: no channel has that response point; expected a channel index "
+                             f"0..{frf.n_channels - 1}" + (f" or one of {', '.join(points)}" if points else ""))
+        mask[index] = True
+    return mask
