@@ -18,7 +18,8 @@ from modal.report import jsonable
 __all__ = ["main"]
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(influence: bool = True) -> argparse.ArgumentParser:
+    """The command-line parser; ``influence=False`` leaves out the ``influence`` command (not imported)."""
     parser = argparse.ArgumentParser(prog="python -m balancer", description="Balancing studies fed by modal identification.")
     sub = parser.add_subparsers(dest="command", required=True)
     run = sub.add_parser("run", help="run a scene end to end")
@@ -27,15 +28,18 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--plots", metavar="DIR", help="folder for the plots")
     run.add_argument("--archive", metavar="EARLIER.h5", help="earlier archive of the scene: reuse unchanged stages")
     run.add_argument("--json", action="store_true", help="print one JSON document on stdout")
-    from .influence.cli import add_parser as add_influence
+    if influence:
+        from .influence.cli import add_parser as add_influence
 
-    add_influence(sub)
+        add_influence(sub)
     return parser
 
 
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit code."""
-    args = build_parser().parse_args(argv)
+    argv = sys.argv[1:] if argv is None else list(argv)
+    # a scene run does not need the influence command's modules
+    args = build_parser(influence=not (argv and argv[0] == "run")).parse_args(argv)
     warnings.showwarning = lambda message, *a, **k: print(f"warning: {message}", file=sys.stderr)
     if args.command == "influence":
         from .influence.cli import run as run_influence
@@ -45,8 +49,11 @@ def main(argv: list[str] | None = None) -> int:
     from .scene.summary import digest
 
     try:
+        import os
+
         run = run_scene(args.scene, out=args.out, plots_dir=args.plots, archive=args.archive,
-                        progress=lambda msg: print(msg, file=sys.stderr, flush=True))
+                        progress=lambda msg: print(msg, file=sys.stderr, flush=True),
+                        plot_jobs=2 if (os.cpu_count() or 1) > 1 else 1)
     except ModalError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 1

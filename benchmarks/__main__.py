@@ -462,8 +462,10 @@ def speed_section(runs: int, quick: bool) -> str:
         results = bench_speed.run(sorted(bench_speed.GOALS), 3 if quick else runs, 60.0 if quick else 180.0)
     text = bench_speed.table(results)
     print(machine_section() + "\n\n" + text, flush=True)
+    before = HERE / "speed_before.md"
     return ("`python -m benchmarks.bench_speed` (each ratio measured in this run; goal 2's peer is the optional "
-            "`bench` extra):\n\n" + text)
+            "`bench` extra):\n\n" + text
+            + ("\n\n" + before.read_text(encoding="utf-8").strip() if before.is_file() else ""))
 
 
 # --------------------------------------------------------------------------- main

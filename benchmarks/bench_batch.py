@@ -5,7 +5,8 @@ The files are UFF 58 driving-point mobilities with two modes and 0.1 % noise, fi
 default options (method auto: band-wise NLS). Rows:
 
 - one process looping: :func:`modal.batch.task.fit_one` over the files in this process (no Dask,
-  no archive): the baseline;
+  no archive): the baseline; and the same loop writing the same archive at the end (one
+  :func:`modal.archive.write_archive` of every result: what the batch's archive costs per file);
 - ``fit_files(..., workers=N, out=...)`` on the embedded LocalCluster (start of the cluster,
   hashing, fitting, per-file parts, archive and table; a fresh archive every run);
 - the rerun of the same batch (every file reused: no cluster is started);
@@ -29,6 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
+from modal.archive import write_archive
 from modal.batch import fit_files, find_files
 from modal.batch.cluster import default_workers
 from modal.batch.task import fit_one
@@ -85,6 +87,13 @@ def main(argv: list[str] | None = None) -> int:
         print("|---|---|---|---|")
         print(row("one process looping (fit_one, no archive)", n, loop, loop[0]))
         counter = iter(range(10**6))
+
+        def loop_archive() -> None:
+            fits = [fit_one(p, options) for p in files]
+            write_archive(Path(tmp) / f"loop{next(counter)}.h5", {"files": fits})
+
+        print(row("one process looping + one write_archive of all results", n, timed(loop_archive, args.runs),
+                  loop[0]))
 
         def fresh(workers: int) -> None:
             out = Path(tmp) / f"run{next(counter)}.h5"

@@ -17,9 +17,11 @@ Run ``python -m benchmarks.bench_speed [--runs N] [--quick] [--only 1 2 3 4 5] [
 4. The bundled demo scene (``python -m balancer run data/synthetic/demo_scene.toml``) as a
    subprocess against the import floor (a subprocess that only imports numpy, scipy,
    h5py, matplotlib, modal and balancer), runs interleaved.  Goal: ratio <= 2.
-5. ``identify`` of a 100 000-line noisy FRF (four modes, accelerance, noise rising
-   100-fold above the hammer's band as in a hammer-test H1 estimate) in a subprocess with
-   a time limit.  Goal: well under a minute (the ratio is against 60 s).
+5. ``identify`` of two 100 000-line noisy FRFs, each in a subprocess with a time limit: a
+   hammer test's H1 estimate (three hits, exponential window, noise above the hammer's
+   band: the issue's pathological 8192-line case, larger) and a synthetic accelerance
+   with noise rising 100-fold above the band.  Goal: well under a minute (the ratio, the
+   worse of the two, is against 60 s).
 
 Every timing is the median of ``--runs`` repetitions with the [min–max] spread; the
 machine and the versions are printed first.
@@ -242,12 +244,48 @@ def noisy_long_frf(lines: int = 100_000, seed: int = 5):
     return FRF(frequency_hz=f, response=noisy, kind="accelerance")
 
 
+def hammer_h1(lines: int = 100_000, seed: int = 5):
+    """A hammer test's H1 estimate with ``lines`` lines, as in the issue's pathological case.
+
+    Three hits (1 ms half-sine pulses: the force spectrum is gone above ~1.5 kHz), four
+    modes (180, 730, 1450, 2600 Hz; the last beyond the hammer's band), white noise on the
+    measured acceleration, exponential window, ``fs`` = 10 kHz: above the band the estimate
+    is noise.
+    """
+    import modal
+
+    fs = 10_000.0
+    segment = 2 * (lines - 1)
+    n = 3 * segment + int(0.3 * fs)
+    t = np.arange(n) / fs
+    force = np.zeros(n)
+    for start in (0.1, 0.1 + segment / fs, 0.1 + 2 * segment / fs):
+        inside = (t >= start) & (t < start + 1e-3)
+        force[inside] = 100.0 * np.sin(np.pi * (t[inside] - start) / 1e-3)
+    fn = np.array([180.0, 730.0, 1450.0, 2600.0])
+    zeta = np.array([0.02, 0.01, 0.015, 0.01])
+    const = np.array([1.0, 0.6, 0.8, 0.5])
+    wn = 2 * np.pi * fn
+    wd = wn * np.sqrt(1 - zeta**2)
+    tau = np.arange(int(2.0 * fs)) / fs  # 2 s of impulse response: every mode decayed to < 1e-10
+    impulse = np.sum(const[:, None] / wd[:, None] * np.exp(-zeta[:, None] * wn[:, None] * tau)
+                     * np.sin(wd[:, None] * tau), axis=0) / fs
+    size = 1 << int(np.ceil(np.log2(n + impulse.size)))
+    displacement = np.fft.irfft(np.fft.rfft(force, size) * np.fft.rfft(impulse, size), size)[:n]
+    acceleration = np.gradient(np.gradient(displacement, 1 / fs), 1 / fs)
+    rng = np.random.default_rng(seed)
+    noisy = acceleration + 0.05 * np.std(acceleration) * rng.standard_normal(n)
+    return modal.estimate_frf(force, noisy, fs, kind="accelerance", response_quantity="acceleration", impact=True,
+                              segment_length=segment, window="exponential", exponential_decay_s=0.5,
+                              pretrigger_s=0.05)
+
+
 _GOAL5_CHILD = """
 import sys, time, warnings
 sys.path.insert(0, {root!r})
-from benchmarks.bench_speed import noisy_long_frf
+from benchmarks.bench_speed import {case}
 import modal
-frf = noisy_long_frf()
+frf = {case}()
 warnings.simplefilter("ignore")
 start = time.perf_counter()
 result = modal.identify(frf)
@@ -255,20 +293,29 @@ print(time.perf_counter() - start, len(result.modes), " ".join(f"{{m.natural_fre
 """
 
 
-def goal5(runs: int, timeout: float) -> dict:
+def _goal5_case(case: str, runs: int, timeout: float) -> tuple[float | None, str]:
     samples, found = [], ""
     for _ in range(max(1, min(runs, 2))):
         try:
-            proc = subprocess.run([sys.executable, "-c", _GOAL5_CHILD.format(root=str(ROOT))], cwd=ROOT,
+            proc = subprocess.run([sys.executable, "-c", _GOAL5_CHILD.format(root=str(ROOT), case=case)], cwd=ROOT,
                                   capture_output=True, text=True, timeout=timeout)
         except subprocess.TimeoutExpired:
-            return {"ratio": None, "text": f"did not finish within the {timeout:.0f} s limit (ratio > {timeout / 60:.2g})"}
+            return None, f"did not finish within the {timeout:.0f} s limit (ratio > {timeout / 60:.2g})"
         if proc.returncode != 0:
-            return {"ratio": None, "text": f"failed: {proc.stderr.strip()[-300:]}"}
+            return None, f"failed: {proc.stderr.strip()[-300:]}"
         seconds, count, *freqs = proc.stdout.split()
         samples.append(float(seconds))
         found = f"{count} modes at {', '.join(freqs[:8])} Hz (truth 180, 730, 1450, 2600)"
-    return {"ratio": _median(samples) / 60.0, "text": f"identify {_spread(samples)}; {found}"}
+    return _median(samples) / 60.0, f"identify {_spread(samples)}; {found}"
+
+
+def goal5(runs: int, timeout: float) -> dict:
+    """Worst of two 100 000-line cases: a hammer test's H1 estimate and a synthetic noisy FRF."""
+    hammer, hammer_text = _goal5_case("hammer_h1", runs, timeout)
+    plain, plain_text = _goal5_case("noisy_long_frf", runs, timeout)
+    ratios = [r for r in (hammer, plain) if r is not None]
+    ratio = None if len(ratios) < 2 else max(ratios)
+    return {"ratio": ratio, "text": f"hammer H1 estimate: {hammer_text}. Synthetic noisy accelerance: {plain_text}"}
 
 
 # --------------------------------------------------------------------------- main

@@ -57,3 +57,11 @@ def synthetic_dir() -> Path:
 @pytest.fixture
 def real_dir() -> Path:
     return REAL
+
+
+@pytest.fixture(scope="session")
+def dask_cluster(tmp_path_factory):
+    """A real ``dask scheduler`` and two ``dask worker`` processes on 127.0.0.1: (address, folder, processes)."""
+    from daskcluster import cluster
+
+    yield from cluster(tmp_path_factory)

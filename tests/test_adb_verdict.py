@@ -148,3 +148,16 @@ def test_points_at_the_boundary_are_left_to_the_eigenvalue_path():
     eig = stability_map(S1, speeds, "D", [S1.D])
     assert np.all(np.isfinite(fast.max_real_part_per_s))
     assert np.array_equal(fast.stability_class, eig.stability_class)
+
+
+def test_another_family_member_gets_the_same_verdicts():
+    # n = 3, a non-symmetric balanced member (S6 of adb.md): rho^2 comes from the actual angles
+    from balancer.adb import balanced_ball_angles
+
+    p = S1.replace(n=3)
+    member = balanced_ball_angles(p, free_angles_rad=[2.0])
+    speeds = np.linspace(0.3, 6.0, 120) * p.natural_frequency_rad_s
+    eig = stability_map(p, speeds, "D", [1e-4, 1e-3, 1e-2], ball_angles_rad=member)
+    fast = stability_map(p, speeds, "D", [1e-4, 1e-3, 1e-2], ball_angles_rad=member, margin=False)
+    assert np.array_equal(fast.stability_class, eig.stability_class)
+    assert np.any(fast.stability_class == STABLE) and np.isnan(fast.max_real_part_per_s).mean() > 0.9

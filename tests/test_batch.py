@@ -2,16 +2,14 @@
 per-file failures as data, resumable after a crash or a lost worker.
 
 A real Dask scheduler and two workers are started from the installed `dask` command on 127.0.0.1
-(subprocesses, free ports, stopped after the module); the local runs use the embedded LocalCluster.
+(the session fixture ``dask_cluster`` of conftest.py); the local runs use the embedded LocalCluster.
 The FRFs are small (301 lines, two modes, band-wise NLS) so that the module stays fast.
 """
 from __future__ import annotations
 
 import csv
 import json
-import os
 import signal
-import socket
 import subprocess
 import sys
 import textwrap
@@ -28,7 +26,8 @@ from modal.errors import ParameterError
 from modal.io import write_frf
 from modal.synthetic import add_noise, modal_frf
 
-DASK = Path(sys.executable).with_name("dask")
+from daskcluster import free_port, start_worker, wait_for_workers
+
 FREQ = np.linspace(20.0, 200.0, 301)  # 0.6 Hz lines; the modes are 2.4 and 5 Hz wide (>= 4 lines per bandwidth)
 NOISE = 1e-3  # of the peak magnitude: the NLS standard errors of f_n are ~1e-5 relative
 
@@ -89,57 +88,6 @@ def assert_same_tables(a: list[dict[str, str]], b: list[dict[str, str]]) -> None
             np.testing.assert_allclose(va, vb, rtol=1e-9, atol=0, equal_nan=True, err_msg=f"{ra['file']} {column}")
 
 
-# ---- a real Dask cluster from the `dask` command ----------------------------------------------------------------
-
-def free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        return sock.getsockname()[1]
-
-
-def start_worker(address: str, name: str, folder: Path) -> subprocess.Popen:
-    """One worker process without a nanny (so that killing it loses it for good)."""
-    return subprocess.Popen([str(DASK), "worker", address, "--name", name, "--nthreads", "1", "--no-nanny",
-                             "--no-dashboard", "--host", "127.0.0.1", "--local-directory", str(folder)],
-                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, cwd=folder)
-
-
-def wait_for_workers(address: str, n: int, timeout: float = 60.0) -> None:
-    from distributed import Client
-
-    with Client(address, timeout="30s", set_as_default=False) as client:
-        client.wait_for_workers(n, timeout=timeout)
-
-
-def stop(procs) -> None:
-    for proc in procs:
-        if proc.poll() is None:
-            proc.terminate()
-    for proc in procs:
-        try:
-            proc.wait(timeout=10)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait()
-
-
-@pytest.fixture(scope="module")
-def cluster(tmp_path_factory):
-    """``dask scheduler`` and two ``dask worker`` processes on 127.0.0.1; yields (address, folder)."""
-    assert DASK.is_file(), f"{DASK}: the dask command is not installed (dask[distributed] is a dependency)"
-    folder = tmp_path_factory.mktemp("dask")
-    port = free_port()
-    address = f"tcp://127.0.0.1:{port}"
-    procs = [subprocess.Popen([str(DASK), "scheduler", "--host", "127.0.0.1", "--port", str(port), "--no-dashboard"],
-                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, cwd=folder)]
-    try:
-        procs += [start_worker(address, f"w{i}", folder) for i in range(2)]
-        wait_for_workers(address, 2)
-        yield address, folder, procs
-    finally:
-        stop(procs[::-1])
-
-
 @pytest.fixture(scope="module")
 def small_set(tmp_path_factory):
     folder = tmp_path_factory.mktemp("small") / "survey"
@@ -149,8 +97,8 @@ def small_set(tmp_path_factory):
 
 # ---- cluster and local: identical tables --------------------------------------------------------------------
 
-def test_cluster_and_local_runs_give_identical_tables(cluster, small_set, tmp_path):
-    address = cluster[0]
+def test_cluster_and_local_runs_give_identical_tables(dask_cluster, small_set, tmp_path):
+    address = dask_cluster[0]
     remote = run_cli(small_set, "--out", tmp_path / "remote.h5", "--scheduler", address, "--json")
     assert remote.returncode == 0, remote.stderr
     local = run_cli(small_set, "--out", tmp_path / "local.h5", "--workers", "2", "--json")
@@ -168,9 +116,9 @@ def test_cluster_and_local_runs_give_identical_tables(cluster, small_set, tmp_pa
     assert not (tmp_path / "remote.h5.parts").exists()  # the parts are in the archive now
 
 
-def test_archive_has_one_group_per_file_with_hash_settings_and_modes(cluster, small_set, tmp_path):
+def test_archive_has_one_group_per_file_with_hash_settings_and_modes(dask_cluster, small_set, tmp_path):
     out = tmp_path / "res.h5"
-    result = fit_files(small_set, client=cluster[0], out=out, method="nls")
+    result = fit_files(small_set, client=dask_cluster[0], out=out, method="nls")
     files = find_files(small_set)
     assert len(files) == 12 and any("/sub/" in f for f in files)  # the sub-folder was searched
     archive = read_archive(out)
@@ -195,28 +143,28 @@ def test_archive_has_one_group_per_file_with_hash_settings_and_modes(cluster, sm
 
 # ---- resumable: content hash and settings ---------------------------------------------------------------------
 
-def test_rerun_refits_only_changed_files_and_changed_settings(cluster, tmp_path):
+def test_rerun_refits_only_changed_files_and_changed_settings(dask_cluster, tmp_path):
     folder = tmp_path / "in"
     paths = write_files(folder, 6)
     out = tmp_path / "res.h5"
-    first = fit_files(folder, client=cluster[0], out=out)
+    first = fit_files(folder, client=dask_cluster[0], out=out)
     assert (first.fitted, first.reused) == (6, 0)
     frf = modal_frf(FREQ, [70.0, 140.0], [0.02, 0.02], [1.0, 0.7], kind="mobility")
     write_frf(add_noise(frf, NOISE, seed=99), paths[2])  # new content under the same name
-    second = fit_files(folder, client=cluster[0], out=out)
+    second = fit_files(folder, client=dask_cluster[0], out=out)
     assert (second.fitted, second.reused) == (1, 5)
     assert [o.file for o in second.outcomes if o.status == "fitted"] == [str(paths[2])]
-    third = fit_files(folder, client=cluster[0], out=out, method="circle")  # other settings: nothing reused
+    third = fit_files(folder, client=dask_cluster[0], out=out, method="circle")  # other settings: nothing reused
     assert (third.fitted, third.reused) == (6, 0)
     assert {row["method"] for row in third.rows()} == {"circle"}
 
 
-def test_worker_killed_mid_batch_completes(cluster, tmp_path):
+def test_worker_killed_mid_batch_completes(dask_cluster, tmp_path):
     """A third worker is killed (SIGKILL, no nanny) while it runs a task: Dask gives its tasks to the
     others and every file is fitted (or, failing that, a rerun completes the batch); the archive is whole."""
     from distributed import Client
 
-    address, folder, procs = cluster
+    address, folder, procs = dask_cluster
     files_dir = tmp_path / "in"
     write_files(files_dir, 30)
     victim = start_worker(address, "victim", folder)
@@ -254,20 +202,20 @@ def _rows(fit):
             for row in parse_table(fit.source, fit.table)]
 
 
-def test_killed_client_loses_only_files_in_flight_and_never_the_archive(cluster, tmp_path):
+def test_killed_client_loses_only_files_in_flight_and_never_the_archive(dask_cluster, tmp_path):
     """kill -9 of the process running a batch: the earlier archive is untouched (same bytes), the files
     done so far are in the parts folder, and the rerun reuses them and finishes."""
     folder = tmp_path / "in"
     write_files(folder, 4)
     out = tmp_path / "res.h5"
-    assert fit_files(folder, client=cluster[0], out=out).fitted == 4
+    assert fit_files(folder, client=dask_cluster[0], out=out).fitted == 4
     before = out.read_bytes()
     write_files(folder, 16, start=4)
     script = textwrap.dedent(f"""
         import os, signal
         from modal.batch import iter_fit
         done = 0
-        for outcome in iter_fit({str(folder)!r}, client={cluster[0]!r}, out={str(out)!r}):
+        for outcome in iter_fit({str(folder)!r}, client={dask_cluster[0]!r}, out={str(out)!r}):
             done += outcome.status == "fitted"
             if done == 6:
                 os.kill(os.getpid(), signal.SIGKILL)
@@ -275,18 +223,18 @@ def test_killed_client_loses_only_files_in_flight_and_never_the_archive(cluster,
     crashed = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
     assert crashed.returncode == -signal.SIGKILL, crashed.stderr
     assert out.read_bytes() == before  # the archive was never touched
-    parts = sorted((tmp_path / "res.h5.parts").glob("*.h5"))  # (workers may still be writing the files in flight)
-    assert len(parts) >= 6
-    for part in parts:  # a part under its final name is always whole (written aside, checked, renamed)
-        assert read_archive(part)["fit"].ok
-    again = fit_files(folder, client=cluster[0], out=out)
+    # a part (one chunk of files) under its final name is always whole: written aside, checked, renamed
+    # (workers may still be writing the chunks that were in flight)
+    saved = [fit for part in (tmp_path / "res.h5.parts").glob("*.h5") for fit in read_archive(part)["files"]]
+    assert len(saved) >= 6 and all(fit.ok for fit in saved)
+    again = fit_files(folder, client=dask_cluster[0], out=out)
     assert again.failed == [] and again.reused >= 4 + 6 and again.fitted + again.reused == 20
     assert len(read_archive(out)["files"]) == 20
 
 
 # ---- 100+ files with two broken ones ------------------------------------------------------------------------
 
-def test_hundred_files_with_two_broken_then_rerun_reuses_everything(tmp_path):
+def test_hundred_files_with_two_broken_then_rerun_reuses_everything(dask_cluster, tmp_path):
     folder = tmp_path / "survey"
     good = write_files(folder, 100)
     truncated = folder / "broken_truncated.uff"
@@ -295,8 +243,9 @@ def test_hundred_files_with_two_broken_then_rerun_reuses_everything(tmp_path):
     garbage = folder / "sub" / "broken_garbage.csv"
     garbage.write_text("not,an\nfrf,file\n")
     out = tmp_path / "res.h5"
-    first = run_cli(folder, "--out", out, "--table", tmp_path / "table.csv", "--workers", "2", "--json",
-                    "--method", "nls")
+    options = ("--out", out, "--table", tmp_path / "table.csv", "--scheduler", dask_cluster[0], "--json",
+               "--method", "nls")
+    first = run_cli(folder, *options)
     assert first.returncode == 1, first.stderr
     doc = json.loads(first.stdout)
     assert (doc["files"], doc["fitted"], doc["reused"]) == (102, 100, 0)
@@ -311,8 +260,7 @@ def test_hundred_files_with_two_broken_then_rerun_reuses_everything(tmp_path):
     assert len(archive["files"]) == 102 and archive["batch"].n_failed == 2
     assert sorted(archive["batch"].failed_files) == sorted([str(truncated), str(garbage)])
 
-    second = run_cli(folder, "--out", out, "--table", tmp_path / "table.csv", "--workers", "2", "--json",
-                     "--method", "nls")
+    second = run_cli(folder, *options)
     assert second.returncode == 1, second.stderr
     again = json.loads(second.stdout)
     # every unchanged file reused, nothing fitted (the two broken files are reported again from the archive)
@@ -323,19 +271,25 @@ def test_hundred_files_with_two_broken_then_rerun_reuses_everything(tmp_path):
 
 # ---- usage and discovery ------------------------------------------------------------------------------------
 
-def test_bad_usage_exits_2(small_set, tmp_path):
+def test_bad_usage_exits_2(small_set, tmp_path, capsys):
+    from modal.cli import main
+
     cases = [
         (tmp_path / "nothing_here", "--out", tmp_path / "r.h5"),  # no file found
         (small_set, "--out", tmp_path / "r.h5", "--scheduler", "tcp://127.0.0.1:1", "--workers", "2"),
         (small_set, "--out", tmp_path / "r.h5", "--method", "nls", "--modes-hz", "70"),
         (small_set, "--out", tmp_path / "missing" / "r.h5"),
         (small_set, "--out", tmp_path / "r.h5", "--workers", "0"),
-        (small_set,),  # no --out
     ]
-    for args in cases:
-        done = run_cli(*args)
-        assert done.returncode == 2, (args, done.stderr)
-        assert "error" in done.stderr and "Traceback" not in done.stderr
+    for args in cases:  # in this process (the same main() as the command; a subprocess below)
+        try:
+            code = main(["batch", *map(str, args)])
+        except SystemExit as exc:  # argparse
+            code = exc.code
+        assert code == 2, args
+        assert "error" in capsys.readouterr().err
+    done = run_cli(small_set)  # no --out
+    assert done.returncode == 2 and "--out" in done.stderr and "Traceback" not in done.stderr
     assert not (tmp_path / "r.h5").exists()
 
 

@@ -156,8 +156,95 @@ def _open_earlier(path) -> h5py.File | None:
     return f
 
 
+class _PlotWorkers:
+    """Stage plots rendered in forked child processes while the parent goes on (``plot_jobs > 1``).
+
+    Each child renders the figures of the stages it is given (atomic writes, as in
+    :func:`~balancer.scene.plots.save_stage_plot`) and reports the paths, or the error,
+    through a pipe.  Falls back to the parent (``submit`` returns False) where ``os.fork``
+    is missing, with more than one thread alive (forking a threaded process is unsafe),
+    or when ``plot_jobs - 1`` children are already running.
+    """
+
+    def __init__(self, jobs: int, folder: Path, results: dict):
+        import os
+        import threading
+
+        self.jobs = max(1, int(jobs))
+        self.folder = folder
+        self.results = results
+        self.children: list[tuple[int, int, tuple[str, ...]]] = []
+        self.finished: set[int] = set()
+        self.usable = self.jobs > 1 and hasattr(os, "fork") and threading.active_count() == 1
+
+    def submit(self, stages: tuple[str, ...]) -> bool:
+        import os
+        import sys
+
+        if not stages or not self.usable or self._running() >= self.jobs - 1:
+            return False
+        from .plots import save_stage_plot
+
+        sys.stdout.flush()
+        sys.stderr.flush()
+        read, write = os.pipe()
+        pid = os.fork()
+        if pid == 0:  # child: render, report, leave without running the parent's exit handlers
+            code = 0
+            try:
+                os.close(read)
+                paths = [str(p) for stage in stages for p in save_stage_plot(stage, self.results, self.folder)]
+                message = json.dumps({"paths": paths})
+            except BaseException as exc:  # noqa: BLE001 - reported to the parent, which raises it
+                message, code = json.dumps({"error": f"{type(exc).__name__}: {exc}"}), 1
+            try:
+                os.write(write, message.encode())
+            finally:
+                os._exit(code)
+        os.close(write)
+        self.children.append((pid, read, stages))
+        return True
+
+    def _running(self) -> int:
+        """Children still drawing (finished ones are reaped; their reports wait in the pipes)."""
+        import os
+
+        for pid, _read, _stages in self.children:
+            if pid not in self.finished and os.waitpid(pid, os.WNOHANG)[0] == pid:
+                self.finished.add(pid)
+        return sum(pid not in self.finished for pid, _read, _stages in self.children)
+
+    def collect(self) -> dict[str, list[Path]]:
+        """Wait for every child; the paths of each stage's plots (raises if a child failed)."""
+        import os
+
+        done: dict[str, list[Path]] = {}
+        errors = []
+        for pid, read, stages in self.children:
+            chunks = []
+            while True:
+                chunk = os.read(read, 65536)
+                if not chunk:
+                    break
+                chunks.append(chunk)
+            os.close(read)
+            if pid not in self.finished:
+                os.waitpid(pid, 0)
+            report = json.loads(b"".join(chunks) or b'{"error": "plot process ended without a report"}')
+            if "error" in report:
+                errors.append(f"plots of {', '.join(stages)}: {report['error']}")
+                continue
+            for path in map(Path, report["paths"]):
+                done.setdefault(next(s for s in stages if path.name.startswith(s + "_")), []).append(path)
+        self.children, self.finished = [], set()
+        if errors:
+            raise RuntimeError("; ".join(errors))
+        return done
+
+
 def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, plots_dir: str | Path | None = None,
-              archive: str | Path | None = None, progress: Callable[[str], None] | None = None) -> SceneRun:
+              archive: str | Path | None = None, progress: Callable[[str], None] | None = None,
+              plot_jobs: int = 1) -> SceneRun:
     """Run a scene end to end.
 
     Parameters
@@ -174,6 +261,11 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, p
         are read back from it instead of being recomputed.
     progress : callable, optional
         Called with a line of text before and after each stage that runs.
+    plot_jobs : int
+        Processes drawing the plots (POSIX only): with 2 or more, the plots of a stage are
+        drawn in a forked child as soon as the stage is done, while the next stages run
+        (``python -m balancer run`` uses 2 on a machine with several CPUs).  The files are
+        the same as with 1 (default: everything in this process).
     """
     if isinstance(scene, (str, Path)):
         scene = load_scene(scene)
@@ -191,6 +283,29 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, p
     finally:
         if earlier is not None:
             earlier.close()
+    outputs = scene.section("outputs")
+    name = scene.section("scene.name") or Path(scene.source).stem or "scene"
+    stored = outputs.get("archive", False)
+    archive_path = None
+    if stored or out is not None:
+        archive_path = Path(out) if out is not None else Path("out") / f"{_slug(name)}.h5"
+    plotted = list(outputs.get("plots") or [])
+    folder = None
+    if plotted:
+        folder = Path(plots_dir) if plots_dir is not None else (
+            archive_path.with_name(archive_path.stem + "_plots") if archive_path else Path("out") / f"{_slug(name)}_plots")
+        folder.mkdir(parents=True, exist_ok=True)
+    workers = _PlotWorkers(plot_jobs, folder, results) if plotted else None
+    pending = list(plotted)  # plot stages not yet handed to a child, in output order
+
+    def hand_over() -> None:
+        # plots whose stage and upstream results are all there go to a child while the parent runs on
+        ready = tuple(s for s in pending if s in results and all(status[t] != "ran" or t in results
+                                                                  for t in dependencies(scene, s)))
+        if workers is not None and ready and workers.submit(ready):
+            for s in ready:
+                pending.remove(s)
+
     for stage in STAGES:
         if status[stage] != "ran":
             continue
@@ -200,25 +315,30 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, p
         results[stage] = STAGE_FUNCTIONS[stage](scene, **kwargs)
         timings[stage] = time.perf_counter() - t0
         say(f"{stage}: done in {timings[stage]:.2f} s")
-    outputs = scene.section("outputs")
-    name = scene.section("scene.name") or Path(scene.source).stem or "scene"
-    archive_path = None
-    stored = outputs.get("archive", False)
-    if stored or out is not None:
+        if stage in pending:
+            hand_over()
+    if archive_path is not None:
         keep = [s for s in STAGES if s in results and (stored is True or stored is False or s in stored)]
-        archive_path = Path(out) if out is not None else Path("out") / f"{_slug(name)}.h5"
         archive_path.parent.mkdir(parents=True, exist_ok=True)
         write_archive(archive_path, {s: results[s] for s in keep}, scene_text=scene.text or None,
                       inputs_hash={s: hashes[s] for s in keep})
     plot_paths = []
-    if outputs.get("plots"):
+    if plotted:
         from .plots import save_stage_plot
 
-        folder = Path(plots_dir) if plots_dir is not None else (
-            archive_path.with_name(archive_path.stem + "_plots") if archive_path else Path("out") / f"{_slug(name)}_plots")
-        folder.mkdir(parents=True, exist_ok=True)
-        for stage in outputs["plots"]:
-            plot_paths += save_stage_plot(stage, results, folder)
+        # split what is left: a child takes the second half while this process draws the first
+        half = (len(pending) + 1) // 2
+        if workers.submit(tuple(pending[half:])):
+            pending = pending[:half]
+        mine = {}
+        for stage in pending:
+            try:
+                mine[stage] = save_stage_plot(stage, results, folder)
+            except Exception as exc:  # the same report as from a child: the stage and the cause
+                raise RuntimeError(f"plots of {stage}: {type(exc).__name__}: {exc}") from exc
+        theirs = workers.collect()
+        for stage in plotted:
+            plot_paths += mine.get(stage, theirs.get(stage, []))
     from .summary import format_summary
 
     summary = format_summary(name, status, results, outputs.get("tables", []), timings,

@@ -24,7 +24,7 @@ def add_batch_parser(sub, add_fit_options) -> argparse.ArgumentParser:
                     "1: some failed (listed); 2: bad usage.")
     batch.add_argument("inputs", nargs="+", metavar="DIR_OR_GLOB", help="folders, glob patterns or files")
     batch.add_argument("--out", required=True, metavar="RESULTS.h5",
-                       help="the archive (replaced whole at the end; per-file results go to RESULTS.h5.parts/ "
+                       help="the archive (replaced whole at the end; results go to RESULTS.h5.parts/ "
                             "meanwhile, so an interrupted run resumes)")
     batch.add_argument("--table", metavar="RESULTS.csv", help="the CSV table (default: the archive's name with .csv)")
     batch.add_argument("--json", action="store_true",

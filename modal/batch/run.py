@@ -86,7 +86,7 @@ def iter_fit(paths: str | os.PathLike | Sequence[str | os.PathLike], *, client: 
         cluster of ``workers`` processes, started only when some file needs fitting.
     out : path-like, optional
         Batch archive; with it, results of an earlier run with the same file content and options
-        are reused, each fitted file is saved at once (``<out>.parts/``), and the archive and the
+        are reused, each chunk of fitted files is saved at once (``<out>.parts/``), and the archive and the
         table are written when the iteration ends. Without it nothing is written.
     table : path-like, optional
         CSV table (default ``out`` with suffix ``.csv``).
@@ -178,6 +178,12 @@ def _run(files: list[str], options: FitOptions, client, out, table, workers, pro
         store.clear()
 
 
+def chunk_size(n_files: int, n_workers: int) -> int:
+    """Files per task: about four tasks per worker (load balance, and a crash loses at most the chunks in
+    flight), at most 16 files (a chunk is one part file: its overhead is paid once)."""
+    return max(1, min(16, -(-n_files // (4 * max(1, n_workers)))))
+
+
 def _fit_pending(pending, options, hashes, client, workers, store, done, statuses, bar) -> Iterator[Outcome]:
     from distributed import as_completed
 
@@ -186,23 +192,29 @@ def _fit_pending(pending, options, hashes, client, workers, store, done, statuse
 
     archive = None if store is None else str(store.archive.resolve())
     with open_client(client, workers) as dask:
-        futures = {dask.submit(fit_and_store, path, options, hashes[path], archive, pure=False): path
-                   for path in pending}
+        size = chunk_size(len(pending), len(dask.scheduler_info().get("workers", {})))
+        chunks = [pending[i:i + size] for i in range(0, len(pending), size)]
+        futures = {dask.submit(fit_and_store, chunk, options, [hashes[p] for p in chunk], archive, pure=False): chunk
+                   for chunk in chunks}
         for future in as_completed(futures, loop=dask.loop):
-            path = futures[future]
+            chunk = futures[future]
             try:
-                entry = future.result()
+                entries = future.result()
             except Exception as exc:  # noqa: BLE001 - a lost worker (KilledWorker) or a cancelled task: data
-                entry = entry_of(FileFit(source=path, sha256=hashes[path], settings=options.settings_json(),
-                                         settings_hash=options.settings_hash(), error=one_line(exc), retry=True))
+                entries = [entry_of(FileFit(source=path, sha256=hashes[path], settings=options.settings_json(),
+                                            settings_hash=options.settings_hash(), error=one_line(exc), retry=True))
+                           for path in chunk]
             future.release()
-            if store is not None and entry.location is None and not entry.retry:
-                entry = store.save(entry.fit)  # the worker could not write the part: the client does
-            if entry.source != path:
-                entry = dataclasses.replace(entry, source=path)
-            done[path], statuses[path] = entry, "failed" if entry.error else "fitted"
-            bar.update()
-            yield _outcome(entry, statuses[path])
+            unstored = [i for i, e in enumerate(entries) if e.location is None and not e.retry]
+            if store is not None and unstored:  # the worker could not write the part: the client does
+                for i, entry in zip(unstored, store.save([entries[i].fit for i in unstored])):
+                    entries[i] = entry
+            for path, entry in zip(chunk, entries):
+                if entry.source != path:
+                    entry = dataclasses.replace(entry, source=path)
+                done[path], statuses[path] = entry, "failed" if entry.error else "fitted"
+                bar.update()
+                yield _outcome(entry, statuses[path])
 
 
 def fit_files(paths: str | os.PathLike | Sequence[str | os.PathLike], *, client: Any = None,

@@ -1,9 +1,10 @@
-"""Where a batch keeps its results: per-file parts while it runs, one archive and one table at the end.
+"""Where a batch keeps its results: parts while it runs, one archive and one table at the end.
 
-Crash safety: each fitted file is written at once to its own small archive in the parts folder
-``<archive>.parts/`` by the worker that fitted it (atomically: temporary file, checked, renamed),
-so an interrupted run (Ctrl-C, kill -9, a lost worker or client) loses at most the files in
-flight. The archive itself is only ever replaced whole (temporary file, checked, renamed; see
+Crash safety: each chunk of fitted files (a Dask task: about four per worker, at most 16 files) is
+written at once to its own small archive in the parts folder ``<archive>.parts/`` by the worker
+that fitted it (atomically: temporary file, checked, renamed), so an interrupted run (Ctrl-C,
+kill -9, a lost worker or client) loses at most the chunks in flight. One part per chunk rather
+than per file: an HDF5 file costs about as much to create and check as a small fit. The archive itself is only ever replaced whole (temporary file, checked, renamed; see
 :func:`modal.io._atomic.atomic_path`): its groups are copied from the parts and from the previous
 archive (HDF5 object copies, no decoding), then the parts folder is removed. A rerun reuses a
 file's result from either place when its content hash and the settings hash are unchanged.
@@ -11,6 +12,7 @@ file's result from either place when its content hash and the settings hash are 
 from __future__ import annotations
 
 import csv
+import hashlib
 import io
 import math
 import os
@@ -113,6 +115,10 @@ class PartStore:
     """Per-file results of one batch archive: the parts folder and the previous archive, keyed by
     (content hash, settings hash).
 
+    A part is a small archive of one chunk of files (``/files/<i>``, one :class:`FileFit` each),
+    written by the worker that fitted them, so that the HDF5 file overhead and the task overhead are
+    paid once per chunk rather than once per file.
+
     Parameters
     ----------
     archive : path-like
@@ -123,51 +129,45 @@ class PartStore:
         self.archive = Path(archive)
         self.folder = parts_folder(self.archive)
 
-    def part(self, sha256: str, settings_hash: str) -> Path:
-        """The part file of a content hash under a settings hash."""
-        return self.folder / f"{sha256}-{settings_hash[:16]}.h5"
+    @staticmethod
+    def _scan(path: Path, settings_hash: str, missing: set[str], found: dict[str, Entry]) -> None:
+        with h5py.File(path, "r") as f:
+            group = f.get("files")
+            for name in group.keys() if isinstance(group, h5py.Group) else ():
+                node = group[name]
+                sha = _text(node.get("sha256"))
+                if sha in missing and _text(node.get("settings_hash")) == settings_hash:
+                    entry = _entry(node, (str(path), node.name))
+                    if entry is not None and not entry.retry:
+                        found[sha] = entry
+                        missing.discard(sha)
 
     def index(self, settings_hash: str, wanted: set[str]) -> dict[str, Entry]:
         """Earlier results for these content hashes under these settings (parts first, then the
         previous archive), without reading them whole; results a rerun tries again (``retry``) are
         left out, and so are unreadable parts and archives (those files are fitted again)."""
         found: dict[str, Entry] = {}
-        if self.folder.is_dir():
-            for sha in wanted:
-                part = self.part(sha, settings_hash)
-                if part.is_file():
-                    try:
-                        with h5py.File(part, "r") as f:
-                            entry = _entry(f["fit"], (str(part), "fit"))
-                            same = _text(f["fit"].get("settings_hash")) == settings_hash
-                    except (OSError, KeyError):
-                        continue
-                    if entry is not None and same and entry.sha256 == sha and not entry.retry:
-                        found[sha] = entry
-        missing = wanted - set(found)
-        if missing and self.archive.is_file():
+        missing = set(wanted)
+        sources = sorted(self.folder.glob(f"{settings_hash[:16]}-*.h5")) if self.folder.is_dir() else []
+        if self.archive.is_file():
+            sources.append(self.archive)
+        for path in sources:
+            if not missing:
+                break
             try:
-                with h5py.File(self.archive, "r") as f:
-                    group = f.get("files")
-                    for name in group.keys() if isinstance(group, h5py.Group) else ():
-                        node = group[name]
-                        sha = _text(node.get("sha256"))
-                        if sha in missing and _text(node.get("settings_hash")) == settings_hash:
-                            entry = _entry(node, (str(self.archive), node.name))
-                            if entry is not None and not entry.retry:
-                                found[sha] = entry
-                                missing.discard(sha)
-            except OSError:
-                pass
+                self._scan(path, settings_hash, missing, found)
+            except (OSError, KeyError):
+                continue
         return found
 
-    def save(self, fit: FileFit) -> Entry:
-        """Write one file's result to the parts folder, atomically; the entry that points at it."""
+    def save(self, fits: Sequence[FileFit]) -> list[Entry]:
+        """Write one chunk of results to a new part, atomically; the entries that point at them."""
         self.folder.mkdir(exist_ok=True)
-        part = self.part(fit.sha256, fit.settings_hash)
-        write_archive(part, {"fit": fit})
-        return Entry(source=fit.source, sha256=fit.sha256, error=fit.error, retry=fit.retry, table=fit.table,
-                     location=(str(part), "fit"))
+        key = hashlib.sha256("".join(f.sha256 for f in fits).encode()).hexdigest()[:16]
+        part = self.folder / f"{fits[0].settings_hash[:16]}-{key}.h5"
+        write_archive(part, {"files": list(fits)})
+        return [Entry(source=fit.source, sha256=fit.sha256, error=fit.error, retry=fit.retry, table=fit.table,
+                      location=(str(part), f"/files/{i}")) for i, fit in enumerate(fits)]
 
     def clear(self) -> None:
         """Remove the parts folder (once the archive holds everything)."""

@@ -55,14 +55,17 @@ def fit_one(path: str, options: FitOptions, sha256: str | None = None) -> FileFi
                    table=table_text(out.results))
 
 
-def fit_and_store(path: str, options: FitOptions, sha256: str | None = None, archive: str | None = None) -> Entry:
-    """:func:`fit_one`, then (with ``archive``) the result written to the archive's parts folder by
-    the process that fitted it; returns the client's :class:`Entry` (small: the table rows and where
-    the result is, or the result itself when it is not stored)."""
-    fit = fit_one(path, options, sha256)
-    if archive is None or fit.retry:
-        return entry_of(fit)
+def fit_and_store(paths: list[str], options: FitOptions, hashes: list[str], archive: str | None = None) -> list[Entry]:
+    """:func:`fit_one` for a chunk of files, then (with ``archive``) their results written to one part
+    in the archive's parts folder by the process that fitted them; returns the client's
+    :class:`Entry` per file (small: the table rows and where the result is, or the result itself when
+    it is not stored)."""
+    fits = [fit_one(path, options, sha) for path, sha in zip(paths, hashes)]
+    keep = [fit for fit in fits if not fit.retry]
+    if archive is None or not keep:
+        return [entry_of(fit) for fit in fits]
     try:
-        return PartStore(archive).save(fit)
-    except (OSError, ModalError):  # parts folder not reachable from this worker: the client stores it
-        return entry_of(fit)
+        stored = iter(PartStore(archive).save(keep))
+    except (OSError, ModalError):  # parts folder not reachable from this worker: the client stores them
+        return [entry_of(fit) for fit in fits]
+    return [entry_of(fit) if fit.retry else next(stored) for fit in fits]
