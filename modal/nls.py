@@ -118,7 +118,8 @@ def _project(Phi, Y):
 
 def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, damping_ratio0,
               region: np.ndarray | None = None, max_iter: int = 200, step_tol: float = 1e-13,
-              background_powers: tuple[int, ...] = (0,), residual_terms: bool = False) -> NLSFit:
+              background_powers: tuple[int, ...] = (0,), residual_terms: bool = False,
+              line_weight: np.ndarray | None = None) -> NLSFit:
     """Fit poles and modal constants of several modes to many channels at once.
 
     Parameters
@@ -148,6 +149,11 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
         (iω)^p (stiffness line) and (iω)^p/(−ω²) (mass line) in the FRF's kind, with
         complex coefficients (after the region columns in ``offsets``; use
         ``region=None`` with them). The lines must then exclude ω = 0.
+    line_weight : ndarray, shape (n_freq,), optional
+        Weighted least squares: each line's residual times this weight, σ_ref/σ_line for a
+        noise σ_line that varies over the lines (an estimate from time data: its noise
+        spikes at the zeros of the force spectrum). ``noise_var`` and the covariances are
+        then those of the weighted problem: ``noise_var`` estimates σ_ref².
     """
     omega = np.asarray(omega, float)
     Y_raw = np.atleast_2d(np.asarray(response, complex))
@@ -178,8 +184,19 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
     n_b_guess = n_modes + background.shape[1]
     Y = _compress(Y, 2 * n_b_guess + 8)
 
+    weight = None
+    if line_weight is not None:
+        weight = np.asarray(line_weight, float)[:, None]
+        compressed = Y is not Y_full
+        Y_full = Y_full * weight  # row weights commute with the channel compression
+        Y = Y * weight if compressed else Y_full
+        background = background * weight
+
     def evaluate(p):
         Phi, dphi = _design(x, p, power, background)
+        if weight is not None:  # the modes' columns (the background's are weighted once, above)
+            Phi[:, :n_modes] *= weight
+            dphi = dphi * weight
         Q, R, QhY, res = _project(Phi, Y)
         return Phi, dphi, Q, R, QhY, res, float(np.sum(res.real**2) + np.sum(res.imag**2))
 

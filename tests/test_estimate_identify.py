@@ -115,3 +115,28 @@ def test_a_hundred_thousand_noisy_lines_identify_in_bounded_time():
     found = np.array([m.natural_frequency_hz for m in result])
     assert found.size == 3 and all(m.ok for m in result)
     np.testing.assert_allclose(found, fn, rtol=1e-3)
+
+
+@pytest.mark.parametrize("lines", [20_000, 100_000])
+def test_hammer_estimate_with_force_zeros_finds_the_true_modes(lines):
+    """A 1 ms hammer pulse has spectral zeros at 1, 2, 3... kHz; there H1 = Gxy/Gxx peaks where its noise peaks
+    (|H| 91 against a noise of 69 at 1500 Hz). Those lines made the automatic choice call the FRF many-mode
+    (global, 95 s on 100 000 lines, phantom modes at every zero) and, unweighted, pulled the band-wise fit of the
+    1450 and 2600 Hz modes onto the zeros at 1500 and 2500 Hz. With the peak test using the noise at the peak
+    and the fit weighted by the estimate's noise per line, every true mode comes out near its truth: within
+    0.1 % (a few of its standard errors; the 2600 Hz mode lies beyond the hammer's band)."""
+    from benchmarks.bench_speed import hammer_h1
+
+    from modal.identify import choose_method
+
+    frf = hammer_h1(lines)
+
+    assert choose_method(frf) == "nls"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", modal.ModalWarning)
+        result = modal.identify(frf)
+    found = np.array([m.natural_frequency_hz for m in result])
+    assert found.size == 4, found
+    assert np.allclose(found, [180.0, 730.0, 1450.0, 2600.0], rtol=1e-3), found
+    for m, f_true in zip(result, [180.0, 730.0, 1450.0]):  # inside the hammer's band: calibrated errors
+        assert abs(m.natural_frequency_hz - f_true) < 4 * m.std.natural_frequency_hz, (f_true, m.natural_frequency_hz)
