@@ -8,7 +8,8 @@ Runs, in order: the five speed ratios of issue 19 (``bench_speed``: SDOF identif
 against a bare least-squares fit, 1000 channels against sdypy-EMA, the stability map
 against numpy's eigenvalues, the demo scene against the import floor, a 100 000-line
 noisy FRF against a minute), identification against the Cramér–Rao bound over damping, noise
-and resolution (``bench_identify``), 1 and 1000 channels, file reading
+and resolution (``bench_identify``), 1 and 1000 channels, the calibration of every
+method's standard errors (``bench_calibration``), file reading
 (``bench_io``), the counterweight optimiser against brute-force grids
 (``bench_crank``), the ball-balancer stability map and simulations against plain
 ``solve_ivp`` (``bench_adb``), batches of files on Dask against one process
@@ -474,8 +475,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--quick", action="store_true", help="small sizes (a smoke run of a minute or two)")
     parser.add_argument("--runs", type=int, default=5, help="repetitions for every median (default 5)")
     parser.add_argument("--trials", type=int, default=50, help="noise trials per SDOF grid cell (default 50)")
-    parser.add_argument("--only", nargs="+", choices=["speed", "identify", "global", "estimate", "io", "crank", "adb",
-                                                      "influence", "batch", "demo"],
+    parser.add_argument("--only", nargs="+", choices=["speed", "identify", "calibration", "global", "estimate", "io",
+                                                      "crank", "adb", "influence", "batch", "demo"],
                         help="run only these sections")
     parser.add_argument("--out", type=Path, default=HERE / "REPORT.md", help="report file (default benchmarks/REPORT.md)")
     parser.add_argument("--refresh-stress", action="store_true",
@@ -488,7 +489,8 @@ def main(argv: list[str] | None = None) -> int:
         args.out.write_text(head + "\n## Stress run\n\n" + stress_summary() + "\n", encoding="utf-8")
         print(f"[benchmarks] refreshed the stress section of {args.out}", file=sys.stderr)
         return 0
-    wanted = set(args.only or ["speed", "identify", "global", "estimate", "io", "crank", "adb", "influence", "batch",
+    wanted = set(args.only or ["speed", "identify", "calibration", "global", "estimate", "io", "crank", "adb",
+                               "influence", "batch",
                                "demo"])
     runs = max(1, args.runs)
     started = time.perf_counter()
@@ -518,6 +520,9 @@ def main(argv: list[str] | None = None) -> int:
         status.append(line)
         return body
 
+    if "calibration" in wanted:
+        sections.append(("Calibration of the standard errors (issue 21)",
+                         run_module("bench_calibration", ["--seeds", "50" if args.quick else "200"])))
     if "global" in wanted:
         sections.append(("Global identification (pLSCF + joint refinement) against sdypy-EMA",
                          run_module("bench_global", ["--runs", str(runs), "--seeds", "2" if args.quick else "5"])))

@@ -15,9 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .model import cramer_rao_sdof
 
-__all__ = ["CircleEstimate", "fit_circle", "circle_fit_curve"]
+__all__ = ["CircleEstimate", "fit_circle", "fit_circles", "circle_fit_curve"]
 
 
 def fit_circle(x: np.ndarray, y: np.ndarray) -> tuple[float, float, float]:
@@ -27,38 +26,45 @@ def fit_circle(x: np.ndarray, y: np.ndarray) -> tuple[float, float, float]:
     conditioned at any physical scale). Falls back to Kasa's fit when the Hyper
     generalised eigenproblem has no admissible solution.
     """
-    mx, my = x.mean(), y.mean()
-    scale = np.sqrt(np.mean((x - mx) ** 2 + (y - my) ** 2)) or 1.0
+    xc, yc, r = fit_circles(np.asarray(x, float)[None, :], np.asarray(y, float)[None, :])
+    return float(xc[0]), float(yc[0]), float(r[0])
+
+
+def fit_circles(x: np.ndarray, y: np.ndarray):
+    """:func:`fit_circle` of a batch of point sets ``x``, ``y`` (B, n); returns three arrays (B,)."""
+    mx, my = x.mean(axis=1, keepdims=True), y.mean(axis=1, keepdims=True)
+    scale = np.sqrt(np.mean((x - mx) ** 2 + (y - my) ** 2, axis=1, keepdims=True))
+    scale = np.where(scale > 0, scale, 1.0)
     u, v = (x - mx) / scale, (y - my) / scale
     z = u**2 + v**2
-    Z = np.column_stack([z, u, v, np.ones_like(u)])
-    M = Z.T @ Z / u.size
-    zbar = z.mean()
-    N = np.array([[8 * zbar, 0, 0, 2], [0, 1, 0, 0], [0, 0, 1, 0], [2, 0, 0, 0]], dtype=float)
-    best = None
+    Z = np.stack([z, u, v, np.ones_like(u)], axis=2)  # (B, n, 4)
+    M = np.einsum("bni,bnj->bij", Z, Z) / u.shape[1]
+    zbar = z.mean(axis=1)
+    N = np.zeros_like(M)
+    N[:, 0, 0] = 8 * zbar
+    N[:, 0, 3] = N[:, 3, 0] = 2
+    N[:, 1, 1] = N[:, 2, 2] = 1
+    a = np.full((x.shape[0], 4), np.nan)
     try:  # N is invertible for Hyper: M a = η N a  ⇔  N⁻¹M a = η a
         vals, vecs = np.linalg.eig(np.linalg.solve(N, M))
-        for k in range(4):
-            if not np.isfinite(vals[k]) or abs(vals[k].imag) > 1e-9 * (1 + abs(vals[k].real)):
-                continue
-            a = np.real(vecs[:, k])
-            norm = a @ N @ a
-            if norm <= 0 or abs(a[0]) < 1e-14 * np.linalg.norm(a):
-                continue
-            eta = (a @ M @ a) / norm
-            if best is None or eta < best[0]:
-                best = (eta, a)
+        vecs = np.real(vecs)  # (B, 4, 4): columns are the eigenvectors
+        norm = np.einsum("bik,bij,bjk->bk", vecs, N, vecs)
+        eta = np.einsum("bik,bij,bjk->bk", vecs, M, vecs) / np.where(norm != 0, norm, np.nan)
+        admissible = (np.isfinite(vals) & (np.abs(vals.imag) <= 1e-9 * (1 + np.abs(vals.real))) & (norm > 0)
+                      & (np.abs(vecs[:, 0, :]) >= 1e-14 * np.linalg.norm(vecs, axis=1)))
+        eta = np.where(admissible, eta, np.inf)
+        best = np.argmin(eta, axis=1)
+        found = np.isfinite(eta[np.arange(x.shape[0]), best])
+        a[found] = vecs[found, :, best[found]]
     except (np.linalg.LinAlgError, ValueError):
-        best = None
-    if best is None:  # Kasa: z + B u + C v + D = 0, linear
-        sol, *_ = np.linalg.lstsq(np.column_stack([u, v, np.ones_like(u)]), -z, rcond=None)
-        a = np.array([1.0, *sol])
-    else:
-        a = best[1]
-    A, B, C, D = a
+        found = np.zeros(x.shape[0], bool)
+    for k in np.flatnonzero(~found):  # Kasa: z + B u + C v + D = 0, linear
+        sol, *_ = np.linalg.lstsq(np.column_stack([u[k], v[k], np.ones_like(u[k])]), -z[k], rcond=None)
+        a[k] = [1.0, *sol]
+    A, B, C, D = a.T
     uc, vc = -B / (2 * A), -C / (2 * A)
-    radius = np.sqrt(max(B**2 + C**2 - 4 * A * D, 0.0)) / (2 * abs(A))
-    return mx + scale * uc, my + scale * vc, scale * radius
+    radius = np.sqrt(np.maximum(B**2 + C**2 - 4 * A * D, 0.0)) / (2 * np.abs(A))
+    return mx[:, 0] + scale[:, 0] * uc, my[:, 0] + scale[:, 0] * vc, scale[:, 0] * radius
 
 
 def directional_unwrap(angles: np.ndarray, points: np.ndarray) -> np.ndarray:
@@ -87,6 +93,12 @@ class CircleEstimate:
     damping_pair_spread: float
     n_points: int
     flags: tuple[str, ...]
+    #: covariance of (ωn, ζ, Re A, Im A) propagated from the noise through this estimator
+    #: (NaN without a noise level); the errors above are its diagonal (plus quantisation
+    #: where the peak is unresolved)
+    cov: np.ndarray | None = None
+    #: ∂(ωn, ζ, Re A, Im A)/∂(Re Y, Im Y) on every line of the band, shape (4, 2, n)
+    jacobian: np.ndarray | None = None
 
 
 def _angle_model(params, w):
@@ -140,16 +152,59 @@ def _levenberg_marquardt(p0, xs, theta, max_iter=100):
     return p, r, _angle_jac(p, xs), ok
 
 
-def _circle_bound(omega, omega_n, zeta, modal_constant, noise_std):
-    """Cramér–Rao standard deviations of (ωn, ζ) for a mobility circle with offset."""
-    try:
-        with np.errstate(all="ignore"):
-            return cramer_rao_sdof(omega, omega_n, zeta, modal_constant, 1, noise_std, offset=True)[:2]
-    except (np.linalg.LinAlgError, ValueError, FloatingPointError):
-        return np.array([np.nan, np.nan])
+def _centre_jacobian(x, y):
+    """∂(xc, yc, ρ)/∂(x_j, y_j) of :func:`fit_circle`, shape (3, 2, n), by central differences
+    (one batch of 4n perturbed point sets)."""
+    n = x.size
+    scale = float(np.sqrt(np.mean((x - x.mean()) ** 2 + (y - y.mean()) ** 2))) or 1.0
+    step = 1e-6 * scale
+    xs = np.repeat(x[None, :], 4 * n, axis=0)
+    ys = np.repeat(y[None, :], 4 * n, axis=0)
+    j = np.arange(n)
+    xs[4 * j, j] += step
+    xs[4 * j + 1, j] -= step
+    ys[4 * j + 2, j] += step
+    ys[4 * j + 3, j] -= step
+    out = np.array(fit_circles(xs, ys))  # (3, 4n)
+    jac = np.empty((3, 2, n))
+    jac[:, 0] = (out[:, 0::4] - out[:, 1::4]) / (2 * step)
+    jac[:, 1] = (out[:, 2::4] - out[:, 3::4]) / (2 * step)
+    return jac
 
 
-def circle_fit_curve(omega: np.ndarray, mobility: np.ndarray, noise_std: float) -> CircleEstimate:
+def _linearisation(z, centre, rho, xs, params, w_ref):
+    """∂(ωn, ζ, Re A, Im A)/∂(Re z_j, Im z_j) of the circle fit, shape (4, 2, n).
+
+    First order through every step the estimate takes: the Hyper circle
+    (numerically, :func:`_centre_jacobian`), the angles about its centre
+    (dθ_j = Im((dz_j − dc)/(z_j − c))), the Gauss–Newton solution of the angle
+    least squares (dp = (JᵀJ)⁻¹Jᵀ dθ) and A = 2ζωn·2ρ·e^{iψ}.
+    """
+    n = z.size
+    x_n, zeta, psi = params
+    d_circle = _centre_jacobian(z.real, z.imag)  # (3, 2, n)
+    w = z - centre
+    a2 = np.abs(w) ** 2
+    # direct part of dθ_j (z_j moves) per (Re, Im)
+    d_theta = np.zeros((n, 2, n))
+    idx = np.arange(n)
+    d_theta[idx, 0, idx] = -w.imag / a2
+    d_theta[idx, 1, idx] = w.real / a2
+    # through the centre: dθ_j = −(−w_i dxc + w_r dyc)/|w|²
+    d_theta -= (-w.imag / a2)[:, None, None] * d_circle[0][None] + (w.real / a2)[:, None, None] * d_circle[1][None]
+    J = _angle_jac(params, xs)
+    solve = np.linalg.solve(J.T @ J, J.T)  # (3, n)
+    d_params = np.einsum("pj,jkn->pkn", solve, d_theta)  # (3, 2, n): x_n, ζ, ψ
+    d_wn = w_ref * d_params[0]
+    d_zeta = d_params[1]
+    d_rho = d_circle[2]
+    wn = x_n * w_ref
+    A = 2 * zeta * wn * 2 * rho * np.exp(1j * psi)
+    dA = A * (d_zeta / zeta + d_wn / wn + d_rho / rho + 1j * d_params[2])
+    return np.stack([d_wn, d_zeta, dA.real, dA.imag])
+
+
+def circle_fit_curve(omega: np.ndarray, mobility: np.ndarray, noise_std, errors: bool = True) -> CircleEstimate:
     """Circle fit of the strongest mode in a band, on one channel of mobility.
 
     Parameters
@@ -158,9 +213,11 @@ def circle_fit_curve(omega: np.ndarray, mobility: np.ndarray, noise_std: float) 
         Lines of the band, rad/s.
     mobility : ndarray of complex
         Mobility on those lines (convert other kinds exactly first).
-    noise_std : float
-        σ of the complex noise on the mobility (for the Cramér–Rao floor of the
-        standard errors).
+    noise_std : float or ndarray
+        σ of the complex noise on the mobility, one value or one per line (for the
+        standard errors, propagated through the estimator's linearisation).
+    errors : bool
+        False: the estimate only (standard errors NaN, no covariance), for start values.
     """
     mag = np.abs(mobility)
     n = mag.size
@@ -220,22 +277,18 @@ def circle_fit_curve(omega: np.ndarray, mobility: np.ndarray, noise_std: float) 
         zeta = min(zeta, 1.0)
         flags.append("did_not_converge")
     std_x = std_z = np.nan
-    dof = xs.size - 3
-    if dof > 0 and ok:
-        s2 = float(np.sum(residual**2) / dof)
-        try:
-            cov = s2 * np.linalg.inv(jac.T @ jac)
-            std_x, std_z = np.sqrt(max(cov[0, 0], 0)), np.sqrt(max(cov[1, 1], 0))
-        except np.linalg.LinAlgError:
-            pass
-    if ok and np.isfinite(noise_std) and noise_std > 0:
-        # the angle residuals ignore the error of the fitted centre, which moves every
-        # angle together (observed scatter ≈ 1.5× that error): the Cramér–Rao bound of
-        # the circle (mode + offset) on the same lines is the floor
-        bound = _circle_bound(w, x_n * w_ref, zeta, 2 * zeta * x_n * w_ref * 2 * rho * np.exp(1j * psi), noise_std)
-        if np.all(np.isfinite(bound)):
-            std_x = max(std_x, bound[0] / w_ref) if np.isfinite(std_x) else bound[0] / w_ref
-            std_z = max(std_z, bound[1]) if np.isfinite(std_z) else bound[1]
+    cov = jacobian = None
+    if ok and errors:
+        # the estimator's own errors, to first order: its linearisation in the data times the
+        # noise of each line (σ/√2 on the real and on the imaginary part, independently)
+        with np.errstate(all="ignore"):
+            local = _linearisation(z, centre, rho, xs, params, w_ref)  # (4, 2, n_sel)
+        jacobian = np.zeros((4, 2, n))
+        jacobian[:, :, sel] = local
+        line_var = np.broadcast_to(np.asarray(noise_std, float) ** 2 / 2, (n,))
+        if np.all(np.isfinite(line_var)) and np.all(np.isfinite(jacobian)):
+            cov = np.einsum("pkn,n,qkn->pq", jacobian, line_var, jacobian)
+            std_x, std_z = np.sqrt(cov[0, 0]) / w_ref, np.sqrt(cov[1, 1])
     if "resolution_limited" in flags or not ok:
         # unresolved peak: the line spacing bounds what the data can say (quantisation)
         spacing = float(np.min(np.diff(xs)))
@@ -247,4 +300,4 @@ def circle_fit_curve(omega: np.ndarray, mobility: np.ndarray, noise_std: float) 
     if np.isfinite(spread) and spread > 0.2:
         flags.append("damping_pair_spread")
     return CircleEstimate(float(omega_n), float(zeta), complex(modal_constant), complex(residual),
-                          float(std_x * w_ref), float(std_z), spread, int(xs.size), tuple(flags))
+                          float(std_x * w_ref), float(std_z), spread, int(xs.size), tuple(flags), cov, jacobian)

@@ -13,7 +13,7 @@ import numpy as np
 
 from .units import TWO_PI
 
-__all__ = ["ModeStd", "ModeResult", "IdentificationResult", "physical_parameters", "FLAG_TEXT"]
+__all__ = ["ModeStd", "ModeResult", "IdentificationResult", "physical_parameters", "physical_covariance", "correlation_of", "FLAG_TEXT"]
 
 #: Every quality flag with the reason it is raised.
 FLAG_TEXT = {
@@ -122,6 +122,14 @@ class ModeResult:
         Modal phase collinearity (Pappa) of the modal constants, per reference
         and averaged: 1 for a real (normal) mode, lower for a complex one. NaN
         where not computed.
+    kcm_correlation : ndarray or None
+        Correlation matrix of the errors of (k, c, m) per channel, shape (3, 3)
+        for a single channel, (n_channels, 3, 3) otherwise. The three share ωn,
+        ζ and the modal constant and are strongly correlated: carry the whole
+        covariance (:attr:`kcm_covariance`) into anything computed from more
+        than one of them. NaN for transfer channels; None where not computed.
+        (A correlation, not a covariance, so that it holds at any scale of the
+        data: k² of an FRF near 1e-300 overflows.)
     """
 
     natural_frequency_hz: float
@@ -143,6 +151,22 @@ class ModeResult:
     mode_shape: np.ndarray | None = None
     participation: np.ndarray | None = None
     mpc: float = float("nan")
+    kcm_correlation: np.ndarray | None = None
+
+    def archive_units(self) -> dict[str, str]:
+        """Units of the fields whose names do not say them (for :mod:`modal.archive`)."""
+        return {"kcm_correlation": "1"}
+
+    @property
+    def kcm_covariance(self) -> np.ndarray | None:
+        """Covariance of (k [N/m], c [N s/m], m [kg]) per channel: the standard errors in
+        ``std`` with :attr:`kcm_correlation`; shape (3, 3) or (n_channels, 3, 3); None where
+        the correlation was not computed."""
+        if self.kcm_correlation is None:
+            return None
+        sd = np.stack([np.asarray(self.std.stiffness_n_per_m, float), np.asarray(self.std.damping_n_s_per_m, float),
+                       np.asarray(self.std.mass_kg, float)], axis=-1)
+        return sd[..., :, None] * np.asarray(self.kcm_correlation, float) * sd[..., None, :]
 
     @property
     def omega_n_rad_s(self) -> float:
@@ -298,7 +322,50 @@ def physical_parameters(omega_n, damping_ratio, modal_constant, cov=None):
         g_c = np.stack([2 * damping_ratio * m + zeros, 2 * m * omega_n + zeros,
                         -c * m * da_dre, -c * m * da_dim], axis=-1)
 
-    def sd(g):
-        return np.sqrt(np.maximum(np.einsum("...i,...ij,...j->...", g, cov, g), 0.0))
+    cov_kcm = physical_covariance(omega_n, damping_ratio, A, cov)
+    diag = np.sqrt(np.maximum(np.diagonal(cov_kcm, axis1=-2, axis2=-1), 0.0))
+    return (k, c, m), (diag[..., 0], diag[..., 1], diag[..., 2])
 
-    return (k, c, m), (sd(g_k), sd(g_c), sd(g_m))
+
+def correlation_of(cov: np.ndarray) -> np.ndarray:
+    """Correlation matrix (..., n, n) of covariance matrices; NaN where a variance is not positive."""
+    cov = np.asarray(cov, float)
+    sd = np.sqrt(np.diagonal(cov, axis1=-2, axis2=-1))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        out = cov / (sd[..., :, None] * sd[..., None, :])
+    return np.where(np.isfinite(out), np.clip(out, -1.0, 1.0), np.nan)
+
+
+def physical_covariance(omega_n, damping_ratio, modal_constant, cov):
+    """Covariance of (k, c, m) from that of (ωn, ζ, Re A, Im A), to first order.
+
+    Parameters
+    ----------
+    omega_n : float
+        Natural frequency, rad/s.
+    damping_ratio : float
+    modal_constant : complex or ndarray of complex
+        Receptance modal constant(s) of driving points, 1/kg.
+    cov : ndarray, shape (..., 4, 4)
+        Covariance of (ωn [rad/s], ζ, Re A, Im A [1/kg]) per channel.
+
+    Returns
+    -------
+    ndarray, shape (..., 3, 3)
+        Rows and columns k (N/m), c (N s/m), m (kg).
+    """
+    A = np.asarray(modal_constant, dtype=complex)
+    a = np.abs(A)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        m = 1.0 / a
+        k = m * omega_n**2
+        c = 2.0 * damping_ratio * m * omega_n
+        da_dre, da_dim = A.real / a, A.imag / a
+        # gradients with respect to (ωn, ζ, Re A, Im A)
+        zeros = np.zeros(A.shape)
+        g_m = np.stack([zeros, zeros, -m**2 * da_dre, -m**2 * da_dim], axis=-1)
+        g_k = np.stack([2 * m * omega_n + zeros, zeros, -k * m * da_dre, -k * m * da_dim], axis=-1)
+        g_c = np.stack([2 * damping_ratio * m + zeros, 2 * m * omega_n + zeros,
+                        -c * m * da_dre, -c * m * da_dim], axis=-1)
+        grad = np.stack([g_k, g_c, g_m], axis=-2)  # (..., 3, 4)
+        return np.einsum("...ai,...ij,...bj->...ab", grad, np.asarray(cov, float), grad)

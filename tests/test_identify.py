@@ -253,17 +253,18 @@ def _method_check_case(lines_per_band, fn=100.0, zeta=0.01, half_widths=5):
     return modal_frf(f, [fn], [zeta], [1.0]), fn, zeta
 
 
-def test_half_power_noise_bias_is_flagged_and_covered():
-    # 300 lines per half-power band, 5 % noise: the noisy maximum lifts the -3 dB level and
-    # ζ comes out low by ~20 of the method's noise-driven errors (docs/stress.md finding 9)
+def test_half_power_noise_bias_is_gone_and_errors_hold():
+    # 300 lines per half-power band, 5 % noise: choosing the peak-fit and crossing-fit lines by
+    # the noisy lines themselves lifted the -3 dB level and ζ came out low by ~20 of the method's
+    # errors (docs/stress.md finding 9). The lines are now chosen on the model of the previous
+    # pass (issue 21): the estimate is unbiased and its propagated errors hold. A calibrated
+    # error fails |z| <= 3 with probability 0.27 % per quantity and seed, 2.7 % over these 10.
     clean, fn, zeta = _method_check_case(300)
-    for seed in range(3):
-        with pytest.warns(QualityWarning, match="method_bias"):
-            mode = identify(add_noise(clean, 0.05, seed=seed), "halfpower", bands_hz=[(clean.frequency_hz[0], clean.frequency_hz[-1])])[0]
-        assert "method_bias" in mode.flags
-        # the errors now hold the difference to the (efficient) refinement: 5 sigma covers the truth
-        assert abs(mode.damping_ratio - zeta) <= 5 * mode.std.damping_ratio
-        assert abs(mode.natural_frequency_hz - fn) <= 5 * mode.std.natural_frequency_hz
+    for seed in range(5):
+        mode = identify(add_noise(clean, 0.05, seed=seed), "halfpower", bands_hz=[(clean.frequency_hz[0], clean.frequency_hz[-1])])[0]
+        assert "method_bias" not in mode.flags
+        assert abs(mode.damping_ratio - zeta) <= 3 * mode.std.damping_ratio
+        assert abs(mode.natural_frequency_hz - fn) <= 3 * mode.std.natural_frequency_hz
 
 
 @pytest.mark.parametrize("method", ["circle", "halfpower"])

@@ -22,6 +22,8 @@ __all__ = [
     "ParameterStd",
     "ParameterBatch",
     "identified_std",
+    "identified_correlation",
+    "STD_ORDER",
 ]
 
 _FIELD_NAMES = ("M", "m", "n", "R", "e", "k", "c", "D")
@@ -323,9 +325,13 @@ def _pick(obj: Any, name: str, channel: int | None) -> float:
     return number
 
 
+#: order of the rows and columns of :attr:`ParameterStd.correlation`
+STD_ORDER = ("k", "c", "M")
+
+
 @dataclass(frozen=True, slots=True)
 class ParameterStd:
-    """Standard errors of the identified rotor parameters (0 where unknown).
+    """Standard errors of the identified rotor parameters (0 where unknown), and their correlation.
 
     Attributes
     ----------
@@ -335,26 +341,48 @@ class ParameterStd:
         Standard error of the support damping, N s/m.
     M : float
         Standard error of the rotor mass, kg.
+    correlation : ndarray, shape (3, 3), or None
+        Correlation of the errors of (k, c, M) (:data:`STD_ORDER`); None: independent.
+        k, c and M identified from one mode share ωn, ζ and the modal constant and are
+        strongly correlated (k and M through 1/|A|: nearly +1).
     """
 
     k: float = 0.0
     c: float = 0.0
     M: float = 0.0
+    correlation: np.ndarray | None = None
 
     def archive_units(self) -> dict[str, str]:
         """Units of the fields whose names do not say them (for :mod:`modal.archive`)."""
-        return {"k": "N/m", "c": "N s/m", "M": "kg"}
+        return {"k": "N/m", "c": "N s/m", "M": "kg", "correlation": "1"}
 
     def __post_init__(self) -> None:
-        for name in ("k", "c", "M"):
+        for name in STD_ORDER:
             value = float(getattr(self, name))
             if not (math.isfinite(value) and value >= 0.0):
                 raise ParameterError(f"standard error of {name} = {value!r}: expected a finite number >= 0")
             object.__setattr__(self, name, value)
+        if self.correlation is not None:
+            r = np.array(self.correlation, dtype=float)
+            ok = (r.shape == (3, 3) and np.all(np.isfinite(r)) and np.allclose(r, r.T, atol=1e-9)
+                  and np.allclose(np.diag(r), 1.0, atol=1e-9) and np.all(np.abs(r) <= 1.0 + 1e-9))
+            if not ok:
+                raise ParameterError(f"correlation of (k, c, M) = {self.correlation!r}: expected a symmetric "
+                                     "3 x 3 matrix with unit diagonal and entries in [-1, 1]")
+            r.flags.writeable = False
+            object.__setattr__(self, "correlation", r)
+
+    @property
+    def covariance(self) -> np.ndarray:
+        """Covariance of (k, c, M), shape (3, 3): N/m, N s/m, kg (independent without a correlation)."""
+        sd = np.array([self.k, self.c, self.M])
+        r = np.eye(3) if self.correlation is None else self.correlation
+        return sd[:, None] * r * sd[None, :]
 
 
 def identified_std(mode: Any, channel: int | None = 0) -> ParameterStd:
-    """Standard errors of k, c, M from an identification result's ``std`` attribute.
+    """Standard errors of k, c, M from an identification result's ``std`` attribute, with their
+    correlation from its ``kcm_correlation`` (when it has one).
 
     Parameters
     ----------
@@ -367,7 +395,7 @@ def identified_std(mode: Any, channel: int | None = 0) -> ParameterStd:
     Returns
     -------
     ParameterStd
-        Standard errors in N/m, N s/m and kg.
+        Standard errors in N/m, N s/m and kg, and the correlation of (k, c, M).
     """
     std = getattr(mode, "std", None)
     if std is None:
@@ -375,7 +403,26 @@ def identified_std(mode: Any, channel: int | None = 0) -> ParameterStd:
     values = {}
     for key, attr in (("k", "stiffness_n_per_m"), ("c", "damping_n_s_per_m"), ("M", "mass_kg")):
         values[key] = _pick(std, attr, channel) if hasattr(std, attr) else 0.0
-    return ParameterStd(**values)
+    return ParameterStd(**values, correlation=identified_correlation(mode, channel))
+
+
+def identified_correlation(mode: Any, channel: int | None = 0) -> np.ndarray | None:
+    """Correlation (3, 3) of the errors of (k, c, M) of an identified mode's channel, or None.
+
+    Read from the mode's ``kcm_correlation`` (rows k, c, m; shape (3, 3) or one per
+    channel); None when it has none or it is not finite (a transfer channel).
+    """
+    r = getattr(mode, "kcm_correlation", None)
+    if r is None:
+        return None
+    r = np.asarray(r, dtype=float)
+    if r.ndim == 3:
+        if channel is None:
+            if r.shape[0] != 1:
+                raise ParameterError(f"kcm_correlation has {r.shape[0]} channels; pass channel=<index> to choose one")
+            channel = 0
+        r = r[channel]
+    return r if r.shape == (3, 3) and np.all(np.isfinite(r)) else None
 
 
 @dataclass(frozen=True, slots=True)

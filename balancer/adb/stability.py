@@ -17,7 +17,7 @@ from modal.errors import ParameterError
 
 from .equilibria import balanced_state
 from .linear import CLASS_NAMES, STABLE, EigenAnalysis, eigen_analysis_nondimensional
-from .parameters import ADBParameters, ParameterStd
+from .parameters import STD_ORDER, ADBParameters, ParameterStd
 
 __all__ = [
     "BalancedStability",
@@ -626,8 +626,9 @@ class ThresholdSensitivity:
     derivative_k, derivative_c, derivative_M : float
         Partial derivatives of the threshold: (rad/s)/(N/m), (rad/s)/(N s/m), (rad/s)/kg.
     std_rad_s : float
-        Standard error propagated linearly from the parameter standard errors (rad/s),
-        assuming independent errors.
+        Standard error propagated linearly from the covariance of the parameters (rad/s):
+        √(gᵀ Σ g), g the derivatives, Σ = ``ParameterStd.covariance`` (their standard
+        errors and correlation; independent when it has none).
     """
 
     threshold_rad_s: float
@@ -649,7 +650,7 @@ def threshold_sensitivity(params: ADBParameters, std: ParameterStd, speed_max_ra
     params : ADBParameters
         Nominal parameters.
     std : ParameterStd
-        Standard errors of k (N/m), c (N s/m) and M (kg).
+        Standard errors of k (N/m), c (N s/m) and M (kg), and their correlation.
     speed_max_rad_s : float
         Upper end of the speed scan (rad/s).
     relative_step : float
@@ -672,7 +673,10 @@ def threshold_sensitivity(params: ADBParameters, std: ParameterStd, speed_max_ra
         up = threshold(params.replace(**{name: value + step}))
         down = threshold(params.replace(**{name: max(value - step, 0.0)}))
         derivatives[name] = (up - down) / (value + step - max(value - step, 0.0))
-    sigma = math.sqrt(sum((derivatives[name] * getattr(std, name)) ** 2 for name in ("k", "c", "M")))
+    # g^T Σ g with the covariance of (k, c, M): identified from one mode they are strongly
+    # correlated (k and M nearly +1), which the independent sum ignored (issue 21)
+    gradient = np.array([derivatives[name] for name in STD_ORDER])
+    sigma = math.sqrt(max(float(gradient @ std.covariance @ gradient), 0.0))
     return ThresholdSensitivity(
         threshold_rad_s=nominal,
         derivative_k=derivatives["k"],

@@ -15,6 +15,7 @@ from modal.errors import SceneError
 from modal.units import TWO_PI
 
 from ..adb import ADBParameters, ParameterStd, identified_std, stable_speed_intervals
+from ..adb.parameters import STD_ORDER, identified_correlation
 from ..adb.simulate import SimulationResult, simulate
 from ..adb.speed import LinearRunUp
 from ..adb.stability import SpeedIntervals
@@ -204,6 +205,8 @@ def stage_rotor(scene: Scene, identify=None, drive=None) -> RotorStage:
                 if isinstance(raw, Reference) and raw.source == "identified" else "")
         sources.append(f"{key} = {raw.text if isinstance(raw, Reference) else raw!r}{used}")
     std = {"k": 0.0, "c": 0.0, "M": 0.0}
+    modes_of: dict[str, int] = {}
+    correlation = np.eye(3)
     if identify is not None:
         channel = _channel(identify, scene)
         for key, field in (("M", "mass"), ("k", "stiffness"), ("c", "damping")):
@@ -212,6 +215,14 @@ def stage_rotor(scene: Scene, identify=None, drive=None) -> RotorStage:
                 mode = identify[raw.mode - 1]
                 value = getattr(identified_std(mode, channel if np.ndim(mode.mass_kg) else None), key)
                 std[key] = value if math.isfinite(value) else 0.0
+                modes_of[key] = raw.mode
+        # k, c, M of one identified mode are correlated (they share ωn, ζ and the modal constant)
+        for i, a in enumerate(STD_ORDER):
+            for j, b in enumerate(STD_ORDER):
+                if i != j and a in modes_of and modes_of.get(b) == modes_of[a]:
+                    mode = identify[modes_of[a] - 1]
+                    r = identified_correlation(mode, channel if np.ndim(mode.mass_kg) else None)
+                    correlation[i, j] = 0.0 if r is None else r[i, j]
     M = values["M"]
     if isinstance(rotor["M"], Reference) and rotor.get("mass_includes_balls", True):
         M -= adb["n"] * adb["m"]
@@ -220,7 +231,7 @@ def stage_rotor(scene: Scene, identify=None, drive=None) -> RotorStage:
                              f"({adb['n']} x {adb['m']} kg) is not positive")
     params = ADBParameters(M=M, m=adb["m"], n=adb["n"], R=adb["R"], e=rotor["e"], k=values["k"], c=values["c"],
                            D=adb["D"])
-    return RotorStage(params, ParameterStd(**std), tuple(sources))
+    return RotorStage(params, ParameterStd(**std, correlation=correlation), tuple(sources))
 
 
 def stage_adb_stability(scene: Scene, rotor: RotorStage) -> StabilityStage:

@@ -22,7 +22,7 @@ from ..frf import FRF, KIND_POWER
 from ..model import mode_basis, solve_linear
 from ..nls import fit_modes
 from ..peaks import estimate_noise_std, find_modes
-from ..results import FLAG_TEXT, IdentificationResult, ModeResult, ModeStd, physical_parameters
+from ..results import FLAG_TEXT, IdentificationResult, ModeResult, ModeStd, correlation_of, physical_covariance, physical_parameters
 from ..units import TWO_PI
 from .plscf import plscf_poles
 from .stabilisation import outside_band_poles, select_poles, stabilisation
@@ -338,12 +338,14 @@ def identify_global(frf: FRF, *, modes_hz=None, order: int | None = None, max_or
         if np.isfinite(mode_mpc) and mode_mpc < MPC_LIMIT:
             flags.add("complex_shape")
         (k, c, mass), (sk, sc, sm) = physical_parameters(wn, zeta, const, cov)
+        cov_kcm = physical_covariance(wn, zeta, const, cov)
         dp = np.asarray(driving, bool)
         if dp.any() and np.any(const[dp].real <= 0):
             flags.add("non_positive_constant")
         undefined = ~dp | (const.real <= 0)
         for arr in (k, c, mass, sk, sc, sm):
             arr[undefined] = np.nan
+        cov_kcm[undefined] = np.nan
         if (~dp).any():
             flags.add("not_driving_point")
         if assumed:
@@ -359,7 +361,7 @@ def identify_global(frf: FRF, *, modes_hz=None, order: int | None = None, max_or
             lines_per_bandwidth=2 * zeta * fn / spacing if spacing > 0 else np.nan, chi2=chi2,
             driving_point=sq(dp), quality=pole.n_stable_orders / max(pole.n_orders, 1),
             mode_shape=shapes[0] if single else shapes, participation=np.asarray(pole.participation),
-            mpc=mode_mpc))
+            mpc=mode_mpc, kcm_correlation=correlation_of(cov_kcm[0] if single else cov_kcm)))
         serious = set(flags) - {"driving_point_assumed", "not_driving_point"}
         if serious:
             category = ResolutionWarning if "outside_band" in serious else QualityWarning
