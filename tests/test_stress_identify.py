@@ -591,9 +591,8 @@ def well_posed_tally(method: str, stress: bool) -> dict:
 #: m 1.15-1.3x, with a mean of -0.36 (ζ) and +0.2-0.33 (k, m). The calibration part of issue 21
 #: (another branch) is to fix them; strict, so the fix makes this fail until the mark goes.
 #: (Circle here: spread 0.83-0.98, mean <= 0.16; it passes, narrowly for m under -m stress: 0.86.)
-CALIBRATION_PENDING = pytest.mark.xfail(strict=True, reason="issue 21: half-power errors too large")
 METHODS = ["nls", "circle", "halfpower"]
-SPREAD_METHODS = ["nls", "circle", pytest.param("halfpower", marks=CALIBRATION_PENDING)]
+SPREAD_METHODS = ["nls", "circle", "halfpower"]
 
 
 @pytest.mark.parametrize("method", METHODS)

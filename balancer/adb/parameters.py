@@ -411,6 +411,13 @@ def identified_correlation(mode: Any, channel: int | None = 0) -> np.ndarray | N
 
     Read from the mode's ``kcm_correlation`` (rows k, c, m; shape (3, 3) or one per
     channel); None when it has none or it is not finite (a transfer channel).
+
+    Parameters
+    ----------
+    mode : ModeResult
+        An identified mode (``modal.identify(...).modes[i]``).
+    channel : int or None
+        Channel (0-based) of a multi-channel result; None for a single-channel one.
     """
     r = getattr(mode, "kcm_correlation", None)
     if r is None:
