@@ -69,12 +69,9 @@ def _time(function, runs: int) -> tuple[list[float], object]:
 # --------------------------------------------------------------------------- goal 1
 def sdof_case():
     """The 61-line SDOF receptance of the issue (fn = 100 Hz, zeta = 0.01, 1 % noise, L = 10)."""
-    from modal.synthetic import add_noise, modal_frf
+    from benchmarks.__main__ import _reference_case
 
-    fn, zeta = 100.0, 0.01
-    bw = 2 * zeta * fn
-    f = np.arange(fn - 3 * bw, fn + 3 * bw + bw / 20, bw / 10)
-    return add_noise(modal_frf(f, [fn], [zeta], [1.0]), 0.01, seed=1), (float(f[0]), float(f[-1]))
+    return _reference_case()
 
 
 def bare_least_squares(frequency_hz: np.ndarray, response: np.ndarray):
@@ -117,14 +114,10 @@ def goal1(runs: int) -> dict:
 
 # --------------------------------------------------------------------------- goal 2
 def thousand_channels():
-    from modal.synthetic import add_noise, modal_frf
+    """1000 channels x 3 modes x 2001 lines, accelerance, 1 % noise (the report's case)."""
+    from benchmarks.__main__ import _thousand_channels
 
-    rng = np.random.default_rng(1)
-    fn = np.array([50.0, 120.0, 300.0])
-    zeta = np.array([0.01, 0.02, 0.03])
-    const = rng.standard_normal((1000, 3)) + 0.05j * rng.standard_normal((1000, 3))
-    f = np.linspace(0, 400, 2001)
-    return add_noise(modal_frf(f, fn, zeta, const, kind="accelerance"), 0.01, seed=2), fn, zeta
+    return _thousand_channels()
 
 
 def goal2(runs: int) -> dict:

@@ -82,7 +82,9 @@ def test_three_separated_modes(kind):
         # and within 1 % (a noise part <= 0.14 of the bias; observed 1.0002-1.0046). "Covers the
         # error" alone held by construction (the refinement is the truth to 1e-9); this also
         # fails for an error that is inflated or not widened.
-        assert 1.0 <= mode.std.damping_ratio / abs(mode.damping_ratio - THREE_ZETA[r]) <= 1.01
+        # The lower end allows the refinement's own distance from the truth (<= 1e-9 relative, asserted for
+        # nls above), which the fold cannot know: 1e-9 x 0.03 against errors >= 1e-5, so 1 - 1e-6
+        assert 1.0 - 1e-6 <= mode.std.damping_ratio / abs(mode.damping_ratio - THREE_ZETA[r]) <= 1.01
 
 
 def test_matrix_system_multichannel_driving_and_transfer():
@@ -283,7 +285,9 @@ def test_single_mode_methods_next_to_another_mode(method):
         # bias; observed 1.0000-1.042). Only "covers" held by construction (refinement = truth).
         for value, truth, std in ((mode.damping_ratio, 0.02, mode.std.damping_ratio),
                                   (mode.natural_frequency_hz, fn, mode.std.natural_frequency_hz)):
-            assert 1.0 <= std / abs(value - truth) <= 1.05, (value, truth, std)
+            # (lower end: the refinement's own 1e-9 relative distance from the truth, as in
+            # test_three_separated_modes)
+            assert 1.0 - 1e-6 <= std / abs(value - truth) <= 1.05, (value, truth, std)
         # mass against the truth: the neighbour adds to the resonance at most
         # |H_other / H_own| = 2ζ ω_r² / |ω_1² − ω_2²| (3.2 % at 100 Hz, 7.2 % at 150 Hz)
         # to the constant the mass comes from (observed: circle 0.7 %)

@@ -67,6 +67,17 @@ def sample_parameters(params: ADBParameters, std: ParameterStd, n_samples: int, 
     Draws outside the physical range (k <= 0, M <= 0, c < 0) are drawn again (from the same
     generator, so the result depends on ``seed`` only).
 
+    Parameters
+    ----------
+    params : ADBParameters
+        Centre of the draws (its k, c, M).
+    std : ParameterStd
+        Standard errors of k (N/m), c (N s/m) and M (kg).
+    n_samples : int
+        Number of draws (>= 1).
+    seed : int
+        Seed of the generator.
+
     Returns
     -------
     ndarray, shape (n_samples, 3)
@@ -177,7 +188,31 @@ def chunked_stability_map(params: ADBParameters, speeds_rad_s, parameter: str, v
                           chunk_size: int = 50, ball_angles_rad=None,
                           condition_cap: float | None = 1e8) -> StabilityMap:
     """:func:`balancer.adb.stability.stability_map` cut into chunks of ``values`` (tasks on a Dask
-    cluster with ``client``); the same map as the one-piece call, row for row."""
+    cluster with ``client``); the same map as the one-piece call, row for row.
+
+    Parameters
+    ----------
+    params : ADBParameters
+        The rotor and balls.
+    speeds_rad_s : array_like, shape (S,)
+        Shaft speeds, rad/s.
+    parameter : str
+        Name of the varied :class:`ADBParameters` field.
+    values : array_like, shape (V,)
+        Its values (SI units of that field).
+    client : dask.distributed.Client, optional
+        Cluster to run the chunks on; None runs them here.
+    chunk_size : int
+        Values per chunk (>= 1).
+    ball_angles_rad : array_like, optional
+        Balanced member to analyse (default: the symmetric one), rad.
+    condition_cap : float or None
+        As in :func:`balancer.adb.stability.stability_map`.
+
+    Returns
+    -------
+    StabilityMap
+    """
     values = np.atleast_1d(np.asarray(values, dtype=float)).reshape(-1)
     if isinstance(chunk_size, bool) or not isinstance(chunk_size, (int, np.integer)) or chunk_size < 1:
         raise ParameterError(f"chunk_size = {chunk_size!r}: expected a whole number >= 1")

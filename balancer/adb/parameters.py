@@ -414,15 +414,10 @@ def identified_correlation(mode: Any, channel: int | None = 0) -> np.ndarray | N
 
     Parameters
     ----------
-    mode : object
-        Identified mode (:class:`modal.ModeResult` or any object with ``kcm_correlation``).
+    mode : ModeResult
+        An identified mode (``modal.identify(...).modes[i]``).
     channel : int or None
-        Channel index when the correlation is given per channel.
-
-    Returns
-    -------
-    ndarray, shape (3, 3), or None
-        Correlation of the errors of (k, c, M), dimensionless.
+        Channel (0-based) of a multi-channel result; None for a single-channel one.
     """
     r = getattr(mode, "kcm_correlation", None)
     if r is None:

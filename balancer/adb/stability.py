@@ -415,8 +415,8 @@ def _routh_rows(group, rows, angles, speeds, ratio, condition_cap, growth, bound
     n = group[0].n
     verdict = balanced_verdicts(mu, zeta, beta, ratio, rho2, n, condition_cap)
     codes[rows] = verdict
-    for name in (growth, bound, nondim):
-        name[rows] = np.nan
+    for array in (growth, bound, nondim):  # no margin where the Routh test decided
+        array[rows] = np.nan
     local, cols = np.nonzero(verdict == UNRESOLVED)
     if local.size:
         companion = _companion_arrays(mu[local, 0], zeta[local, 0], beta[local, 0], ratio[local, cols],
