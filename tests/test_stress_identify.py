@@ -586,11 +586,10 @@ def well_posed_tally(method: str, stress: bool) -> dict:
     return tally
 
 
-#: Half-power's reported errors are too large: its frequency 1.7-2x (spread of z 0.51 in the
-#: default cases, 0.59 under -m stress; 0.64-0.67 in issue 21's 400-trial measurement), ζ, k,
-#: m 1.15-1.3x, with a mean of -0.36 (ζ) and +0.2-0.33 (k, m). The calibration part of issue 21
-#: (another branch) is to fix them; strict, so the fix makes this fail until the mark goes.
-#: (Circle here: spread 0.83-0.98, mean <= 0.16; it passes, narrowly for m under -m stress: 0.86.)
+#: Measured on main after issue 21's calibration (spread of z for fn, ζ, m; default 40 cases /
+#: -m stress 200): NLS 1.02, 0.94, 1.05 / 0.99, 1.01, 1.01; circle 1.06, 1.09, 1.08 / 1.08,
+#: 1.02, 1.01; half-power 0.91, 0.97, 0.96 / 0.96, 1.01, 1.01; |mean| <= 0.21. (Before it,
+#: half-power's frequency spread was 0.51 / 0.59: errors 1.7-2x too large.)
 METHODS = ["nls", "circle", "halfpower"]
 SPREAD_METHODS = ["nls", "circle", "halfpower"]
 
