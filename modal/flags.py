@@ -10,7 +10,7 @@ import numpy as np
 
 from .results import FLAG_TEXT
 
-__all__ = ["CHI2_LIMIT", "RELATIVE_MISFIT", "FLAG_ACTION", "INFORMATIONAL", "DRIVING_POINT_ONLY", "TRANSFER_ONLY", "channel_flags", "contradictions",
+__all__ = ["CHI2_LIMIT", "RELATIVE_MISFIT", "lines_near_mode", "FLAG_ACTION", "INFORMATIONAL", "DRIVING_POINT_ONLY", "TRANSFER_ONLY", "channel_flags", "contradictions",
            "flags_markdown"]
 
 #: chi-square (residual variance over the noise variance) above which a model may be flagged model_inadequate
@@ -22,6 +22,13 @@ CHI2_LIMIT = 3.0
 #: into one peak show 4.5 % (three modes, exact data) and 5.3 % (a pair 1 Hz apart, 0.2 % noise). On noisy
 #: data chi-square alone decides: a misfit of 3 noise σ there is above this fraction already.
 RELATIVE_MISFIT = 0.03
+
+
+def lines_near_mode(omega: np.ndarray, omega_n: float, damping_ratio: float) -> np.ndarray:
+    """The lines (mask over ``omega``, rad/s) where :data:`RELATIVE_MISFIT` is measured for a mode at
+    ``omega_n`` (rad/s): within ±3 half-power widths of it, at least ±3 line spacings."""
+    spacing = float(np.median(np.diff(omega))) if omega.size > 1 else 0.0
+    return np.abs(omega - omega_n) <= max(3 * 2 * damping_ratio * omega_n, 3 * spacing)
 
 #: What to do when a flag is raised.
 FLAG_ACTION = {

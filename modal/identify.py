@@ -10,7 +10,7 @@ from .checks import find_missing_mode, residual_noise_std, residual_structure, r
 from .circlefit import circle_fit_curve
 from .errors import IdentificationError, QualityWarning, ResolutionWarning, warn
 from .estimate.correction import remove_window_damping
-from .flags import CHI2_LIMIT, RELATIVE_MISFIT
+from .flags import CHI2_LIMIT, RELATIVE_MISFIT, lines_near_mode
 from .frf import FRF, KIND_POWER
 from .halfpower import half_power_curve
 from .model import mode_basis, solve_linear
@@ -462,8 +462,7 @@ def _local_misfit(frf, bands, power, omega_n, damping_ratio) -> np.ndarray:
         design = np.hstack([basis, ((1j * omega) ** power)[:, None]])
         coef = solve_linear(design, h.T)
         residual = h - (design @ coef).T
-        spacing = float(np.median(np.diff(omega)))
-        near = np.abs(omega - wn) <= max(3 * 2 * zeta * wn, 3 * spacing)
+        near = lines_near_mode(omega, wn, zeta)
         if near.sum() < 3:
             near = np.argsort(np.abs(omega - wn))[:3]
         data = np.linalg.norm(h[:, near])
@@ -643,19 +642,25 @@ def choose_method(frf: FRF, bands_hz=None, min_prominence_db: float = 6.0) -> st
     (one to a few well-separated modes, where it is the Cramér–Rao-efficient choice). Bands given
     explicitly keep the band-wise method.
     """
+    return _auto_choice(frf, bands_hz, min_prominence_db)[0]
+
+
+def _auto_choice(frf: FRF, bands_hz, min_prominence_db: float) -> tuple[str, list | None]:
+    """:func:`choose_method`'s choice and the peaks' bands it found (None when it did not search), so that
+    identify does not search the peaks twice."""
     if bands_hz is not None:
-        return "nls"
+        return "nls", None
     from .global_ import channel_grid
 
     index, _, transposed = channel_grid(frf)
     if index.shape[1] > 1:
-        return "global"
+        return "global", None
     try:  # the peaks identify itself would fit: the same noise-aware test (an estimate's noise per line)
-        peaks = len(find_modes(frf, min_prominence_db=min_prominence_db, noise_std=estimate_noise_std(frf),
-                               line_noise_std=getattr(frf, "noise_std", None)))
+        bands = find_modes(frf, min_prominence_db=min_prominence_db, noise_std=estimate_noise_std(frf),
+                           line_noise_std=getattr(frf, "noise_std", None))
     except IdentificationError:
-        return "nls"
-    return "global" if peaks >= AUTO_GLOBAL_PEAKS else "nls"
+        return "nls", None
+    return ("global" if len(bands) >= AUTO_GLOBAL_PEAKS else "nls"), bands
 
 
 def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, driving_point=None,
@@ -724,8 +729,9 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
                           driving_point=driving_point, min_prominence_db=min_prominence_db, max_modes=max_modes,
                           **global_options)
         return unscale_result(result, gain)
+    found = None  # peak bands the automatic choice already searched
     if method == "auto":  # chosen on the (possibly rescaled) data, so the choice never overflows
-        method = "global" if global_options else choose_method(frf, bands_hz, min_prominence_db)
+        method, found = ("global", None) if global_options else _auto_choice(frf, bands_hz, min_prominence_db)
     if method == "global":
         from .global_ import identify_global
 
@@ -736,9 +742,13 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
     estimated_noise = estimate_noise_std(frf)
     # an FRF estimated from time data carries its own calibrated noise per line (modal.estimate_frf)
     line_noise = getattr(frf, "noise_std", None)
-    bands = bands_from_hz(frf, bands_hz) if bands_hz is not None else find_modes(
-        frf, min_prominence_db=min_prominence_db, max_modes=max_modes, noise_std=estimated_noise,
-        line_noise_std=line_noise)
+    if bands_hz is not None:
+        bands = bands_from_hz(frf, bands_hz)
+    elif found is not None and max_modes is None:  # the automatic choice's search, with the same arguments
+        bands = found
+    else:
+        bands = find_modes(frf, min_prominence_db=min_prominence_db, max_modes=max_modes, noise_std=estimated_noise,
+                           line_noise_std=line_noise)
     known_noise = noise_std is None and line_noise is not None
     if known_noise:
         estimated_noise = _band_noise(frf, bands, line_noise)

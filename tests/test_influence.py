@@ -234,7 +234,8 @@ def test_readings_in_users_units():
 
 
 # ---------------------------------------------------------------- bad readings
-def one_line_error(call, field):
+def assert_one_line_error(call, field):
+    """Assert that ``call`` raises a ParameterError whose message is one line naming ``field``."""
     with pytest.raises(ParameterError) as info:
         call()
     message = str(info.value)
@@ -244,18 +245,18 @@ def one_line_error(call, field):
 
 def test_bad_readings_give_one_line_errors_naming_the_field():
     alpha = influence_matrix(HS_INITIAL, HS_RUNS, HS_TRIALS)
-    one_line_error(lambda: influence_matrix(HS_INITIAL, HS_RUNS[:1], HS_TRIALS), "trial_runs")  # fewer runs than planes
-    one_line_error(lambda: influence_matrix(HS_INITIAL, np.array([HS_RUNS[0], HS_INITIAL]), HS_TRIALS), "trial_runs[1]")
+    assert_one_line_error(lambda: influence_matrix(HS_INITIAL, HS_RUNS[:1], HS_TRIALS), "trial_runs")  # fewer runs than planes
+    assert_one_line_error(lambda: influence_matrix(HS_INITIAL, np.array([HS_RUNS[0], HS_INITIAL]), HS_TRIALS), "trial_runs[1]")
     nan_initial = HS_INITIAL.copy()
     nan_initial[1] = np.nan
-    one_line_error(lambda: influence_matrix(nan_initial, HS_RUNS, HS_TRIALS), "initial[1]")
-    one_line_error(lambda: influence_matrix(HS_INITIAL, HS_RUNS[:, :1], HS_TRIALS), "trial_runs")  # mismatched shapes
-    one_line_error(lambda: correction(alpha, HS_INITIAL[:1]), "alpha")
-    one_line_error(lambda: influence_matrix(HS_INITIAL, HS_RUNS, [1.15, 0.0]), "trial_unbalances[1]")
+    assert_one_line_error(lambda: influence_matrix(nan_initial, HS_RUNS, HS_TRIALS), "initial[1]")
+    assert_one_line_error(lambda: influence_matrix(HS_INITIAL, HS_RUNS[:, :1], HS_TRIALS), "trial_runs")  # mismatched shapes
+    assert_one_line_error(lambda: correction(alpha, HS_INITIAL[:1]), "alpha")
+    assert_one_line_error(lambda: influence_matrix(HS_INITIAL, HS_RUNS, [1.15, 0.0]), "trial_unbalances[1]")
     singular = np.column_stack([alpha[:, 0], 2 * alpha[:, 0]])
-    one_line_error(lambda: correction(singular, HS_INITIAL), "alpha")
-    one_line_error(lambda: correction(alpha, HS_INITIAL, method="l1"), "method")
-    one_line_error(lambda: vibration([1.0], [1.0], "furlongs"), "units")
+    assert_one_line_error(lambda: correction(singular, HS_INITIAL), "alpha")
+    assert_one_line_error(lambda: correction(alpha, HS_INITIAL, method="l1"), "method")
+    assert_one_line_error(lambda: vibration([1.0], [1.0], "furlongs"), "units")
 
 
 def test_nearly_dependent_planes_warn():

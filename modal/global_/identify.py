@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import IdentificationError, QualityWarning, ResolutionWarning, warn
-from ..flags import CHI2_LIMIT, RELATIVE_MISFIT
+from ..flags import CHI2_LIMIT, RELATIVE_MISFIT, lines_near_mode
 from ..frf import FRF, KIND_POWER
 from ..model import mode_basis, solve_linear
 from ..nls import fit_modes
@@ -154,8 +154,7 @@ def _spare_duplicates(omega_n, weak, statistic):
 
 def _local_misfit(omega, H, misfit, noise, wn, zeta):
     """(chi-square, relative misfit) on the lines within ±3 half-power widths (at least ±3 lines) of a mode."""
-    spacing = float(np.median(np.diff(omega)))
-    near = np.abs(omega - wn) <= max(3 * 2 * zeta * wn, 3 * spacing)
+    near = lines_near_mode(omega, wn, zeta)
     if not near.any():
         return np.nan, np.nan
     with np.errstate(divide="ignore", invalid="ignore"):
