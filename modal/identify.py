@@ -6,7 +6,7 @@ import warnings
 
 import numpy as np
 
-from .checks import find_missing_mode, residual_noise_std, residual_structure, restart_pole
+from .checks import find_missing_mode, fit_residual, residual_noise_std, residual_structure, restart_pole
 from .circlefit import circle_fit_curve
 from .errors import IdentificationError, QualityWarning, ResolutionWarning, warn
 from .estimate.correction import remove_window_damping
@@ -15,6 +15,7 @@ from .frf import FRF, KIND_POWER
 from .halfpower import half_power_curve
 from .model import mode_basis, solve_linear
 from .nls import fit_modes, truncation_shift
+from .rational import rational_pole
 from .propagate import combine_poles, constant_covariance, magnitude_to_complex
 from .peaks import ModeBand, bands_from_hz, estimate_noise_std, find_modes
 from .results import FLAG_TEXT, IdentificationResult, ModeResult, ModeStd, correlation_of, physical_covariance, physical_parameters
@@ -297,6 +298,65 @@ def _start_pole(frf, band, power, noise):
     return best
 
 
+def _quick_start(frf, band, power, noise):
+    """(ωn, ζ) of a band's one-mode rational fit (:func:`modal.rational.rational_pole`) on its
+    strongest channels, or None when it gives no pole inside the band."""
+    omega, h = _mode_arrays(frf, band)
+    if h.shape[0] > START_CHANNELS:
+        strongest = np.argsort(_channel_weights(frf, band, noise))[::-1][:START_CHANNELS]
+        h, noise = h[strongest], np.asarray(noise)[strongest]
+    with np.errstate(all="ignore"):
+        pole = rational_pole(omega, h, noise)
+    if pole is None or not (TWO_PI * band.low_hz <= pole[0] <= TWO_PI * band.high_hz and 0 < pole[1] < 1):
+        return None
+    return pole
+
+
+def _doubtful(fit, bands) -> bool:
+    """Whether a band-wise NLS fit shows a sign of a poor start: not converged, a pole outside
+    its band, ζ at or past critical or not resolved (relative error above ``REL_STD_LIMIT``)."""
+    if not fit.converged or not np.all(np.isfinite(fit.noise_var)):
+        return True
+    wn, zeta = np.sort(fit.omega_n), fit.damping_ratio[np.argsort(fit.omega_n)]
+    s_zeta = np.sqrt(np.abs(fit.mode_cov[np.argsort(fit.omega_n), 0, 1, 1]))
+    low = TWO_PI * np.array([b.low_hz for b in bands])
+    high = TWO_PI * np.array([b.high_hz for b in bands])
+    return not (np.all((wn >= low) & (wn <= high)) and np.all((zeta > 0) & (zeta < 1))
+                and np.all(s_zeta <= REL_STD_LIMIT * zeta))
+
+
+def _nls_fit(frf, bands, power, noise):
+    """The band-wise NLS fit of every band's mode, from the cheapest start that serves.
+
+    Each band starts from its one-mode rational fit (a few linear solves); a band where
+    that gives no pole, or a fit that looks doubtful (:func:`_doubtful`), takes the
+    half-power and circle starts of :func:`_start_pole` as well, and the fit with the lower
+    residual is kept.
+    """
+    quick = [_quick_start(frf, band, power, noise) for band in bands]
+    if all(q is not None for q in quick):
+        fit = _fit_bands(frf, bands, power, [q[0] for q in quick], [q[1] for q in quick])
+        if not _doubtful(fit, bands):
+            return fit
+    else:
+        fit = None
+    starts = [_start_pole(frf, band, power, noise) for band in bands]
+    careful = _fit_bands(frf, bands, power, [s[0] for s in starts], [s[1] for s in starts])
+    if fit is None or _fit_cost(frf, bands, careful) <= _fit_cost(frf, bands, fit):
+        return careful
+    return fit
+
+
+def _fit_cost(frf, bands, fit) -> float:
+    """Residual of a band-wise fit summed over channels, each scaled by its largest value."""
+    if not np.all(np.isfinite(fit.noise_var)):
+        return np.inf
+    keep, _ = _regions(bands, frf.frequency_hz)
+    scale = np.abs(frf.channels[:, keep]).max(axis=1)
+    scale[scale == 0] = 1.0
+    return float(np.sum(fit.noise_var / scale**2))
+
+
 def _bandwise_covariance(frf, bands, power, poles, noise, own_constants=None):
     """Covariance (n_modes, n_ch, 4, 4) of (ωn, ζ, Re A, Im A) of the half-power or circle result.
 
@@ -471,17 +531,19 @@ def _local_misfit(frf, bands, power, omega_n, damping_ratio) -> np.ndarray:
     return out
 
 
-def _fit_noise(frf, bands, power, omega_n, damping_ratio, estimated_noise, channels=None, known=False):
+def _fit_noise(frf, bands, power, omega_n, damping_ratio, estimated_noise, channels=None, known=False, residual=None):
     """:func:`modal.checks.residual_noise_std` on the lines of the bands (all or some channels).
 
     ``known``: the noise came with the FRF (an estimate from time data) and is taken as it is.
+    ``residual``: the fit's residual on those lines and channels, if the caller has it.
     """
     rows = slice(None) if channels is None else channels
     if known:
         return np.asarray(estimated_noise, float)[rows]
     omega, response, region = _band_data(frf, bands, channels)
     with np.errstate(all="ignore"):
-        return residual_noise_std(omega, response, power, region, omega_n, damping_ratio, estimated_noise[rows])
+        return residual_noise_std(omega, response, power, region, omega_n, damping_ratio, estimated_noise[rows],
+                                  residual)
 
 
 def _line_weight(frf, bands):
@@ -550,7 +612,7 @@ def _fit_bands(frf, bands, power, omega_n0, damping_ratio0, channels=None):
     return fit
 
 
-def _truncation(frf, bands, power, fit, channels=None):
+def _truncation(frf, bands, power, fit, channels=None, residual=None):
     """Shift of the fit when the band backgrounds gain a slope and a curvature, or None.
 
     Measured only where the residual is smooth across the lines (ratio of
@@ -559,11 +621,11 @@ def _truncation(frf, bands, power, fit, channels=None):
     truncation bias of the modes outside the bands (:func:`modal.nls.truncation_shift`).
     With white residuals the shift would be noise only and is not measured.
     Returns (pole shift (n_modes, 2), constant shift (n_modes, n_channels)) in
-    the fit's order of modes.
+    the fit's order of modes. ``residual``: the fit's residual, if the caller has it.
     """
     omega, response, region = _band_data(frf, bands, channels)
     with np.errstate(all="ignore"):
-        structure = residual_structure(omega, response, power, region, fit.omega_n, fit.damping_ratio)
+        structure = residual_structure(omega, response, power, region, fit.omega_n, fit.damping_ratio, residual)
     if not structure > STRUCTURED_RATIO:
         return None
     return truncation_shift(omega, response, power, region, fit)
@@ -576,13 +638,13 @@ def _with_shift(cov, pole_shift, constant_shift):
     return cov + d[:, :, None] * d[:, None, :]
 
 
-def _missing_mode(frf, bands, power, omega_n, damping_ratio, estimated_noise):
-    """:func:`modal.checks.find_missing_mode` on the lines of the bands."""
+def _missing_mode(frf, bands, power, omega_n, damping_ratio, estimated_noise, residual=None):
+    """:func:`modal.checks.find_missing_mode` on the lines of the bands (``residual``: the fit's, if known)."""
     omega, response, region = _band_data(frf, bands)
     bands_rad = [(TWO_PI * b.low_hz, TWO_PI * b.high_hz) for b in bands]
     with np.errstate(all="ignore"):
         return find_missing_mode(omega, response, power, region, omega_n, damping_ratio, estimated_noise,
-                                 bands_rad)
+                                 bands_rad, residual)
 
 
 def _overlap(per_mode, index) -> float:
@@ -835,14 +897,17 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
                 reference = (wn - d_wn, zeta - d_z, np.where(const_biased, const - d_const, const), noise_cov)
             per_mode.append((wn, zeta, const, cov, s_wn, s_z, flags, q, chi2, reference))
     else:
-        starts = [_start_pole(frf, band, power, noise) for band in bands]
-        fit = _fit_bands(frf, bands, power, [s[0] for s in starts], [s[1] for s in starts])
+        fit = _nls_fit(frf, bands, power, noise)
+        # the checks all measure the residual of the same modes on the same lines: computed once
+        with np.errstate(all="ignore"):
+            omega_b, response_b, region_b = _band_data(frf, bands)
+            residual = fit_residual(omega_b, response_b, power, region_b, fit.omega_n, fit.damping_ratio)
         chi2 = _chi2(fit.noise_var, _fit_noise(frf, bands, power, fit.omega_n, fit.damping_ratio,
-                                               estimated_noise, known=known_noise))
-        missing_mode = _missing_mode(frf, bands, power, fit.omega_n, fit.damping_ratio, estimated_noise)
+                                               estimated_noise, known=known_noise, residual=residual))
+        missing_mode = _missing_mode(frf, bands, power, fit.omega_n, fit.damping_ratio, estimated_noise, residual)
         # near-exact data: the offset's truncation (modes outside the bands) biases the poles
         # beyond their white-noise errors; its measured shift is added to them (finding 26)
-        shift = _truncation(frf, bands, power, fit)
+        shift = _truncation(frf, bands, power, fit, residual=residual)
         order = np.argsort(fit.omega_n)  # two close poles may cross during the fit
         relative = _local_misfit(frf, bands, power, fit.omega_n[order], fit.damping_ratio[order])
         for b, (band, r) in enumerate(zip(bands, order)):

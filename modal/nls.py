@@ -16,8 +16,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .model import mode_basis, mode_basis_derivatives
-
 __all__ = ["NLSFit", "fit_modes", "truncation_shift"]
 
 
@@ -63,6 +61,10 @@ def _background(x, region, n_regions, powers):
     """
     if not n_regions:
         return np.zeros((x.size, 0), dtype=complex)
+    if tuple(powers) == (0,):  # one complex offset per region
+        cols = np.zeros((x.size, n_regions), dtype=complex)
+        cols[np.arange(x.size), region] = 1.0
+        return cols
     lo = np.full(n_regions, np.inf)
     hi = np.full(n_regions, -np.inf)
     np.minimum.at(lo, region, x)
@@ -75,16 +77,22 @@ def _background(x, region, n_regions, powers):
     return cols.reshape(x.size, -1)
 
 
-def _design(x, params, power, background):
+def _design(x, numerator, x_squared, params, out, dphi):
+    """Basis Φ = [modes | background] and ∂Φ/∂θ of the mode columns, written into ``out`` and ``dphi``.
+
+    ``numerator`` is (i x)^p and ``x_squared`` x², computed once per fit; ``out`` holds the
+    background columns already (they do not depend on the poles).
+    """
     n_modes = params.size // 2
-    xr, zeta = params[0::2], params[1::2]
-    phi = mode_basis(x, xr, zeta, power)
-    Phi = np.hstack([phi.T, background])
-    d_x, d_zeta = mode_basis_derivatives(x, xr, zeta, power)
-    dphi = np.empty((x.size, 2 * n_modes), dtype=complex)
-    dphi[:, 0::2] = d_x.T
-    dphi[:, 1::2] = d_zeta.T
-    return Phi, dphi
+    xr, zeta = params[0::2, None], params[1::2, None]
+    damping = 2j * zeta * x  # (n_modes, n_freq)
+    denom = xr * xr - x_squared + damping * xr
+    phi = numerator / denom
+    slope = phi / denom
+    out[:, :n_modes] = phi.T
+    dphi[:, 0::2] = (-slope * (2 * xr + damping)).T
+    dphi[:, 1::2] = (-slope * (2j * xr * x)).T
+    return out, dphi
 
 
 def _compress(Y: np.ndarray, rank: int) -> np.ndarray:
@@ -161,7 +169,8 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
     ch_scale = np.abs(Y_raw).max(axis=1)
     ch_scale[ch_scale == 0] = 1.0
     Y = np.ascontiguousarray((Y_raw / ch_scale[:, None]).T)  # (n_freq, n_ch), each channel scaled to max 1
-    w_ref = float(np.median(np.atleast_1d(omega_n0)))
+    w_ref = np.atleast_1d(np.asarray(omega_n0, float))
+    w_ref = float(w_ref[0] if w_ref.size == 1 else np.median(w_ref))
     x = omega / w_ref
     n_regions = 0 if region is None else int(region.max()) + 1
     params = np.empty(2 * np.size(omega_n0))
@@ -174,8 +183,8 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
     # a mode below the noise can be driven towards ζ = 0 step after step; it stops at a
     # half-power width of 1e-6 line spacings, far below anything the lines resolve
     zeta_lo = 1e-6 * float(np.min(np.diff(x))) / (2 * x.max()) if x.size > 1 else 1e-12
-    params[0::2] = np.clip(params[0::2], x_lo, x_hi)
-    params[1::2] = np.clip(params[1::2], zeta_lo, ZETA_MAX)
+    params[0::2] = np.minimum(np.maximum(params[0::2], x_lo), x_hi)
+    params[1::2] = np.minimum(np.maximum(params[1::2], zeta_lo), ZETA_MAX)
     Y_full = Y
     background = _background(x, region, n_regions, background_powers)
     if residual_terms:
@@ -192,15 +201,22 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
         Y = Y * weight if compressed else Y_full
         background = background * weight
 
+    numerator, x_squared = (1j * x) ** power, x * x
+    n_b = n_modes + background.shape[1]
+
     def evaluate(p):
-        Phi, dphi = _design(x, p, power, background)
+        Phi = np.empty((x.size, n_b), dtype=complex)
+        Phi[:, n_modes:] = background
+        Phi, dphi = _design(x, numerator, x_squared, p, Phi, np.empty((x.size, n_theta), complex))
         if weight is not None:  # the modes' columns (the background's are weighted once, above)
             Phi[:, :n_modes] *= weight
-            dphi = dphi * weight
+            dphi *= weight
         Q, R, QhY, res = _project(Phi, Y)
-        return Phi, dphi, Q, R, QhY, res, float(np.sum(res.real**2) + np.sum(res.imag**2))
+        return Phi, dphi, Q, R, QhY, res, float(np.vdot(res, res).real)
 
     state = evaluate(params)
+    mode_of = np.repeat(np.arange(n_modes), 2)
+    diagonal = np.arange(n_theta)
     lam = 1e-4
     converged = False
     n_iter = 0
@@ -208,18 +224,18 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
         Phi, dphi, Q, R, QhY, res, cost = state
         C = np.linalg.solve(R, QhY)  # (n_b, n_ch)
         E = dphi - Q @ (Q.conj().T @ dphi)  # projected basis derivatives, (n_freq, n_theta)
-        mode_of = np.repeat(np.arange(n_modes), 2)
         Cm = C[mode_of]  # (n_theta, n_ch): the coefficient multiplying each derivative
         EhE = E.conj().T @ E
         CCh = Cm.conj() @ Cm.T
         JtJ = np.real(EhE * CCh)
         g = -np.real(np.sum((E.conj().T @ Y) * Cm.conj(), axis=1))
-        diag = np.diag(JtJ).copy()
-        diag[diag <= 0] = 1e-300
+        diag = np.maximum(JtJ.diagonal(), 1e-300)
         accepted = False
         for _ in range(40):
             try:
-                step = np.linalg.solve(JtJ + lam * np.diag(diag), -g)
+                damped = JtJ.copy()
+                damped[diagonal, diagonal] += lam * diag
+                step = np.linalg.solve(damped, -g)
             except np.linalg.LinAlgError:
                 lam *= 10
                 continue
@@ -232,12 +248,14 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
             # kept inside a box (ωn within a factor 2 of the lines, ζ ≤ ZETA_MAX) move halfway
             # to the bound, so an unidentifiable mode cannot run off to overflow
             x_r, zeta_t = trial[0::2], trial[1::2]
-            x_r = np.where(x_r < x_lo, (params[0::2] + x_lo) / 2, np.where(x_r > x_hi, (params[0::2] + x_hi) / 2, x_r))
-            zeta_t = np.where(zeta_t > 0, zeta_t, np.maximum(params[1::2] / 10, zeta_lo))
-            zeta_t = np.where(zeta_t > ZETA_MAX, (params[1::2] + ZETA_MAX) / 2, zeta_t)
-            trial[0::2], trial[1::2] = x_r, zeta_t
-            step = trial - params
-            if np.all(np.isfinite(trial)):
+            if x_r.min() < x_lo or x_r.max() > x_hi or zeta_t.min() <= 0 or zeta_t.max() > ZETA_MAX:
+                x_r = np.where(x_r < x_lo, (params[0::2] + x_lo) / 2,
+                               np.where(x_r > x_hi, (params[0::2] + x_hi) / 2, x_r))
+                zeta_t = np.where(zeta_t > 0, zeta_t, np.maximum(params[1::2] / 10, zeta_lo))
+                zeta_t = np.where(zeta_t > ZETA_MAX, (params[1::2] + ZETA_MAX) / 2, zeta_t)
+                trial[0::2], trial[1::2] = x_r, zeta_t
+                step = trial - params
+            if np.isfinite(trial).all():
                 new_state = evaluate(trial)
                 if new_state[-1] <= cost:
                     accepted = True
@@ -268,7 +286,6 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
     noise_var = rss / dof if dof > 0 else np.full(n_ch, np.nan)
     # Fisher information of the poles (Schur complement via the projected Jacobian)
     E = dphi - Q @ (Q.conj().T @ dphi)
-    mode_of = np.repeat(np.arange(n_modes), 2)
     Cm = C[mode_of]
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         weights = np.where(noise_var > 0, 1.0 / noise_var, np.inf)
