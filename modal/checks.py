@@ -34,6 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import special
 
+from .frf import line_spacing
 from .model import mode_basis, solve_linear
 from .nls import fit_modes
 from .peaks import neighbour_noise_std
@@ -215,6 +216,8 @@ def residual_structure(omega: np.ndarray, response: np.ndarray, power: int, regi
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = np.sum(np.abs(res) ** 2, axis=1) / dof / neighbour_noise_std(omega, res) ** 2
     ratio = ratio[np.isfinite(ratio)]
+    if ratio.size == 1:
+        return float(ratio[0])
     return float(np.median(ratio)) if ratio.size else np.nan
 
 
@@ -299,7 +302,7 @@ def find_missing_mode(omega: np.ndarray, response: np.ndarray, power: int, regio
     if not np.all(sigma2 > 0):
         return None
     energy = np.mean(np.abs(res) ** 2 / sigma2[:, None], axis=0)
-    spacing = float(np.median(np.diff(omega)))
+    spacing = line_spacing(omega)
     half_power = float(np.median(2 * zeta * omega_n)) if zeta.size > 1 else float(2 * zeta[0] * omega_n[0])
     width = int(min(max(round(half_power / spacing), 3), max(3, omega.size // 4)))
     smooth = _smoothed(energy, region, width)

@@ -11,7 +11,7 @@ from .circlefit import circle_fit_curve
 from .errors import IdentificationError, QualityWarning, ResolutionWarning, warn
 from .estimate.correction import remove_window_damping
 from .flags import CHI2_LIMIT, RELATIVE_MISFIT, lines_near_mode
-from .frf import FRF, KIND_POWER
+from .frf import FRF, KIND_POWER, line_spacing
 from .halfpower import half_power_curve
 from .model import mode_basis, solve_linear
 from .nls import fit_modes, truncation_shift
@@ -490,7 +490,10 @@ def _chi2(residual_var, noise_std) -> float:
     """Median over channels of the residual variance over the estimated noise variance."""
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = residual_var / np.where(noise_std > 0, noise_std, np.nan) ** 2
-    return float(np.nanmedian(ratio)) if np.isfinite(ratio).any() else np.nan
+    if not np.isfinite(ratio).any():
+        return np.nan
+    kept = ratio[~np.isnan(ratio)]  # the nan-median, without its cost on one channel
+    return float(kept[0]) if kept.size == 1 else float(np.median(kept))
 
 
 def _band_noise(frf, bands, line_noise):
@@ -738,7 +741,9 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
         data, else ``"nls"`` (:func:`choose_method`); ``result.method`` says
         which ran.
         ``"nls"``: complex nonlinear least squares of all modes
-        together, started from the better of half-power and circle fit.
+        together, each band started from its one-mode rational fit
+            (:func:`modal.rational.rational_pole`; from the better of half-power and
+            circle fit where that gives no pole or a doubtful fit).
         ``"global"``: poly-reference LSCF (PolyMAX) poles with a stabilisation
         diagram, then a joint refinement of all poles, modal constants and
         residual terms over the whole band (:func:`modal.global_.identify_global`;
@@ -943,7 +948,7 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
         if assumed:
             flags.add("driving_point_assumed")
         omega_b, _ = _mode_arrays(frf, band)
-        spacing = float(np.median(np.diff(omega_b))) if omega_b.size > 1 else np.nan
+        spacing = line_spacing(omega_b) if omega_b.size > 1 else np.nan
         lines_per_bw = 2 * zeta * wn / spacing if spacing > 0 else np.nan
         others = [b.peak_hz for b in bands if b is not band and band.low_hz < b.peak_hz < band.high_hz]
         if _overlap(per_mode, index) > OVERLAP_LIMIT:

@@ -15,6 +15,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.linalg import lapack
 
 __all__ = ["NLSFit", "fit_modes", "truncation_shift"]
 
@@ -47,6 +48,8 @@ class NLSFit:
     converged: bool
     n_iter: int
 
+
+_GEQRF, _UNGQR, _TRTRS, _POSV = lapack.zgeqrf, lapack.zungqr, lapack.ztrtrs, lapack.dposv
 
 #: largest damping ratio the fit may reach (far past critical: the mode is then a slope)
 ZETA_MAX = 10.0
@@ -116,8 +119,39 @@ def _compress(Y: np.ndarray, rank: int) -> np.ndarray:
     return np.ascontiguousarray(Y @ V)
 
 
+def _thin_qr(A: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Reduced QR of a complex (m, n) matrix; LAPACK's geqrf/ungqr called directly when m ≥ n
+    (half the call overhead of ``numpy.linalg.qr``, which dominates on a one-mode band)."""
+    m, n = A.shape
+    if m < n or n == 0:
+        return np.linalg.qr(A)
+    packed, tau, _work, info = _GEQRF(A)
+    if info != 0:
+        return np.linalg.qr(A)
+    R = np.triu(packed[:n])
+    Q, _work, info = _UNGQR(packed, tau, overwrite_a=1)
+    if info != 0:
+        return np.linalg.qr(A)
+    return Q, R
+
+
+def _solve_upper(R: np.ndarray, B: np.ndarray) -> np.ndarray:
+    """R⁻¹ B for an upper-triangular R (raises LinAlgError on an exactly singular R, as ``solve``)."""
+    X, info = _TRTRS(R, B)
+    if info != 0:
+        raise np.linalg.LinAlgError("singular triangular factor in the least-squares basis")
+    return X
+
+
+def _solve_spd(A: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """A⁻¹ b for the damped normal equations (symmetric positive definite): Cholesky through
+    LAPACK's posv, with ``numpy.linalg.solve`` where rounding leaves A not positive definite."""
+    _c, x, info = _POSV(A, b)
+    return x if info == 0 else np.linalg.solve(A, b)
+
+
 def _project(Phi, Y):
-    Q, R = np.linalg.qr(Phi)
+    Q, R = _thin_qr(Phi)
     Q = np.ascontiguousarray(Q)
     QhY = Q.conj().T @ Y
     res = Y - Q @ QhY
@@ -182,7 +216,7 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
     x_lo, x_hi = 0.5 * x.min(), 2.0 * x.max()
     # a mode below the noise can be driven towards ζ = 0 step after step; it stops at a
     # half-power width of 1e-6 line spacings, far below anything the lines resolve
-    zeta_lo = 1e-6 * float(np.min(np.diff(x))) / (2 * x.max()) if x.size > 1 else 1e-12
+    zeta_lo = 1e-6 * float((x[1:] - x[:-1]).min()) / (2 * x.max()) if x.size > 1 else 1e-12
     params[0::2] = np.minimum(np.maximum(params[0::2], x_lo), x_hi)
     params[1::2] = np.minimum(np.maximum(params[1::2], zeta_lo), ZETA_MAX)
     Y_full = Y
@@ -222,7 +256,7 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
     n_iter = 0
     for n_iter in range(1, max_iter + 1):
         Phi, dphi, Q, R, QhY, res, cost = state
-        C = np.linalg.solve(R, QhY)  # (n_b, n_ch)
+        C = _solve_upper(R, QhY)  # (n_b, n_ch)
         E = dphi - Q @ (Q.conj().T @ dphi)  # projected basis derivatives, (n_freq, n_theta)
         Cm = C[mode_of]  # (n_theta, n_ch): the coefficient multiplying each derivative
         EhE = E.conj().T @ E
@@ -235,12 +269,13 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
             try:
                 damped = JtJ.copy()
                 damped[diagonal, diagonal] += lam * diag
-                step = np.linalg.solve(damped, -g)
+                step = _solve_spd(damped, -g)
             except np.linalg.LinAlgError:
                 lam *= 10
                 continue
             trial = params + step
-            if lam <= 1e-2 and np.max(np.abs(step) / np.maximum(np.abs(params), 1e-300)) < step_tol:
+            rel_step = float(np.max(np.abs(step) / np.maximum(np.abs(params), 1e-300)))
+            if lam <= 1e-2 and rel_step < step_tol:
                 break  # the Gauss–Newton step is below rounding: converged, nothing to evaluate
             # a pole the step would push to ζ ≤ 0 (a mode below the noise sliding onto a
             # spike) moves to a tenth of its value instead; rejecting the whole step drove λ
@@ -255,6 +290,7 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
                 zeta_t = np.where(zeta_t > ZETA_MAX, (params[1::2] + ZETA_MAX) / 2, zeta_t)
                 trial[0::2], trial[1::2] = x_r, zeta_t
                 step = trial - params
+                rel_step = float(np.max(np.abs(step) / np.maximum(np.abs(params), 1e-300)))
             if np.isfinite(trial).all():
                 new_state = evaluate(trial)
                 if new_state[-1] <= cost:
@@ -262,10 +298,9 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
                     break
             lam *= 4
         if not accepted:
-            small = np.max(np.abs(step) / np.maximum(np.abs(params), 1e-300)) < step_tol
+            small = rel_step < step_tol
             converged = bool(small or cost <= 1e-28 * np.vdot(Y, Y).real)
             break
-        rel_step = np.max(np.abs(step) / np.maximum(np.abs(params), 1e-300))
         params, state = trial, new_state
         lam = max(lam / 3, 1e-12)
         flat = cost - new_state[-1] <= 1e-13 * cost  # no decrease left above rounding
@@ -280,7 +315,7 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
         res = Y - Q @ QhY
     n_freq = x.size
     n_b = Phi.shape[1]
-    C = np.linalg.solve(R, QhY)
+    C = _solve_upper(R, QhY)
     rss = np.sum(np.abs(res) ** 2, axis=0)
     dof = n_freq - n_b - n_theta / (2 * n_ch)
     noise_var = rss / dof if dof > 0 else np.full(n_ch, np.nan)
@@ -312,7 +347,7 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
         g_re, g_im = G.real, G.imag
         blk = mode_cov[r]
         idx = [2 * r, 2 * r + 1]
-        blk[:, :2, :2] = cov_theta[np.ix_(idx, idx)]
+        blk[:, :2, :2] = cov_theta[2 * r:2 * r + 2, 2 * r:2 * r + 2]
         cross_re = cov_theta[idx] @ g_re  # (2, n_ch)
         cross_im = cov_theta[idx] @ g_im
         blk[:, :2, 2] = cross_re.T

@@ -19,10 +19,15 @@ from __future__ import annotations
 
 import numpy as np
 
+from .nls import _thin_qr
+
 __all__ = ["rational_pole"]
 
 #: Sanathanan–Koerner re-weighting passes after Levy's fit
 SK_PASSES = 1
+#: relative size (of squared norms) below which a column or the 2x2 system counts as rank-deficient:
+#: rounding of the projection is ~1e-16 relative in norm, 1e-32 in square; a pole needs far more
+RANK_TOL = 1e-20
 
 
 def rational_pole(omega: np.ndarray, response: np.ndarray, noise_std=None,
@@ -63,16 +68,25 @@ def rational_pole(omega: np.ndarray, response: np.ndarray, noise_std=None,
     weight = np.ones(omega.size)
     a0 = a1 = np.nan
     for _ in range(passes + 1):
-        q, _r = np.linalg.qr(basis * weight[:, None])
+        q, _r = _thin_qr(basis * weight[:, None])
         qh = q.conj().T
         # columns H·1, H·s and the right-hand side −H·s², weighted, numerators projected out
         cols = np.stack([h, hs, rhs], axis=2) * weight[None, :, None]  # (n_ch, n_freq, 3)
+        before = np.real(np.einsum("cfi,cfi->i", cols[..., :2].conj(), cols[..., :2]))
         cols = cols - q @ (qh @ cols)
-        gram = np.real(np.einsum("cfi,cfj->ij", cols.conj(), cols))
-        try:
-            a0, a1 = np.linalg.solve(gram[:2, :2], gram[:2, 2])
-        except np.linalg.LinAlgError:
+        flat = cols.reshape(-1, 3)
+        gram = np.real(flat.conj().T @ flat)
+        # a response the numerators alone explain (no pole: a constant, a slope) leaves only
+        # rounding in the denominator's columns: no pole to report
+        if not np.all(gram.diagonal()[:2] > RANK_TOL * before):
             return None
+        # the 2x2 normal equations by Cramer's rule
+        det = gram[0, 0] * gram[1, 1] - gram[0, 1] * gram[1, 0]
+        if not det > RANK_TOL * gram[0, 0] * gram[1, 1]:
+            return None
+        with np.errstate(divide="ignore", invalid="ignore"):
+            a0 = (gram[0, 2] * gram[1, 1] - gram[0, 1] * gram[1, 2]) / det
+            a1 = (gram[0, 0] * gram[1, 2] - gram[1, 0] * gram[0, 2]) / det
         if not (np.isfinite(a0) and np.isfinite(a1) and a0 > 0):
             return None
         denominator = np.abs(a0 + a1 * s + s * s)
