@@ -261,7 +261,8 @@ def restart_pole(omega: np.ndarray, response: np.ndarray, power: int, region: np
 
 def find_missing_mode(omega: np.ndarray, response: np.ndarray, power: int, region: np.ndarray,
                       omega_n, damping_ratio, noise_std, bands_rad,
-                      residual: np.ndarray | None = None) -> MissingMode | None:
+                      residual: np.ndarray | None = None,
+                      residual_noise: np.ndarray | None = None) -> MissingMode | None:
     """Test the residual of fitted modes for one more mode.
 
     Parameters
@@ -284,6 +285,9 @@ def find_missing_mode(omega: np.ndarray, response: np.ndarray, power: int, regio
     residual : ndarray, shape (n_channels, n_freq), optional
         The residual of the fitted modes if the caller has it (:func:`fit_residual`);
         computed otherwise.
+    residual_noise : ndarray, shape (n_channels,), optional
+        :func:`residual_noise_std` of that residual if the caller has it (it is per
+        channel, so the strongest channels' values are the same); computed otherwise.
 
     Returns
     -------
@@ -298,7 +302,10 @@ def find_missing_mode(omega: np.ndarray, response: np.ndarray, power: int, regio
     Y = response[strongest]
     n_ch = Y.shape[0]
     res = residual[strongest] if residual is not None else _residual(omega, Y, omega_n, zeta, power, region)
-    sigma2 = _seen_through(res, omega, Y, noise_std[strongest]) ** 2
+    if residual_noise is not None:
+        sigma2 = np.asarray(residual_noise, float)[strongest] ** 2
+    else:
+        sigma2 = _seen_through(res, omega, Y, noise_std[strongest]) ** 2
     if not np.all(sigma2 > 0):
         return None
     energy = np.mean(np.abs(res) ** 2 / sigma2[:, None], axis=0)

@@ -641,13 +641,14 @@ def _with_shift(cov, pole_shift, constant_shift):
     return cov + d[:, :, None] * d[:, None, :]
 
 
-def _missing_mode(frf, bands, power, omega_n, damping_ratio, estimated_noise, residual=None):
-    """:func:`modal.checks.find_missing_mode` on the lines of the bands (``residual``: the fit's, if known)."""
+def _missing_mode(frf, bands, power, omega_n, damping_ratio, estimated_noise, residual=None, residual_noise=None):
+    """:func:`modal.checks.find_missing_mode` on the lines of the bands (``residual`` and ``residual_noise``:
+    the fit's residual and its :func:`modal.checks.residual_noise_std`, if known)."""
     omega, response, region = _band_data(frf, bands)
     bands_rad = [(TWO_PI * b.low_hz, TWO_PI * b.high_hz) for b in bands]
     with np.errstate(all="ignore"):
         return find_missing_mode(omega, response, power, region, omega_n, damping_ratio, estimated_noise,
-                                 bands_rad, residual)
+                                 bands_rad, residual, residual_noise)
 
 
 def _overlap(per_mode, index) -> float:
@@ -907,9 +908,12 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
         with np.errstate(all="ignore"):
             omega_b, response_b, region_b = _band_data(frf, bands)
             residual = fit_residual(omega_b, response_b, power, region_b, fit.omega_n, fit.damping_ratio)
-        chi2 = _chi2(fit.noise_var, _fit_noise(frf, bands, power, fit.omega_n, fit.damping_ratio,
-                                               estimated_noise, known=known_noise, residual=residual))
-        missing_mode = _missing_mode(frf, bands, power, fit.omega_n, fit.damping_ratio, estimated_noise, residual)
+        fit_noise = _fit_noise(frf, bands, power, fit.omega_n, fit.damping_ratio, estimated_noise, known=known_noise,
+                               residual=residual)
+        chi2 = _chi2(fit.noise_var, fit_noise)
+        # the check's noise is the residual's own: with a known noise (time data) it computes it itself
+        missing_mode = _missing_mode(frf, bands, power, fit.omega_n, fit.damping_ratio, estimated_noise, residual,
+                                     None if known_noise else fit_noise)
         # near-exact data: the offset's truncation (modes outside the bands) biases the poles
         # beyond their white-noise errors; its measured shift is added to them (finding 26)
         shift = _truncation(frf, bands, power, fit, residual=residual)
