@@ -156,102 +156,227 @@ def _open_earlier(path) -> h5py.File | None:
     return f
 
 
-class _PlotWorkers:
-    """Stage plots rendered in forked child processes while the parent goes on (``plot_jobs > 1``).
+#: rough CPU cost (s) of each stage's figures and of importing matplotlib's figure machinery: used only to decide
+#: which figures the parent takes over from the plotting child at the end (the output does not depend on it)
+_PLOT_COST_S = {"identify": 0.15, "adb_response": 0.14, "compressor": 0.1, "adb_stability": 0.04, "mounts": 0.04}
+_PLOT_IMPORT_COST_S = 0.14
 
-    Each child renders the figures of the stages it is given (atomic writes, as in
-    :func:`~balancer.scene.plots.save_stage_plot`) and reports the paths, or the error,
-    through a pipe.  Falls back to the parent (``submit`` returns False) where ``os.fork``
-    is missing, with more than one thread alive (forking a threaded process is unsafe),
-    or when ``plot_jobs - 1`` children are already running.
+
+class _Plotter:
+    """A forked child that draws the stage plots while the parent runs the stages (``plot_jobs > 1``).
+
+    Started before the first stage, the child imports the plotting modules (matplotlib) while the
+    parent computes; each plot stage's results (with those of the stages it depends on) are sent to
+    it, pickled through a pipe, as soon as they are complete, and it draws them in that order (atomic
+    writes, as :func:`~balancer.scene.plots.save_stage_plot`).  At the end the parent takes over
+    figures the child has not started when that finishes sooner (:meth:`share`), so no figure is
+    drawn twice on purpose and both CPUs draw.  ``started`` is False (everything drawn in the parent)
+    where ``os.fork`` is missing or more than one thread is alive (forking a threaded process is unsafe).
     """
 
-    def __init__(self, jobs: int, folder: Path, results: dict):
+    def __init__(self, jobs: int, folder: Path):
         import os
         import threading
 
-        self.jobs = max(1, int(jobs))
         self.folder = folder
-        self.results = results
-        self.children: list[tuple[int, int, tuple[str, ...]]] = []
-        self.finished: set[int] = set()
+        self.pid: int | None = None
+        self.sent: list[str] = []
         self._drawn: list[Path] = []
-        self.usable = self.jobs > 1 and hasattr(os, "fork") and threading.active_count() == 1
+        self._status_text = b""
+        self._started_order: list[str] = []
+        if max(1, int(jobs)) > 1 and hasattr(os, "fork") and threading.active_count() == 1:
+            self._fork()
 
-    def submit(self, stages: tuple[str, ...]) -> bool:
+    @property
+    def started(self) -> bool:
+        return self.pid is not None
+
+    def _fork(self) -> None:
         import os
         import sys
-
-        if not stages or not self.usable or self._running() >= self.jobs - 1:
-            return False
-        from .plots import save_stage_plot
 
         self.folder.mkdir(parents=True, exist_ok=True)
         sys.stdout.flush()
         sys.stderr.flush()
-        read, write = os.pipe()
+        jobs_read, self._jobs = os.pipe()
+        self._status, status_write = os.pipe()
+        self._report, report_write = os.pipe()
         pid = os.fork()
-        if pid == 0:  # child: render, report, leave without running the parent's exit handlers
+        if pid == 0:  # child: draw, report, leave without running the parent's exit handlers
             code = 0
             try:
-                os.close(read)
-                paths = [str(p) for stage in stages for p in save_stage_plot(stage, self.results, self.folder)]
-                message = json.dumps({"paths": paths})
+                for fd in (self._jobs, self._status, self._report):
+                    os.close(fd)
+                report = self._serve(jobs_read, status_write)
+                code = 1 if "error" in report else 0
             except BaseException as exc:  # noqa: BLE001 - reported to the parent, which raises it
-                message, code = json.dumps({"error": f"{type(exc).__name__}: {exc}"}), 1
+                report, code = {"error": f"{type(exc).__name__}: {exc}"}, 1
             try:
-                os.write(write, message.encode())
+                data = json.dumps(report).encode()
+                while data:
+                    data = data[os.write(report_write, data):]
             finally:
                 os._exit(code)
-        os.close(write)
-        self.children.append((pid, read, stages))
+        for fd in (jobs_read, status_write, report_write):
+            os.close(fd)
+        self.pid = pid
+
+    # ---- child side
+    def _serve(self, jobs_read: int, status_write: int) -> dict:
+        import os
+        import pickle
+        import queue
+        import threading
+
+        messages: queue.Queue = queue.Queue()
+
+        def reader() -> None:  # drains the pipe so that the parent never waits on a full pipe
+            with os.fdopen(jobs_read, "rb") as pipe:
+                while True:
+                    head = pipe.read(8)
+                    if len(head) < 8:
+                        messages.put(("end",))
+                        return
+                    messages.put(pipe.read(int.from_bytes(head, "little")))
+
+        threading.Thread(target=reader, daemon=True).start()
+        from .plots import save_stage_plot  # matplotlib, imported while the parent computes
+
+        todo: list[str] = []
+        given: dict[str, dict] = {}
+        skip: set[str] = set()
+        drawn: dict[str, list[str]] = {}
+        error = None
+        ended = False
+        while True:
+            block = not todo and not ended
+            while True:
+                try:
+                    message = messages.get(block=block)
+                except queue.Empty:
+                    break
+                block = False
+                if not isinstance(message, tuple):
+                    message = pickle.loads(message)
+                if message[0] == "draw":
+                    todo.append(message[1])
+                    given[message[1]] = message[2]
+                elif message[0] == "skip":
+                    skip.update(message[1])
+                else:
+                    ended = True
+            todo = [stage for stage in todo if stage not in skip]
+            if todo and error is None:
+                stage = todo.pop(0)
+                os.write(status_write, stage.encode() + b"\n")
+                try:
+                    drawn[stage] = [str(p) for p in save_stage_plot(stage, given.pop(stage), self.folder)]
+                except Exception as exc:  # the same report as from the parent: the stage and the cause
+                    error = f"plots of {stage}: {type(exc).__name__}: {exc}"
+                continue
+            todo = []
+            if ended:
+                return {"drawn": drawn} if error is None else {"drawn": drawn, "error": error}
+
+    # ---- parent side
+    def _send(self, message: tuple) -> bool:
+        import os
+        import pickle
+
+        try:
+            data = pickle.dumps(message, protocol=pickle.HIGHEST_PROTOCOL)
+        except Exception:  # noqa: BLE001 - a result that does not pickle is drawn by the parent
+            return False
+        data = len(data).to_bytes(8, "little") + data
+        try:
+            while data:
+                data = data[os.write(self._jobs, data):]
+        except BrokenPipeError:  # the child has ended (its report says why)
+            return False
         return True
 
-    def _running(self) -> int:
-        """Children still drawing (finished ones are reaped; their reports wait in the pipes)."""
+    def submit(self, stage: str, results: dict) -> bool:
+        """Send a stage's plot to the child; False if it stays with the parent."""
+        if not self.started or not self._send(("draw", stage, results)):
+            return False
+        self.sent.append(stage)
+        return True
+
+    def _started_stages(self) -> set[str]:
         import os
+        import select
 
-        for pid, _read, _stages in self.children:
-            if pid not in self.finished and os.waitpid(pid, os.WNOHANG)[0] == pid:
-                self.finished.add(pid)
-        return sum(pid not in self.finished for pid, _read, _stages in self.children)
+        text = b""
+        while select.select([self._status], [], [], 0)[0]:
+            chunk = os.read(self._status, 65536)
+            if not chunk:
+                break
+            text += chunk
+        self._status_text += text
+        self._started_order = [line.decode() for line in self._status_text.split(b"\n") if line]
+        return set(self._started_order)
 
-    def abandon(self) -> None:
-        """Wait for every child and remove the plots they drew (the run failed)."""
-        try:
-            self.collect()
-        except RuntimeError:
-            pass
-        for path in self._drawn:
-            path.unlink(missing_ok=True)
+    def share(self) -> list[str]:
+        """Take back, from the end of the child's queue, the figures the parent draws sooner (matplotlib
+        to import, if not yet, plus their drawing, against what the child has left); tell the child."""
+        import sys
+
+        if not self.started:
+            return []
+        started = self._started_stages()
+        waiting = [stage for stage in self.sent if stage not in started]
+        cost = {stage: _PLOT_COST_S.get(stage, 0.1) for stage in waiting}
+        parent = 0.0 if "balancer.scene.plots" in sys.modules else _PLOT_IMPORT_COST_S
+        # what the child has left: about half of the figure it drew last (it may be done with it) and the waiting ones
+        last = self._started_order[-1] if self._started_order else ""
+        child = 0.5 * _PLOT_COST_S.get(last, 0.1) * bool(last) + sum(cost.values())
+        taken: list[str] = []
+        for stage in reversed(waiting):
+            if parent + cost[stage] >= child - cost[stage]:
+                break
+            parent += cost[stage]
+            child -= cost[stage]
+            taken.insert(0, stage)
+        self._send(("skip", taken))
+        return taken
 
     def collect(self) -> dict[str, list[Path]]:
-        """Wait for every child; the paths of each stage's plots (raises if a child failed)."""
+        """Tell the child there is nothing more, wait for it; the paths of each stage it drew (raises
+        RuntimeError if a figure failed there)."""
         import os
 
-        done: dict[str, list[Path]] = {}
-        errors = []
-        for pid, read, stages in self.children:
-            chunks = []
-            while True:
-                chunk = os.read(read, 65536)
-                if not chunk:
-                    break
-                chunks.append(chunk)
-            os.close(read)
-            if pid not in self.finished:
-                os.waitpid(pid, 0)
-            report = json.loads(b"".join(chunks) or b'{"error": "plot process ended without a report"}')
-            if "error" in report:
-                errors.append(f"plots of {', '.join(stages)}: {report['error']}")
-                continue
-            for path in map(Path, report["paths"]):
-                self._drawn.append(path)
-                done.setdefault(next(s for s in stages if path.name.startswith(s + "_")), []).append(path)
-        self.children, self.finished = [], set()
-        if errors:
-            raise RuntimeError("; ".join(errors))
+        if not self.started:
+            return {}
+        self._send(("end",))
+        os.close(self._jobs)
+        chunks = []
+        while True:
+            chunk = os.read(self._report, 65536)
+            if not chunk:
+                break
+            chunks.append(chunk)
+        for fd in (self._report, self._status):
+            os.close(fd)
+        os.waitpid(self.pid, 0)
+        self.pid = None
+        report = json.loads(b"".join(chunks) or b'{"error": "plot process ended without a report"}')
+        done = {stage: [Path(p) for p in paths] for stage, paths in report.get("drawn", {}).items()}
+        for paths in done.values():
+            self._drawn.extend(paths)
+        if "error" in report:
+            raise RuntimeError(report["error"])
         return done
+
+    def abandon(self) -> None:
+        """Wait for the child and remove the plots it drew (the run failed)."""
+        if self.started:
+            self._send(("skip", list(self.sent)))
+            try:
+                self.collect()
+            except RuntimeError:
+                pass
+        for path in self._drawn:
+            path.unlink(missing_ok=True)
 
 
 def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, plots_dir: str | Path | None = None,
@@ -306,19 +431,22 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, p
     if plotted:
         folder = Path(plots_dir) if plots_dir is not None else (
             archive_path.with_name(archive_path.stem + "_plots") if archive_path else Path("out") / f"{_slug(name)}_plots")
-    workers = _PlotWorkers(plot_jobs, folder, results) if plotted else None
-    pending = list(plotted)  # plot stages not yet handed to a child, in output order
+    plotter = _Plotter(plot_jobs, folder) if plotted else None
+    pending = list(plotted)  # plot stages not yet handed to the child, in output order
 
     def hand_over() -> None:
-        # plots whose stage and upstream results are all there go to a child while the parent runs on
-        ready = tuple(s for s in pending if s in results and all(status[t] != "ran" or t in results
-                                                                  for t in dependencies(scene, s)))
-        if workers is not None and ready and workers.submit(ready):
-            for s in ready:
-                pending.remove(s)
+        # plots whose stage and upstream results are all there go to the child while the parent runs on
+        for stage in list(pending):
+            if stage not in results or not all(status[t] != "ran" or t in results for t in dependencies(scene, stage)):
+                continue
+            given = {s: results[s] for s in _closure(scene, [stage]) if s in results}
+            if plotter.submit(stage, given):
+                pending.remove(stage)
 
     plot_paths = []
     try:
+        if plotter is not None and plotter.started:
+            hand_over()  # reused stages' plots can start at once
         for stage in STAGES:
             if status[stage] != "ran":
                 continue
@@ -328,7 +456,7 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, p
             results[stage] = STAGE_FUNCTIONS[stage](scene, **kwargs)
             timings[stage] = time.perf_counter() - t0
             say(f"{stage}: done in {timings[stage]:.2f} s")
-            if stage in pending:
+            if plotter is not None and plotter.started and pending:
                 hand_over()
         if archive_path is not None:
             keep = [s for s in STAGES if s in results and (stored is True or stored is False or s in stored)]
@@ -336,25 +464,24 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, p
             write_archive(archive_path, {s: results[s] for s in keep}, scene_text=scene.text or None,
                           inputs_hash={s: hashes[s] for s in keep})
         if plotted:
-            from .plots import save_stage_plot
-
             folder.mkdir(parents=True, exist_ok=True)
-            # split what is left: a child takes the second half while this process draws the first
-            half = (len(pending) + 1) // 2
-            if workers.submit(tuple(pending[half:])):
-                pending = pending[:half]
+            taken = plotter.share()
+            mine_to_draw = [s for s in plotted if s in pending or s in taken]
             mine = {}
-            for stage in pending:
+            if mine_to_draw:
+                from .plots import save_stage_plot
+
+            for stage in mine_to_draw:
                 try:
                     mine[stage] = save_stage_plot(stage, results, folder)
-                except Exception as exc:  # the same report as from a child: the stage and the cause
+                except Exception as exc:  # the same report as from the child: the stage and the cause
                     raise RuntimeError(f"plots of {stage}: {type(exc).__name__}: {exc}") from exc
-            theirs = workers.collect()
+            theirs = plotter.collect()
             for stage in plotted:
                 plot_paths += mine.get(stage, theirs.get(stage, []))
     except BaseException:
-        if workers is not None:  # a failed run leaves no plots drawn early by a child
-            workers.abandon()
+        if plotter is not None:  # a failed run leaves no plots drawn by the child
+            plotter.abandon()
         raise
     from .summary import format_summary
 
