@@ -156,22 +156,88 @@ def _open_earlier(path) -> h5py.File | None:
     return f
 
 
-#: rough CPU cost (s) of each stage's figures and of importing matplotlib's figure machinery: used only to decide
-#: which figures the parent takes over from the plotting child at the end (the output does not depend on it)
+#: rough CPU cost (s) of each stage's figures: used only to split the waiting figures between the plotting
+#: process and its helper (the files do not depend on it)
 _PLOT_COST_S = {"identify": 0.15, "adb_response": 0.14, "compressor": 0.1, "adb_stability": 0.04, "mounts": 0.04}
-_PLOT_IMPORT_COST_S = 0.14
+
+
+def _split_for_helper(waiting: list[str]) -> int:
+    """How many figures, from the end of ``waiting``, a helper takes so that both halves cost about the same
+    (0 when fewer than two wait)."""
+    cost = [_PLOT_COST_S.get(stage, 0.1) for stage in waiting]
+    taken = 0
+    while taken < len(waiting) - 1 and sum(cost[len(cost) - taken - 1:]) <= sum(cost[:len(cost) - taken - 1]):
+        taken += 1
+    return taken
+
+
+def _draw_and_report(stages: list[tuple[str, str]], folder: Path, save_stage_plot) -> dict:
+    """Draw each (stage, pickled results file) pair; {"drawn": {stage: paths}} and "error" on the first failure."""
+    import os
+    import pickle
+
+    drawn: dict[str, list[str]] = {}
+    for index, (stage, payload) in enumerate(stages):
+        try:
+            with open(payload, "rb") as handle:
+                given = pickle.load(handle)
+            os.unlink(payload)
+            drawn[stage] = [str(p) for p in save_stage_plot(stage, given, folder)]
+        except Exception as exc:  # the same report as from the parent: the stage and the cause
+            for _stage, rest in stages[index:]:
+                Path(rest).unlink(missing_ok=True)
+            return {"drawn": drawn, "error": f"plots of {stage}: {type(exc).__name__}: {exc}"}
+    return {"drawn": drawn}
+
+
+def _write_report(fd: int, report: dict) -> None:
+    import os
+
+    data = json.dumps(report).encode()
+    while data:
+        data = data[os.write(fd, data):]
+
+
+def _read_report(fd: int) -> dict:
+    import os
+
+    chunks = []
+    while True:
+        chunk = os.read(fd, 65536)
+        if not chunk:
+            break
+        chunks.append(chunk)
+    os.close(fd)
+    return json.loads(b"".join(chunks) or b'{"error": "plot process ended without a report"}')
+
+
+def _fork_quietly() -> int:
+    """``os.fork`` with the garbage collector's objects frozen around it, so that the child's collections
+    do not write to (and copy) every page of the parent's objects."""
+    import gc
+    import os
+    import sys
+
+    sys.stdout.flush()
+    sys.stderr.flush()
+    gc.freeze()
+    pid = os.fork()
+    if pid != 0:
+        gc.unfreeze()
+    return pid
 
 
 class _Plotter:
-    """A forked child that draws the stage plots while the parent runs the stages (``plot_jobs > 1``).
+    """A forked process that draws the stage plots while the parent runs the stages (``plot_jobs > 1``).
 
-    Started before the first stage, the child imports the plotting modules (matplotlib) while the
-    parent computes; each plot stage's results (with those of the stages it depends on) are sent to
-    it, pickled through a pipe, as soon as they are complete, and it draws them in that order (atomic
-    writes, as :func:`~balancer.scene.plots.save_stage_plot`).  At the end the parent takes over
-    figures the child has not started when that finishes sooner (:meth:`share`), so no figure is
-    drawn twice on purpose and both CPUs draw.  ``started`` is False (everything drawn in the parent)
-    where ``os.fork`` is missing or more than one thread is alive (forking a threaded process is unsafe).
+    Started before the first stage, it imports the plotting modules (matplotlib) while the parent
+    computes.  Each plot stage's results (with those of the stages it depends on) are pickled to a
+    temporary file as soon as they are complete and announced through a pipe (the parent never waits on
+    the plotter); the plotter draws them in that order (atomic writes, as
+    :func:`~balancer.scene.plots.save_stage_plot`).  When two or more figures wait, it forks a helper,
+    which inherits matplotlib already imported, for the later ones: both CPUs draw once the parent is
+    done, and matplotlib is imported once.  ``started`` is False (everything drawn in the parent) where
+    ``os.fork`` is missing or more than one thread is alive (forking a threaded process is unsafe).
     """
 
     def __init__(self, jobs: int, folder: Path):
@@ -180,10 +246,8 @@ class _Plotter:
 
         self.folder = folder
         self.pid: int | None = None
-        self.sent: list[str] = []
+        self._payloads: list[str] = []
         self._drawn: list[Path] = []
-        self._status_text = b""
-        self._started_order: list[str] = []
         if max(1, int(jobs)) > 1 and hasattr(os, "fork") and threading.active_count() == 1:
             self._fork()
 
@@ -193,173 +257,138 @@ class _Plotter:
 
     def _fork(self) -> None:
         import os
-        import sys
 
         self.folder.mkdir(parents=True, exist_ok=True)
-        sys.stdout.flush()
-        sys.stderr.flush()
         jobs_read, self._jobs = os.pipe()
-        self._status, status_write = os.pipe()
         self._report, report_write = os.pipe()
-        pid = os.fork()
-        if pid == 0:  # child: draw, report, leave without running the parent's exit handlers
-            code = 0
+        pid = _fork_quietly()
+        if pid == 0:  # plotter: draw, report, leave without running the parent's exit handlers
+            code = 1
             try:
-                for fd in (self._jobs, self._status, self._report):
-                    os.close(fd)
-                report = self._serve(jobs_read, status_write)
+                os.close(self._jobs)
+                os.close(self._report)
+                report = self._serve(jobs_read)
                 code = 1 if "error" in report else 0
             except BaseException as exc:  # noqa: BLE001 - reported to the parent, which raises it
-                report, code = {"error": f"{type(exc).__name__}: {exc}"}, 1
+                report = {"error": f"{type(exc).__name__}: {exc}"}
             try:
-                data = json.dumps(report).encode()
-                while data:
-                    data = data[os.write(report_write, data):]
+                _write_report(report_write, report)
             finally:
                 os._exit(code)
-        for fd in (jobs_read, status_write, report_write):
-            os.close(fd)
+        os.close(jobs_read)
+        os.close(report_write)
         self.pid = pid
 
-    # ---- child side
-    def _serve(self, jobs_read: int, status_write: int) -> dict:
-        import os
-        import pickle
-        import queue
-        import threading
-
-        messages: queue.Queue = queue.Queue()
-
-        def reader() -> None:  # drains the pipe so that the parent never waits on a full pipe
-            with os.fdopen(jobs_read, "rb") as pipe:
-                while True:
-                    head = pipe.read(8)
-                    if len(head) < 8:
-                        messages.put(("end",))
-                        return
-                    messages.put(pipe.read(int.from_bytes(head, "little")))
-
-        threading.Thread(target=reader, daemon=True).start()
-        from .plots import save_stage_plot  # matplotlib, imported while the parent computes
-
-        todo: list[str] = []
-        given: dict[str, dict] = {}
-        skip: set[str] = set()
-        drawn: dict[str, list[str]] = {}
-        error = None
-        ended = False
-        while True:
-            block = not todo and not ended
-            while True:
-                try:
-                    message = messages.get(block=block)
-                except queue.Empty:
-                    break
-                block = False
-                if not isinstance(message, tuple):
-                    message = pickle.loads(message)
-                if message[0] == "draw":
-                    todo.append(message[1])
-                    given[message[1]] = message[2]
-                elif message[0] == "skip":
-                    skip.update(message[1])
-                else:
-                    ended = True
-            todo = [stage for stage in todo if stage not in skip]
-            if todo and error is None:
-                stage = todo.pop(0)
-                os.write(status_write, stage.encode() + b"\n")
-                try:
-                    drawn[stage] = [str(p) for p in save_stage_plot(stage, given.pop(stage), self.folder)]
-                except Exception as exc:  # the same report as from the parent: the stage and the cause
-                    error = f"plots of {stage}: {type(exc).__name__}: {exc}"
-                continue
-            todo = []
-            if ended:
-                return {"drawn": drawn} if error is None else {"drawn": drawn, "error": error}
-
-    # ---- parent side
-    def _send(self, message: tuple) -> bool:
-        import os
-        import pickle
-
-        try:
-            data = pickle.dumps(message, protocol=pickle.HIGHEST_PROTOCOL)
-        except Exception:  # noqa: BLE001 - a result that does not pickle is drawn by the parent
-            return False
-        data = len(data).to_bytes(8, "little") + data
-        try:
-            while data:
-                data = data[os.write(self._jobs, data):]
-        except BrokenPipeError:  # the child has ended (its report says why)
-            return False
-        return True
-
-    def submit(self, stage: str, results: dict) -> bool:
-        """Send a stage's plot to the child; False if it stays with the parent."""
-        if not self.started or not self._send(("draw", stage, results)):
-            return False
-        self.sent.append(stage)
-        return True
-
-    def _started_stages(self) -> set[str]:
+    # ---- plotter side
+    def _serve(self, jobs_read: int) -> dict:
         import os
         import select
 
-        text = b""
-        while select.select([self._status], [], [], 0)[0]:
-            chunk = os.read(self._status, 65536)
-            if not chunk:
-                break
-            text += chunk
-        self._status_text += text
-        self._started_order = [line.decode() for line in self._status_text.split(b"\n") if line]
-        return set(self._started_order)
+        from .plots import save_stage_plot  # matplotlib, imported while the parent computes
 
-    def share(self) -> list[str]:
-        """Take back, from the end of the child's queue, the figures the parent draws sooner (matplotlib
-        to import, if not yet, plus their drawing, against what the child has left); tell the child."""
-        import sys
+        todo: list[tuple[str, str]] = []
+        drawn: dict[str, list[str]] = {}
+        errors: list[str] = []
+        helper: tuple[int, int] | None = None  # (pid, report fd) of the running helper
+        buffer, ended = b"", False
+
+        def reap(block: bool) -> None:
+            nonlocal helper
+            if helper is None or (not block and os.waitpid(helper[0], os.WNOHANG)[0] == 0):
+                return
+            report = _read_report(helper[1])
+            if block:
+                os.waitpid(helper[0], 0)
+            drawn.update(report.get("drawn", {}))
+            if "error" in report:
+                errors.append(report["error"])
+            helper = None
+
+        while True:
+            # what the parent has sent; wait for it only when there is nothing to draw
+            while not ended and (not todo or select.select([jobs_read], [], [], 0)[0]):
+                chunk = os.read(jobs_read, 65536)
+                if not chunk:
+                    ended = True
+                    break
+                *lines, buffer = (buffer + chunk).split(b"\n")
+                for line in lines:
+                    message = json.loads(line)
+                    if message.get("end"):
+                        ended = True
+                    else:
+                        todo.append((message["stage"], message["file"]))
+            reap(block=False)
+            if todo and not errors:
+                share = _split_for_helper([stage for stage, _file in todo]) if helper is None else 0
+                if share:
+                    read, write = os.pipe()
+                    pid = _fork_quietly()
+                    if pid == 0:  # helper: the later figures
+                        code = 1
+                        try:
+                            os.close(read)
+                            report = _draw_and_report(todo[-share:], self.folder, save_stage_plot)
+                            code = 1 if "error" in report else 0
+                        except BaseException as exc:  # noqa: BLE001
+                            report = {"error": f"{type(exc).__name__}: {exc}"}
+                        try:
+                            _write_report(write, report)
+                        finally:
+                            os._exit(code)
+                    os.close(write)
+                    helper = (pid, read)
+                    todo = todo[:-share]
+                report = _draw_and_report(todo[:1], self.folder, save_stage_plot)
+                todo = todo[1:]
+                drawn.update(report["drawn"])
+                if "error" in report:
+                    errors.append(report["error"])
+                continue
+            if ended:
+                for _stage, payload in todo:  # not drawn after a failure
+                    Path(payload).unlink(missing_ok=True)
+                reap(block=True)
+                return {"drawn": drawn, **({"error": "; ".join(errors)} if errors else {})}
+
+    # ---- parent side
+    def submit(self, stage: str, results: dict) -> bool:
+        """Hand a stage's plot to the plotter; False if it stays with the parent."""
+        import os
+        import pickle
+        import tempfile
 
         if not self.started:
-            return []
-        started = self._started_stages()
-        waiting = [stage for stage in self.sent if stage not in started]
-        cost = {stage: _PLOT_COST_S.get(stage, 0.1) for stage in waiting}
-        parent = 0.0 if "balancer.scene.plots" in sys.modules else _PLOT_IMPORT_COST_S
-        # what the child has left: about half of the figure it drew last (it may be done with it) and the waiting ones
-        last = self._started_order[-1] if self._started_order else ""
-        child = 0.5 * _PLOT_COST_S.get(last, 0.1) * bool(last) + sum(cost.values())
-        taken: list[str] = []
-        for stage in reversed(waiting):
-            if parent + cost[stage] >= child - cost[stage]:
-                break
-            parent += cost[stage]
-            child -= cost[stage]
-            taken.insert(0, stage)
-        self._send(("skip", taken))
-        return taken
+            return False
+        handle, payload = tempfile.mkstemp(prefix="modalbal-plot-", suffix=".pickle")
+        try:
+            with os.fdopen(handle, "wb") as out:
+                pickle.dump(results, out, protocol=pickle.HIGHEST_PROTOCOL)
+            line = json.dumps({"stage": stage, "file": payload}).encode() + b"\n"
+            os.write(self._jobs, line)  # a short line: the pipe never fills
+        except Exception:  # noqa: BLE001 - results that do not pickle (or a plotter gone) are drawn here
+            Path(payload).unlink(missing_ok=True)
+            return False
+        self._payloads.append(payload)
+        return True
 
     def collect(self) -> dict[str, list[Path]]:
-        """Tell the child there is nothing more, wait for it; the paths of each stage it drew (raises
+        """Tell the plotter there is nothing more, wait for it; the paths of each stage it drew (raises
         RuntimeError if a figure failed there)."""
         import os
 
         if not self.started:
             return {}
-        self._send(("end",))
+        try:
+            os.write(self._jobs, json.dumps({"end": True}).encode() + b"\n")
+        except BrokenPipeError:  # the plotter has ended (its report says why)
+            pass
         os.close(self._jobs)
-        chunks = []
-        while True:
-            chunk = os.read(self._report, 65536)
-            if not chunk:
-                break
-            chunks.append(chunk)
-        for fd in (self._report, self._status):
-            os.close(fd)
+        report = _read_report(self._report)
         os.waitpid(self.pid, 0)
         self.pid = None
-        report = json.loads(b"".join(chunks) or b'{"error": "plot process ended without a report"}')
+        for payload in self._payloads:  # left behind by a failure
+            Path(payload).unlink(missing_ok=True)
         done = {stage: [Path(p) for p in paths] for stage, paths in report.get("drawn", {}).items()}
         for paths in done.values():
             self._drawn.extend(paths)
@@ -368,9 +397,8 @@ class _Plotter:
         return done
 
     def abandon(self) -> None:
-        """Wait for the child and remove the plots it drew (the run failed)."""
+        """Wait for the plotter and remove the plots it drew (the run failed)."""
         if self.started:
-            self._send(("skip", list(self.sent)))
             try:
                 self.collect()
             except RuntimeError:
@@ -465,13 +493,11 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, p
                           inputs_hash={s: hashes[s] for s in keep})
         if plotted:
             folder.mkdir(parents=True, exist_ok=True)
-            taken = plotter.share()
-            mine_to_draw = [s for s in plotted if s in pending or s in taken]
             mine = {}
-            if mine_to_draw:
+            if pending:  # not handed to the plotter (no fork here, or results that do not pickle)
                 from .plots import save_stage_plot
 
-            for stage in mine_to_draw:
+            for stage in pending:
                 try:
                     mine[stage] = save_stage_plot(stage, results, folder)
                 except Exception as exc:  # the same report as from the child: the stage and the cause
