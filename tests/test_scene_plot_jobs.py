@@ -104,13 +104,3 @@ def test_a_failing_plot_is_reported_with_its_stage(tmp_path, monkeypatch, jobs):
     with pytest.raises(RuntimeError, match="plots of identify.*ValueError: no figure today"):
         run_scene(DEMO, out=tmp_path / "c.h5", plots_dir=tmp_path / "c", plot_jobs=jobs)
 
-
-def test_the_helper_takes_the_later_figures_at_about_half_the_cost():
-    # the plotting process forks a helper for the later waiting figures, so that both CPUs draw: it takes
-    # from the end while its share costs no more than what is left to the plotter
-    from balancer.scene.runner import _split_for_helper
-
-    assert _split_for_helper([]) == 0 and _split_for_helper(["identify"]) == 0
-    assert _split_for_helper(["identify", "adb_stability"]) == 1
-    # 0.04 + 0.14 left against compressor + mounts (0.1 + 0.04); taking adb_response too would leave 0.04
-    assert _split_for_helper(["adb_stability", "adb_response", "compressor", "mounts"]) == 2

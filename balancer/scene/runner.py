@@ -156,38 +156,9 @@ def _open_earlier(path) -> h5py.File | None:
     return f
 
 
-#: rough CPU cost (s) of each stage's figures: used only to split the waiting figures between the plotting
-#: process and its helper (the files do not depend on it)
-_PLOT_COST_S = {"identify": 0.15, "adb_response": 0.14, "compressor": 0.1, "adb_stability": 0.04, "mounts": 0.04}
-
-
-def _split_for_helper(waiting: list[str]) -> int:
-    """How many figures, from the end of ``waiting``, a helper takes so that both halves cost about the same
-    (0 when fewer than two wait)."""
-    cost = [_PLOT_COST_S.get(stage, 0.1) for stage in waiting]
-    taken = 0
-    while taken < len(waiting) - 1 and sum(cost[len(cost) - taken - 1:]) <= sum(cost[:len(cost) - taken - 1]):
-        taken += 1
-    return taken
-
-
-def _draw_and_report(stages: list[tuple[str, str]], folder: Path, save_stage_plot) -> dict:
-    """Draw each (stage, pickled results file) pair; {"drawn": {stage: paths}} and "error" on the first failure."""
-    import os
-    import pickle
-
-    drawn: dict[str, list[str]] = {}
-    for index, (stage, payload) in enumerate(stages):
-        try:
-            with open(payload, "rb") as handle:
-                given = pickle.load(handle)
-            os.unlink(payload)
-            drawn[stage] = [str(p) for p in save_stage_plot(stage, given, folder)]
-        except Exception as exc:  # the same report as from the parent: the stage and the cause
-            for _stage, rest in stages[index:]:
-                Path(rest).unlink(missing_ok=True)
-            return {"drawn": drawn, "error": f"plots of {stage}: {type(exc).__name__}: {exc}"}
-    return {"drawn": drawn}
+#: size of one job record on the plotters' pipe: written at once (atomic below PIPE_BUF) and read whole by
+#: whichever drawing process is free
+_RECORD = 1024
 
 
 def _write_report(fd: int, report: dict) -> None:
@@ -227,17 +198,48 @@ def _fork_quietly() -> int:
     return pid
 
 
-class _Plotter:
-    """A forked process that draws the stage plots while the parent runs the stages (``plot_jobs > 1``).
+def _draw_jobs(jobs_read: int, folder: Path) -> dict:
+    """Take job records from the pipe until it is closed and draw each; {"drawn": {stage: paths}}, with
+    "error" naming the stage and the cause of the first failure (the later jobs are then only discarded)."""
+    import os
+    import pickle
 
-    Started before the first stage, it imports the plotting modules (matplotlib) while the parent
-    computes.  Each plot stage's results (with those of the stages it depends on) are pickled to a
-    temporary file as soon as they are complete and announced through a pipe (the parent never waits on
-    the plotter); the plotter draws them in that order (atomic writes, as
-    :func:`~balancer.scene.plots.save_stage_plot`).  When two or more figures wait, it forks a helper,
-    which inherits matplotlib already imported, for the later ones: both CPUs draw once the parent is
-    done, and matplotlib is imported once.  ``started`` is False (everything drawn in the parent) where
-    ``os.fork`` is missing or more than one thread is alive (forking a threaded process is unsafe).
+    from .plots import save_stage_plot
+
+    drawn: dict[str, list[str]] = {}
+    error = None
+    while True:
+        record = os.read(jobs_read, _RECORD)
+        while record and len(record) < _RECORD:  # not expected (records are written whole), but be exact
+            more = os.read(jobs_read, _RECORD - len(record))
+            if not more:
+                break
+            record += more
+        if not record:
+            return {"drawn": drawn} if error is None else {"drawn": drawn, "error": error}
+        job = json.loads(record)
+        try:
+            if error is None:
+                with open(job["file"], "rb") as handle:
+                    given = pickle.load(handle)
+                drawn[job["stage"]] = [str(p) for p in save_stage_plot(job["stage"], given, folder)]
+        except Exception as exc:  # the same report as from the parent: the stage and the cause
+            error = f"plots of {job['stage']}: {type(exc).__name__}: {exc}"
+        finally:
+            Path(job["file"]).unlink(missing_ok=True)
+
+
+class _Plotter:
+    """Two forked processes that draw the stage plots while the parent runs the stages (``plot_jobs > 1``).
+
+    The plotter is forked before the first stage and imports the plotting modules (matplotlib) while the
+    parent computes; then it forks a helper, which inherits them, and both take figures from one queue
+    (whichever is free draws the next), so matplotlib is imported once and both CPUs draw once the parent
+    is done.  Each plot stage's results (with those of the stages it depends on) are pickled to a temporary
+    file as soon as they are complete and announced by a fixed-size record on a pipe (the parent never
+    waits on the plotters).  Figures are written atomically, as by
+    :func:`~balancer.scene.plots.save_stage_plot`.  ``started`` is False (everything drawn in the parent)
+    where ``os.fork`` is missing or more than one thread is alive (forking a threaded process is unsafe).
     """
 
     def __init__(self, jobs: int, folder: Path):
@@ -279,77 +281,33 @@ class _Plotter:
         os.close(report_write)
         self.pid = pid
 
-    # ---- plotter side
     def _serve(self, jobs_read: int) -> dict:
+        """The plotter: import, fork the helper, draw; the two reports merged."""
         import os
-        import select
 
-        from .plots import save_stage_plot  # matplotlib, imported while the parent computes
+        from . import plots  # noqa: F401 - matplotlib, imported while the parent computes
 
-        todo: list[tuple[str, str]] = []
-        drawn: dict[str, list[str]] = {}
-        errors: list[str] = []
-        helper: tuple[int, int] | None = None  # (pid, report fd) of the running helper
-        buffer, ended = b"", False
-
-        def reap(block: bool) -> None:
-            nonlocal helper
-            if helper is None or (not block and os.waitpid(helper[0], os.WNOHANG)[0] == 0):
-                return
-            report = _read_report(helper[1])
-            if block:
-                os.waitpid(helper[0], 0)
-            drawn.update(report.get("drawn", {}))
-            if "error" in report:
-                errors.append(report["error"])
-            helper = None
-
-        while True:
-            # what the parent has sent; wait for it only when there is nothing to draw
-            while not ended and (not todo or select.select([jobs_read], [], [], 0)[0]):
-                chunk = os.read(jobs_read, 65536)
-                if not chunk:
-                    ended = True
-                    break
-                *lines, buffer = (buffer + chunk).split(b"\n")
-                for line in lines:
-                    message = json.loads(line)
-                    if message.get("end"):
-                        ended = True
-                    else:
-                        todo.append((message["stage"], message["file"]))
-            reap(block=False)
-            if todo and not errors:
-                share = _split_for_helper([stage for stage, _file in todo]) if helper is None else 0
-                if share:
-                    read, write = os.pipe()
-                    pid = _fork_quietly()
-                    if pid == 0:  # helper: the later figures
-                        code = 1
-                        try:
-                            os.close(read)
-                            report = _draw_and_report(todo[-share:], self.folder, save_stage_plot)
-                            code = 1 if "error" in report else 0
-                        except BaseException as exc:  # noqa: BLE001
-                            report = {"error": f"{type(exc).__name__}: {exc}"}
-                        try:
-                            _write_report(write, report)
-                        finally:
-                            os._exit(code)
-                    os.close(write)
-                    helper = (pid, read)
-                    todo = todo[:-share]
-                report = _draw_and_report(todo[:1], self.folder, save_stage_plot)
-                todo = todo[1:]
-                drawn.update(report["drawn"])
-                if "error" in report:
-                    errors.append(report["error"])
-                continue
-            if ended:
-                for _stage, payload in todo:  # not drawn after a failure
-                    Path(payload).unlink(missing_ok=True)
-                reap(block=True)
-                return {"drawn": drawn, **({"error": "; ".join(errors)} if errors else {})}
+        read, write = os.pipe()
+        helper = _fork_quietly()
+        if helper == 0:
+            code = 1
+            try:
+                os.close(read)
+                report = _draw_jobs(jobs_read, self.folder)
+                code = 1 if "error" in report else 0
+            except BaseException as exc:  # noqa: BLE001
+                report = {"error": f"{type(exc).__name__}: {exc}"}
+            try:
+                _write_report(write, report)
+            finally:
+                os._exit(code)
+        os.close(write)
+        mine = _draw_jobs(jobs_read, self.folder)
+        theirs = _read_report(read)
+        os.waitpid(helper, 0)
+        errors = [r["error"] for r in (mine, theirs) if "error" in r]
+        return {"drawn": {**mine.get("drawn", {}), **theirs.get("drawn", {})},
+                **({"error": "; ".join(errors)} if errors else {})}
 
     # ---- parent side
     def submit(self, stage: str, results: dict) -> bool:
@@ -364,8 +322,10 @@ class _Plotter:
         try:
             with os.fdopen(handle, "wb") as out:
                 pickle.dump(results, out, protocol=pickle.HIGHEST_PROTOCOL)
-            line = json.dumps({"stage": stage, "file": payload}).encode() + b"\n"
-            os.write(self._jobs, line)  # a short line: the pipe never fills
+            record = json.dumps({"stage": stage, "file": payload}).encode()
+            if len(record) > _RECORD:
+                raise ValueError("job record too long")
+            os.write(self._jobs, record.ljust(_RECORD))  # one atomic write; the pipe holds 64 records
         except Exception:  # noqa: BLE001 - results that do not pickle (or a plotter gone) are drawn here
             Path(payload).unlink(missing_ok=True)
             return False
@@ -379,11 +339,7 @@ class _Plotter:
 
         if not self.started:
             return {}
-        try:
-            os.write(self._jobs, json.dumps({"end": True}).encode() + b"\n")
-        except BrokenPipeError:  # the plotter has ended (its report says why)
-            pass
-        os.close(self._jobs)
+        os.close(self._jobs)  # the end of the queue for both drawing processes
         report = _read_report(self._report)
         os.waitpid(self.pid, 0)
         self.pid = None
