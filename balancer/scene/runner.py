@@ -283,8 +283,12 @@ class _Plotter:
 
     def _serve(self, jobs_read: int) -> dict:
         """The plotter: import, fork the helper, draw; the two reports merged."""
+        import gc
         import os
 
+        # a short-lived process that ends with os._exit: cyclic garbage (a drawn figure) need not be
+        # collected, and not collecting saves ~7 % of the drawing
+        gc.disable()
         from . import plots  # noqa: F401 - matplotlib, imported while the parent computes
 
         read, write = os.pipe()
