@@ -387,8 +387,9 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, p
     progress : callable, optional
         Called with a line of text before and after each stage that runs.
     plot_jobs : int
-        Processes drawing the plots (POSIX only): with 2 or more, the plots of a stage are
-        drawn in a forked child as soon as the stage is done, while the next stages run
+        Processes drawing the plots (POSIX only): with 2 or more, two forked processes draw
+        them (matplotlib imported once, while this process starts on the stages), each
+        stage's plots as soon as the stage is done, while the next stages run
         (``python -m balancer run`` uses 2 on a machine with several CPUs).  The files are
         the same as with 1 (default: everything in this process).
     """
