@@ -9,6 +9,7 @@ from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 
 from .errors import ModalError
+from .figures import margins, plain_log_ticks
 from .frf import FRF, KIND_POWER
 from .model import mode_basis
 from .results import IdentificationResult
@@ -94,6 +95,11 @@ def _model_name(result: IdentificationResult) -> str:
     return result.method + (f"; {flagged} of {len(result.modes)} modes flagged" if flagged else "")
 
 
+def _spacing(gap_in: float, extent_in: float, n: int) -> float:
+    """matplotlib's wspace/hspace (a fraction of the mean axes size) for a gap in inches between n axes."""
+    return gap_in / ((extent_in - (n - 1) * gap_in) / n) if n > 1 else 0.0
+
+
 def plot_fit(frf: FRF, result: IdentificationResult | Sequence[IdentificationResult], channel: int | None = None,
              figure: Figure | None = None) -> Figure:
     """Magnitude and phase with the fitted model(s) over the data, and each mode's Nyquist plot.
@@ -127,10 +133,25 @@ def plot_fit(frf: FRF, result: IdentificationResult | Sequence[IdentificationRes
     n_modes = len(first)
     ncols = max(min(n_modes, _NYQUIST_COLUMNS), 2)
     nrows_nyq = max(-(-n_modes // _NYQUIST_COLUMNS), 1)
-    fig = figure if figure is not None else Figure(figsize=(11, 5 + 2.2 * nrows_nyq), layout="constrained")
-    grid = fig.add_gridspec(2 + nrows_nyq, ncols, height_ratios=[1.4, 1.0] + [1.1] * nrows_nyq)
-    ax_mag = fig.add_subplot(grid[0, :])
-    ax_phase = fig.add_subplot(grid[1, :], sharex=ax_mag)
+    if figure is None:
+        # margins fixed in inches (a layout engine would measure every label twice before drawing)
+        width, height = 11.0, 5.0 + 2.2 * nrows_nyq
+        fig = Figure(figsize=(width, height))
+        frame = margins(width, height, left=0.8, right=0.3, bottom=0.5, top=0.15)
+        inner_w, inner_h = width - 1.1, height - 0.65
+        # between the phase and the Nyquist rows: the phase's x label, a Nyquist title and its offset text
+        outer = fig.add_gridspec(2, 1, height_ratios=[2.4, 1.1 * nrows_nyq], hspace=_spacing(0.95, inner_h, 2),
+                                 left=frame["left"], right=frame["right"], bottom=frame["bottom"], top=frame["top"])
+        top_h = (inner_h - 0.95) * 2.4 / (2.4 + 1.1 * nrows_nyq)
+        top = outer[0].subgridspec(2, 1, height_ratios=[1.4, 1.0], hspace=_spacing(0.3, top_h, 2))
+        nyq = outer[1].subgridspec(nrows_nyq, ncols, wspace=_spacing(0.5, inner_w, ncols),
+                                   hspace=_spacing(0.75, inner_h - 0.95 - top_h, nrows_nyq))
+    else:
+        fig = figure
+        grid = fig.add_gridspec(2 + nrows_nyq, ncols, height_ratios=[1.4, 1.0] + [1.1] * nrows_nyq)
+        top, nyq = grid[:2, :].subgridspec(2, 1, height_ratios=[1.4, 1.0]), grid[2:, :].subgridspec(nrows_nyq, ncols)
+    ax_mag = fig.add_subplot(top[0, 0])
+    ax_phase = fig.add_subplot(top[1, 0], sharex=ax_mag)
     colours = [f"C{i % 10}" for i in range(len(channels))]
     if rms:
         data_rms = np.sqrt(np.mean(np.abs(data) ** 2, axis=0))
@@ -153,6 +174,7 @@ def plot_fit(frf: FRF, result: IdentificationResult | Sequence[IdentificationRes
         ax_phase.plot(f, np.degrees(np.angle(data[ch])), ".", ms=2, color=colour)
         for k, model in enumerate(models):
             ax_phase.plot(f, np.degrees(np.angle(model[ch])), _STYLES[k % 4], lw=1, color=colour)
+    plain_log_ticks(ax_mag.yaxis)
     ax_mag.set_ylabel(f"|H| [{frf.units}]")
     ax_mag.legend(loc="best", fontsize="x-small", ncol=1 + (len(channels) * (1 + len(results)) > 6))
     ax_phase.set_ylabel("phase [deg]")
@@ -164,7 +186,7 @@ def plot_fit(frf: FRF, result: IdentificationResult | Sequence[IdentificationRes
 
     power = KIND_POWER[frf.kind]
     for r, mode in enumerate(first):
-        ax = fig.add_subplot(grid[2 + r // _NYQUIST_COLUMNS, r % _NYQUIST_COLUMNS])
+        ax = fig.add_subplot(nyq[r // _NYQUIST_COLUMNS, r % _NYQUIST_COLUMNS])
         if channel is not None:
             ch = channel
         else:

@@ -527,3 +527,14 @@ def test_every_public_parameter_is_documented():
             missing += [f"{module.__name__}.{name}({p})" for p in inspect.signature(obj).parameters
                         if not re.search(rf"\b{p}\b", doc)]
     assert missing == []
+
+
+@pytest.mark.parametrize("series", [None, "leading"])
+def test_objective_of_many_fractions_is_each_fractions_own(seed000, series):
+    # shaking_objective searches every fraction's peaks at once (one numpy call per zoom pass); the same
+    # grid and passes as one fraction at a time (the scalar path), so the same numbers to the last bit
+    mech = seed000 if series is None else dataclasses.replace(seed000, series=series)
+    alphas = np.linspace(-0.5, 1.0, 31)
+    together = shaking_objective(mech, SPEED_000_RPM, alphas)
+    alone = [shaking_objective(mech, SPEED_000_RPM, [a])[0] for a in alphas]
+    np.testing.assert_array_equal(together, alone)

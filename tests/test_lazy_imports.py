@@ -11,7 +11,8 @@ ROOT = Path(__file__).resolve().parent.parent
 
 def _modules_after(code: str) -> dict:
     script = (f"import sys, json\nsys.path.insert(0, {str(ROOT)!r})\n{code}\n"
-              "print(json.dumps({m: m in sys.modules for m in ('balancer.influence', 'matplotlib.figure')}))")
+              "print(json.dumps({m: m in sys.modules for m in ('balancer.influence', 'matplotlib.figure', 'scipy.optimize',"
+              "'scipy.integrate', 'scipy.linalg')}))")
     proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, proc.stderr[-2000:]
     return json.loads(proc.stdout.strip().splitlines()[-1])
@@ -30,3 +31,14 @@ def test_the_scene_command_line_leaves_the_influence_command_out():
     code = "import balancer.cli\nassert balancer.cli.main(['run', 'no_such_scene.toml']) == 1"
     assert _modules_after(code)["balancer.influence"] is False
     assert _modules_after("import balancer.cli\nbalancer.cli.build_parser()")["balancer.influence"] is True
+
+
+def test_the_scene_runner_imports_the_solvers_only_when_a_stage_needs_them():
+    # `python -m balancer run` forks its plotting process before the first stage: what the parent has
+    # imported by then is paid before both processes can work, so the solvers (scipy.optimize ~0.1 s,
+    # scipy.integrate, scipy.linalg) wait until a stage calls them
+    loaded = _modules_after("import balancer.cli, balancer.scene.runner, balancer.scene.plots")
+    assert not any(loaded[m] for m in ("scipy.optimize", "scipy.integrate", "scipy.linalg"))
+    assert _modules_after("from balancer.adb import ADBParameters, simulate\n"
+                          "simulate(ADBParameters(M=1.0, m=0.02, n=2, R=0.05, e=5e-4, k=1e4, c=20.0, D=1e-3), 150.0,"
+                          " 0.05)")["scipy.integrate"] is True

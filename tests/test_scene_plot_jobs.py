@@ -103,3 +103,4 @@ def test_a_failing_plot_is_reported_with_its_stage(tmp_path, monkeypatch, jobs):
     monkeypatch.setitem(plots._FIGURES, "identify", broken)
     with pytest.raises(RuntimeError, match="plots of identify.*ValueError: no figure today"):
         run_scene(DEMO, out=tmp_path / "c.h5", plots_dir=tmp_path / "c", plot_jobs=jobs)
+

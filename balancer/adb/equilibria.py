@@ -23,7 +23,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import brentq
 
 from modal.errors import ParameterError
 
@@ -66,6 +65,8 @@ def symmetric_spacing_rad(n: int, unbalance_ratio: float) -> float:
 
     def kernel(delta: float) -> float:
         return math.sin(n * delta / 2.0) / math.sin(delta / 2.0) - a
+
+    from scipy.optimize import brentq  # scipy.optimize only when solving (import ~0.1 s)
 
     return brentq(kernel, 1e-12, 2.0 * math.pi / n, xtol=1e-15, rtol=4 * np.finfo(float).eps)
 

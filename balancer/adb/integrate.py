@@ -17,7 +17,6 @@ from dataclasses import dataclass
 from typing import Any, Sequence
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 from modal.errors import ParameterError
 
@@ -207,6 +206,8 @@ def integrate(
         options["jac"] = jac
         if chosen == "LSODA" and batch.size > 1:
             options["lband"] = options["uband"] = size - 1
+    from scipy.integrate import solve_ivp  # scipy.integrate only when simulating
+
     solution = solve_ivp(fun, (times[0], times[-1]), y0.reshape(-1), method=chosen, t_eval=times,
                          rtol=rtol_eff, atol=atol_eff, **options)
     if solution.status != 0:

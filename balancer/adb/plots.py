@@ -8,6 +8,8 @@ from matplotlib.axes import Axes
 from matplotlib.colors import ListedColormap
 from matplotlib.figure import Figure
 
+from modal.figures import plain_log_ticks
+
 from .simulate import SimulationResult
 from .stability import StabilityMap
 from .studies import SettlingStudy
@@ -99,6 +101,7 @@ def plot_amplitude(result: SimulationResult, *, ax: Axes | None = None, log: boo
         ax.axvline(result.settling_time_s, ls="--", color="k", lw=0.8, label="balls settled")
     if log:
         ax.set_yscale("log")
+        plain_log_ticks(ax.yaxis)
     ax.set_xlabel("time (s)")
     ax.set_ylabel("amplitude (m)")
     ax.set_title(f"final state: {result.final_state}")

@@ -14,7 +14,6 @@ from dataclasses import dataclass
 from typing import Any, Sequence
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 from modal.errors import ParameterError
 
@@ -340,6 +339,8 @@ def _integrate_clamped_then_free(params, profile, y0, times, release, frame, met
     max_speed = float(np.max(np.abs(profile.speed_rad_s(times)))) if not constant else abs(profile.speed)
     atol = _absolute_tolerances(batch, rtol, max_speed, frame == "fixed")
     before = times[times <= release]
+    from scipy.integrate import solve_ivp  # scipy.integrate only when simulating
+
     first = solve_ivp(fun, (times[0], release), y0, method="DOP853", t_eval=np.append(before, release)
                       if before[-1] < release else before, rtol=rtol, atol=atol, dense_output=False)
     if first.status != 0:
@@ -463,6 +464,8 @@ def _without_balls(params, profile, frame, position, velocity, speed0, times, rt
 
         def fun(t, y):
             return bare(y, float(profile.speed_rad_s(t)), float(profile.acceleration_rad_s2(t)))
+    from scipy.integrate import solve_ivp
+
     solution = solve_ivp(fun, (times[0], times[-1]), y0, method="DOP853", t_eval=times, rtol=rtol, atol=atol)
     if solution.status != 0:
         raise ParameterError(f"integration without balls failed: {solution.message}")

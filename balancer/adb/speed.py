@@ -91,12 +91,18 @@ class LinearRunUp:
 
     def speed_rad_s(self, time_s):
         """Speed (rad/s) at ``time_s``."""
+        if isinstance(time_s, float):  # one time (the integrator's case): plain floats, the same arithmetic
+            fraction = min(max((time_s - self.start_time_s) / self.duration_s, 0.0), 1.0)
+            return self.start_speed + (self.end_speed - self.start_speed) * fraction
         fraction = np.clip((np.asarray(time_s, dtype=float) - self.start_time_s) / self.duration_s, 0.0, 1.0)
         value = self.start_speed + (self.end_speed - self.start_speed) * fraction
         return value if np.ndim(time_s) else float(value)
 
     def acceleration_rad_s2(self, time_s):
         """Angular acceleration (rad/s^2); the ramp rate inside ``[start, end)``, else 0."""
+        if isinstance(time_s, float):
+            inside = self.start_time_s <= time_s < self.start_time_s + self.duration_s
+            return self.rate_rad_s2 if inside else 0.0
         t = np.asarray(time_s, dtype=float)
         inside = (t >= self.start_time_s) & (t < self.start_time_s + self.duration_s)
         value = np.where(inside, self.rate_rad_s2, 0.0)

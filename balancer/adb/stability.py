@@ -11,7 +11,6 @@ from dataclasses import dataclass
 from typing import Iterator, Sequence
 
 import numpy as np
-from scipy.optimize import brentq
 
 from modal.errors import ParameterError
 
@@ -269,6 +268,8 @@ def stable_speed_intervals(
         low, high = speeds[index], speeds[index + 1]
         if growth(low) * growth(high) > 0.0:
             return high if stable[index + 1] else low
+        from scipy.optimize import brentq  # scipy.optimize only when refining (import ~0.1 s)
+
         return brentq(growth, low, high, xtol=xtol_ratio * wn, rtol=4 * np.finfo(float).eps)
 
     intervals = []

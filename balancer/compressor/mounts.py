@@ -33,7 +33,6 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import linalg
 
 from modal.errors import ParameterError
 
@@ -289,6 +288,8 @@ def damping_matrix(system: MountedBody) -> np.ndarray:
     """
     damping = _mount_damping_matrix(system.mounts)
     if system.damping_ratio > 0.0:
+        from scipy import linalg  # scipy.linalg only when solving (generalised eigenproblem)
+
         mass = mass_matrix(system.body)
         eig, shapes = linalg.eigh(stiffness_matrix(system.mounts), mass)
         omega = np.sqrt(eig)
@@ -388,6 +389,8 @@ def natural_modes(system: MountedBody) -> MountModes:
     -------
     MountModes
     """
+    from scipy import linalg
+
     mass = mass_matrix(system.body)
     eig, shapes = linalg.eigh(stiffness_matrix(system.mounts), mass)
     share = shapes * (mass @ shapes)

@@ -6,6 +6,7 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
+from modal.figures import fixed_figure
 from modal.io._atomic import atomic_path
 
 __all__ = ["stage_figures", "save_stage_plot"]
@@ -22,7 +23,7 @@ def _identify(results):
 def _stability(results):
     stage = results["adb_stability"]
     wn = stage.intervals.natural_frequency_rad_s
-    fig = Figure(figsize=(7, 4), layout="constrained")
+    fig = fixed_figure(7, 4, left=0.75, right=0.2, bottom=0.55, top=0.35)
     ax = fig.add_subplot()
     ax.plot(stage.speeds_rad_s / wn, stage.max_real_part_per_s, lw=1.2)
     ax.axhline(0, color="0.5", lw=0.8)
@@ -38,7 +39,8 @@ def _response(results):
     from ..adb.plots import plot_amplitude, plot_ball_angles, plot_orbit, plot_run_up
 
     r = results["adb_response"]
-    fig = Figure(figsize=(10, 7), layout="constrained")
+    # the left column's log labels (10⁻¹²) and the right column's y label set the gaps
+    fig = fixed_figure(10, 7, left=0.85, right=0.15, bottom=0.5, top=0.35, wgap=0.95, hgap=0.6, ncols=2, nrows=2)
     ax_amp, ax_orbit, ax_balls, ax_runup = fig.subplots(2, 2).ravel()
     plot_amplitude(r, ax=ax_amp)
     plot_orbit(r, ax=ax_orbit)
@@ -58,7 +60,7 @@ def _compressor(results):
 
 def _mounts(results):
     m = results["mounts"]
-    fig = Figure(figsize=(7, 4), layout="constrained")
+    fig = fixed_figure(7, 4, left=0.7, right=0.15, bottom=0.5, top=0.15)  # bottom: the rotated tick labels
     ax = fig.add_subplot()
     before = m.comparison.base_force_amplitude_before_n
     after = m.comparison.base_force_amplitude_after_n
@@ -123,6 +125,7 @@ def save_stage_plot(stage: str, results, folder: Path) -> list[Path]:
     for name, fig in stage_figures(stage, results):
         path = Path(folder) / f"{stage}_{name}.png"
         with atomic_path(path) as tmp:
-            fig.savefig(tmp, dpi=100, format="png")
+            # zlib level 3: the same pixels, ~10 % larger files, a third less time than the default 6
+            fig.savefig(tmp, dpi=100, format="png", pil_kwargs={"compress_level": 3})
         paths.append(path)
     return paths

@@ -156,102 +156,215 @@ def _open_earlier(path) -> h5py.File | None:
     return f
 
 
-class _PlotWorkers:
-    """Stage plots rendered in forked child processes while the parent goes on (``plot_jobs > 1``).
+#: size of one job record on the plotters' pipe: written at once (atomic below PIPE_BUF) and read whole by
+#: whichever drawing process is free
+_RECORD = 1024
 
-    Each child renders the figures of the stages it is given (atomic writes, as in
-    :func:`~balancer.scene.plots.save_stage_plot`) and reports the paths, or the error,
-    through a pipe.  Falls back to the parent (``submit`` returns False) where ``os.fork``
-    is missing, with more than one thread alive (forking a threaded process is unsafe),
-    or when ``plot_jobs - 1`` children are already running.
+
+def _write_report(fd: int, report: dict) -> None:
+    import os
+
+    data = json.dumps(report).encode()
+    while data:
+        data = data[os.write(fd, data):]
+
+
+def _read_report(fd: int) -> dict:
+    import os
+
+    chunks = []
+    while True:
+        chunk = os.read(fd, 65536)
+        if not chunk:
+            break
+        chunks.append(chunk)
+    os.close(fd)
+    return json.loads(b"".join(chunks) or b'{"error": "plot process ended without a report"}')
+
+
+def _fork_quietly() -> int:
+    """``os.fork`` with the garbage collector's objects frozen around it, so that the child's collections
+    do not write to (and copy) every page of the parent's objects."""
+    import gc
+    import os
+    import sys
+
+    sys.stdout.flush()
+    sys.stderr.flush()
+    gc.freeze()
+    pid = os.fork()
+    if pid != 0:
+        gc.unfreeze()
+    return pid
+
+
+def _draw_jobs(jobs_read: int, folder: Path) -> dict:
+    """Take job records from the pipe until it is closed and draw each; {"drawn": {stage: paths}}, with
+    "error" naming the stage and the cause of the first failure (the later jobs are then only discarded)."""
+    import os
+    import pickle
+
+    from .plots import save_stage_plot
+
+    drawn: dict[str, list[str]] = {}
+    error = None
+    while True:
+        record = os.read(jobs_read, _RECORD)
+        while record and len(record) < _RECORD:  # not expected (records are written whole), but be exact
+            more = os.read(jobs_read, _RECORD - len(record))
+            if not more:
+                break
+            record += more
+        if not record:
+            return {"drawn": drawn} if error is None else {"drawn": drawn, "error": error}
+        job = json.loads(record)
+        try:
+            if error is None:
+                with open(job["file"], "rb") as handle:
+                    given = pickle.load(handle)
+                drawn[job["stage"]] = [str(p) for p in save_stage_plot(job["stage"], given, folder)]
+        except Exception as exc:  # the same report as from the parent: the stage and the cause
+            error = f"plots of {job['stage']}: {type(exc).__name__}: {exc}"
+        finally:
+            Path(job["file"]).unlink(missing_ok=True)
+
+
+class _Plotter:
+    """Two forked processes that draw the stage plots while the parent runs the stages (``plot_jobs > 1``).
+
+    The plotter is forked before the first stage and imports the plotting modules (matplotlib) while the
+    parent computes; then it forks a helper, which inherits them, and both take figures from one queue
+    (whichever is free draws the next), so matplotlib is imported once and both CPUs draw once the parent
+    is done.  Each plot stage's results (with those of the stages it depends on) are pickled to a temporary
+    file as soon as they are complete and announced by a fixed-size record on a pipe (the parent never
+    waits on the plotters).  Figures are written atomically, as by
+    :func:`~balancer.scene.plots.save_stage_plot`.  ``started`` is False (everything drawn in the parent)
+    where ``os.fork`` is missing or more than one thread is alive (forking a threaded process is unsafe).
     """
 
-    def __init__(self, jobs: int, folder: Path, results: dict):
+    def __init__(self, jobs: int, folder: Path):
         import os
         import threading
 
-        self.jobs = max(1, int(jobs))
         self.folder = folder
-        self.results = results
-        self.children: list[tuple[int, int, tuple[str, ...]]] = []
-        self.finished: set[int] = set()
+        self.pid: int | None = None
+        self._payloads: list[str] = []
         self._drawn: list[Path] = []
-        self.usable = self.jobs > 1 and hasattr(os, "fork") and threading.active_count() == 1
+        if max(1, int(jobs)) > 1 and hasattr(os, "fork") and threading.active_count() == 1:
+            self._fork()
 
-    def submit(self, stages: tuple[str, ...]) -> bool:
+    @property
+    def started(self) -> bool:
+        return self.pid is not None
+
+    def _fork(self) -> None:
         import os
-        import sys
-
-        if not stages or not self.usable or self._running() >= self.jobs - 1:
-            return False
-        from .plots import save_stage_plot
 
         self.folder.mkdir(parents=True, exist_ok=True)
-        sys.stdout.flush()
-        sys.stderr.flush()
+        jobs_read, self._jobs = os.pipe()
+        self._report, report_write = os.pipe()
+        pid = _fork_quietly()
+        if pid == 0:  # plotter: draw, report, leave without running the parent's exit handlers
+            code = 1
+            try:
+                os.close(self._jobs)
+                os.close(self._report)
+                report = self._serve(jobs_read)
+                code = 1 if "error" in report else 0
+            except BaseException as exc:  # noqa: BLE001 - reported to the parent, which raises it
+                report = {"error": f"{type(exc).__name__}: {exc}"}
+            try:
+                _write_report(report_write, report)
+            finally:
+                os._exit(code)
+        os.close(jobs_read)
+        os.close(report_write)
+        self.pid = pid
+
+    def _serve(self, jobs_read: int) -> dict:
+        """The plotter: import, fork the helper, draw; the two reports merged."""
+        import gc
+        import os
+
+        # a short-lived process that ends with os._exit: cyclic garbage (a drawn figure) need not be
+        # collected, and not collecting saves ~7 % of the drawing
+        gc.disable()
+        from . import plots  # noqa: F401 - matplotlib, imported while the parent computes
+
         read, write = os.pipe()
-        pid = os.fork()
-        if pid == 0:  # child: render, report, leave without running the parent's exit handlers
-            code = 0
+        helper = _fork_quietly()
+        if helper == 0:
+            code = 1
             try:
                 os.close(read)
-                paths = [str(p) for stage in stages for p in save_stage_plot(stage, self.results, self.folder)]
-                message = json.dumps({"paths": paths})
-            except BaseException as exc:  # noqa: BLE001 - reported to the parent, which raises it
-                message, code = json.dumps({"error": f"{type(exc).__name__}: {exc}"}), 1
+                report = _draw_jobs(jobs_read, self.folder)
+                code = 1 if "error" in report else 0
+            except BaseException as exc:  # noqa: BLE001
+                report = {"error": f"{type(exc).__name__}: {exc}"}
             try:
-                os.write(write, message.encode())
+                _write_report(write, report)
             finally:
                 os._exit(code)
         os.close(write)
-        self.children.append((pid, read, stages))
+        mine = _draw_jobs(jobs_read, self.folder)
+        theirs = _read_report(read)
+        os.waitpid(helper, 0)
+        errors = [r["error"] for r in (mine, theirs) if "error" in r]
+        return {"drawn": {**mine.get("drawn", {}), **theirs.get("drawn", {})},
+                **({"error": "; ".join(errors)} if errors else {})}
+
+    # ---- parent side
+    def submit(self, stage: str, results: dict) -> bool:
+        """Hand a stage's plot to the plotter; False if it stays with the parent."""
+        import os
+        import pickle
+        import tempfile
+
+        if not self.started:
+            return False
+        handle, payload = tempfile.mkstemp(prefix="modalbal-plot-", suffix=".pickle")
+        try:
+            with os.fdopen(handle, "wb") as out:
+                pickle.dump(results, out, protocol=pickle.HIGHEST_PROTOCOL)
+            record = json.dumps({"stage": stage, "file": payload}).encode()
+            if len(record) > _RECORD:
+                raise ValueError("job record too long")
+            os.write(self._jobs, record.ljust(_RECORD))  # one atomic write; the pipe holds 64 records
+        except Exception:  # noqa: BLE001 - results that do not pickle (or a plotter gone) are drawn here
+            Path(payload).unlink(missing_ok=True)
+            return False
+        self._payloads.append(payload)
         return True
 
-    def _running(self) -> int:
-        """Children still drawing (finished ones are reaped; their reports wait in the pipes)."""
+    def collect(self) -> dict[str, list[Path]]:
+        """Tell the plotter there is nothing more, wait for it; the paths of each stage it drew (raises
+        RuntimeError if a figure failed there)."""
         import os
 
-        for pid, _read, _stages in self.children:
-            if pid not in self.finished and os.waitpid(pid, os.WNOHANG)[0] == pid:
-                self.finished.add(pid)
-        return sum(pid not in self.finished for pid, _read, _stages in self.children)
+        if not self.started:
+            return {}
+        os.close(self._jobs)  # the end of the queue for both drawing processes
+        report = _read_report(self._report)
+        os.waitpid(self.pid, 0)
+        self.pid = None
+        for payload in self._payloads:  # left behind by a failure
+            Path(payload).unlink(missing_ok=True)
+        done = {stage: [Path(p) for p in paths] for stage, paths in report.get("drawn", {}).items()}
+        for paths in done.values():
+            self._drawn.extend(paths)
+        if "error" in report:
+            raise RuntimeError(report["error"])
+        return done
 
     def abandon(self) -> None:
-        """Wait for every child and remove the plots they drew (the run failed)."""
-        try:
-            self.collect()
-        except RuntimeError:
-            pass
+        """Wait for the plotter and remove the plots it drew (the run failed)."""
+        if self.started:
+            try:
+                self.collect()
+            except RuntimeError:
+                pass
         for path in self._drawn:
             path.unlink(missing_ok=True)
-
-    def collect(self) -> dict[str, list[Path]]:
-        """Wait for every child; the paths of each stage's plots (raises if a child failed)."""
-        import os
-
-        done: dict[str, list[Path]] = {}
-        errors = []
-        for pid, read, stages in self.children:
-            chunks = []
-            while True:
-                chunk = os.read(read, 65536)
-                if not chunk:
-                    break
-                chunks.append(chunk)
-            os.close(read)
-            if pid not in self.finished:
-                os.waitpid(pid, 0)
-            report = json.loads(b"".join(chunks) or b'{"error": "plot process ended without a report"}')
-            if "error" in report:
-                errors.append(f"plots of {', '.join(stages)}: {report['error']}")
-                continue
-            for path in map(Path, report["paths"]):
-                self._drawn.append(path)
-                done.setdefault(next(s for s in stages if path.name.startswith(s + "_")), []).append(path)
-        self.children, self.finished = [], set()
-        if errors:
-            raise RuntimeError("; ".join(errors))
-        return done
 
 
 def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, plots_dir: str | Path | None = None,
@@ -274,8 +387,9 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, p
     progress : callable, optional
         Called with a line of text before and after each stage that runs.
     plot_jobs : int
-        Processes drawing the plots (POSIX only): with 2 or more, the plots of a stage are
-        drawn in a forked child as soon as the stage is done, while the next stages run
+        Processes drawing the plots (POSIX only): with 2 or more, two forked processes draw
+        them (matplotlib imported once, while this process starts on the stages), each
+        stage's plots as soon as the stage is done, while the next stages run
         (``python -m balancer run`` uses 2 on a machine with several CPUs).  The files are
         the same as with 1 (default: everything in this process).
     """
@@ -306,19 +420,22 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, p
     if plotted:
         folder = Path(plots_dir) if plots_dir is not None else (
             archive_path.with_name(archive_path.stem + "_plots") if archive_path else Path("out") / f"{_slug(name)}_plots")
-    workers = _PlotWorkers(plot_jobs, folder, results) if plotted else None
-    pending = list(plotted)  # plot stages not yet handed to a child, in output order
+    plotter = _Plotter(plot_jobs, folder) if plotted else None
+    pending = list(plotted)  # plot stages not yet handed to the child, in output order
 
     def hand_over() -> None:
-        # plots whose stage and upstream results are all there go to a child while the parent runs on
-        ready = tuple(s for s in pending if s in results and all(status[t] != "ran" or t in results
-                                                                  for t in dependencies(scene, s)))
-        if workers is not None and ready and workers.submit(ready):
-            for s in ready:
-                pending.remove(s)
+        # plots whose stage and upstream results are all there go to the child while the parent runs on
+        for stage in list(pending):
+            if stage not in results or not all(status[t] != "ran" or t in results for t in dependencies(scene, stage)):
+                continue
+            given = {s: results[s] for s in _closure(scene, [stage]) if s in results}
+            if plotter.submit(stage, given):
+                pending.remove(stage)
 
     plot_paths = []
     try:
+        if plotter is not None and plotter.started:
+            hand_over()  # reused stages' plots can start at once
         for stage in STAGES:
             if status[stage] != "ran":
                 continue
@@ -328,7 +445,7 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, p
             results[stage] = STAGE_FUNCTIONS[stage](scene, **kwargs)
             timings[stage] = time.perf_counter() - t0
             say(f"{stage}: done in {timings[stage]:.2f} s")
-            if stage in pending:
+            if plotter is not None and plotter.started and pending:
                 hand_over()
         if archive_path is not None:
             keep = [s for s in STAGES if s in results and (stored is True or stored is False or s in stored)]
@@ -336,25 +453,22 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, p
             write_archive(archive_path, {s: results[s] for s in keep}, scene_text=scene.text or None,
                           inputs_hash={s: hashes[s] for s in keep})
         if plotted:
-            from .plots import save_stage_plot
-
             folder.mkdir(parents=True, exist_ok=True)
-            # split what is left: a child takes the second half while this process draws the first
-            half = (len(pending) + 1) // 2
-            if workers.submit(tuple(pending[half:])):
-                pending = pending[:half]
             mine = {}
+            if pending:  # not handed to the plotter (no fork here, or results that do not pickle)
+                from .plots import save_stage_plot
+
             for stage in pending:
                 try:
                     mine[stage] = save_stage_plot(stage, results, folder)
-                except Exception as exc:  # the same report as from a child: the stage and the cause
+                except Exception as exc:  # the same report as from the child: the stage and the cause
                     raise RuntimeError(f"plots of {stage}: {type(exc).__name__}: {exc}") from exc
-            theirs = workers.collect()
+            theirs = plotter.collect()
             for stage in plotted:
                 plot_paths += mine.get(stage, theirs.get(stage, []))
     except BaseException:
-        if workers is not None:  # a failed run leaves no plots drawn early by a child
-            workers.abandon()
+        if plotter is not None:  # a failed run leaves no plots drawn by the child
+            plotter.abandon()
         raise
     from .summary import format_summary
 

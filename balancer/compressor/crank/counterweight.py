@@ -6,7 +6,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import optimize
 
 from modal.errors import ParameterError
 
@@ -274,6 +273,8 @@ def optimal_counterweight(mech: SliderCrank, speed_rpm: float, objective: Object
         return _objective_value(mech, omega, (m_rot + alpha * m_rec) * r, objective)
 
     # For "max" a coarse bracket suffices: the equal-peak root polishes it.
+    from scipy import optimize  # scipy.optimize only when optimising (import ~0.1 s)
+
     res = optimize.minimize_scalar(phi, bounds=(lower, upper), method="bounded",
                                    options={"xatol": 1e-7 if objective == "max" else 1e-10})
     alpha, method = float(res.x), "bounded Brent"
@@ -318,6 +319,8 @@ def _polish_equal_peak(mech: SliderCrank, omega: float, alpha: float, lower: flo
         u = (m_rot + a * m_rec) * r
         return _local_peak(mech, omega, u, angle_a, half_width)[1] - _local_peak(
             mech, omega, u, angle_b, half_width)[1]
+
+    from scipy import optimize
 
     step = 1e-6
     for _ in range(20):

@@ -1,0 +1,78 @@
+"""Figures drawn cheaply (issue 19 goal 4): fixed margins instead of a layout engine, log labels without
+mathtext; nothing may overlap or fall off the figure because of it."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.ticker import LogFormatterSciNotation
+
+from modal.figures import PlainLogFormatter, margins
+
+ROOT = Path(__file__).resolve().parent.parent
+DEMO = ROOT / "data" / "synthetic" / "demo_scene.toml"
+
+
+@pytest.mark.parametrize("low, high, value, text", [(1e-4, 1e13, 1e-3, "10⁻³"), (1e-4, 1e13, 1.0, "10⁰"),
+                                                     (1e-4, 1e13, 1e12, "10¹²"), (1e-3, 1e-2, 2e-3, "2×10⁻³"),
+                                                     (1e4, 3e4, 2e4, "2×10⁴")])
+def test_plain_log_labels_say_what_mathtext_said(low, high, value, text):
+    from matplotlib.figure import Figure
+
+    ax = Figure().add_subplot()
+    ax.set_yscale("log")
+    ax.set_ylim(low, high)
+    labels = []
+    for formatter in (PlainLogFormatter(labelOnlyBase=False), LogFormatterSciNotation(labelOnlyBase=False)):
+        formatter.set_axis(ax.yaxis)
+        formatter.set_locs([value])
+        labels.append(formatter(value))
+    plain, math = labels
+    assert plain == text and "$" not in plain
+    # mathtext said the same: e.g. $\mathdefault{2\times10^{-3}}$
+    mantissa, _, exponent = text.translate(str.maketrans("⁻⁰¹²³⁴⁵⁶⁷⁸⁹", "-0123456789")).partition("10")
+    assert math == r"$\mathdefault{" + mantissa.replace("×", r"\times") + "10^{" + exponent + "}}$"
+
+
+def test_margins_in_inches():
+    frame = margins(10.0, 5.0, left=1.0, right=0.5, bottom=0.5, top=0.25, wgap=1.0, hgap=0.5, ncols=2, nrows=2)
+    assert frame["left"] == pytest.approx(0.1) and frame["right"] == pytest.approx(0.95)
+    assert frame["bottom"] == pytest.approx(0.1) and frame["top"] == pytest.approx(0.95)
+    # axes (10 - 1.5 - 1) / 2 = 3.75 in wide, (5 - 0.75 - 0.5) / 2 = 1.875 in high
+    assert frame["wspace"] == pytest.approx(1.0 / 3.75) and frame["hspace"] == pytest.approx(0.5 / 1.875)
+    with pytest.raises(ValueError, match="no room"):
+        margins(2.0, 2.0, left=1.0, right=1.0, bottom=0.1, top=0.1)
+
+
+@pytest.fixture(scope="module")
+def demo_results(tmp_path_factory):
+    from balancer.scene import run_scene
+
+    folder = tmp_path_factory.mktemp("demo")
+    scene = dict(__import__("tomllib").loads(DEMO.read_text()))
+    scene["outputs"] = {**scene["outputs"], "plots": [], "archive": False}
+    scene["frf"] = {**scene["frf"], "file": str(DEMO.parent / scene["frf"]["file"])}
+    return run_scene(scene, plots_dir=folder).results
+
+
+@pytest.mark.parametrize("stage", ["identify", "adb_stability", "adb_response", "mounts"])
+def test_scene_figures_fit_without_a_layout_engine(demo_results, stage):
+    from balancer.scene.plots import stage_figures
+
+    for name, fig in stage_figures(stage, demo_results):
+        assert fig.get_layout_engine() is None, name
+        canvas = FigureCanvasAgg(fig)
+        canvas.draw()
+        renderer = canvas.get_renderer()
+        width, height = canvas.get_width_height()
+        # each axes with all it draws (tick labels, axis labels, title, legend, offset text)
+        boxes = [ax.get_tightbbox(renderer) for ax in fig.axes]
+        for ax, box in zip(fig.axes, boxes):  # on the figure (1 px of antialiasing)
+            assert box.x0 >= -1 and box.y0 >= -1 and box.x1 <= width + 1 and box.y1 <= height + 1, (name, ax.get_title())
+            for label in ax.get_xticklabels() + ax.get_yticklabels():
+                assert "$" not in label.get_text(), label.get_text()  # no mathtext
+        for i, a in enumerate(boxes):  # no axes' labels run into another axes
+            for b in boxes[i + 1:]:
+                overlap = (min(a.x1, b.x1) - max(a.x0, b.x0), min(a.y1, b.y1) - max(a.y0, b.y0))
+                assert min(overlap) <= 1.0, (stage, name, a, b)
