@@ -16,8 +16,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .model import mode_basis, mode_basis_derivatives
-
 __all__ = ["NLSFit", "fit_modes", "truncation_shift"]
 
 
@@ -38,6 +36,12 @@ class NLSFit:
         Residual estimate of E|n|² per channel.
     converged : bool
     n_iter : int
+    residual : ndarray, shape (n_freq, n_channels), optional
+        Residual of the fit, each channel divided by its ``channel_scale`` (and each line
+        times its weight, for a weighted fit).
+    channel_scale : ndarray, shape (n_channels,), optional
+        max |H| of each channel over the lines, FRF unit (``residual`` is divided by it, or by 1
+        where it is 0).
     """
 
     omega_n: np.ndarray
@@ -48,6 +52,8 @@ class NLSFit:
     noise_var: np.ndarray
     converged: bool
     n_iter: int
+    residual: np.ndarray | None = None
+    channel_scale: np.ndarray | None = None
 
 
 #: largest damping ratio the fit may reach (far past critical: the mode is then a slope)
@@ -75,15 +81,26 @@ def _background(x, region, n_regions, powers):
     return cols.reshape(x.size, -1)
 
 
-def _design(x, params, power, background):
+def _design(x, params, power, background, kind=None, x2=None):
+    """Design (n_freq, n_modes + n_background) and its pole derivatives (n_freq, 2 n_modes).
+
+    :func:`modal.model.mode_basis` and :func:`modal.model.mode_basis_derivatives` (the same
+    arithmetic, so the same values), with the denominator formed once and, given ``kind``
+    = (i x)^p and ``x2`` = x², nothing recomputed that does not depend on the poles.
+    """
     n_modes = params.size // 2
-    xr, zeta = params[0::2], params[1::2]
-    phi = mode_basis(x, xr, zeta, power)
-    Phi = np.hstack([phi.T, background])
-    d_x, d_zeta = mode_basis_derivatives(x, xr, zeta, power)
+    xr, zeta = params[0::2][None, :], params[1::2][None, :]
+    w = x[:, None]
+    kind = ((1j * x) ** power if kind is None else kind)[:, None]
+    w2 = (x**2 if x2 is None else x2)[:, None]
+    denom = xr**2 - w2 + 2j * zeta * xr * w
+    Phi = np.empty((x.size, n_modes + background.shape[1]), dtype=complex)
+    np.divide(kind, denom, out=Phi[:, :n_modes])
+    Phi[:, n_modes:] = background
+    num = kind / denom**2
     dphi = np.empty((x.size, 2 * n_modes), dtype=complex)
-    dphi[:, 0::2] = d_x.T
-    dphi[:, 1::2] = d_zeta.T
+    dphi[:, 0::2] = -num * (2 * xr + 2j * zeta * w)
+    dphi[:, 1::2] = -num * (2j * xr * w)
     return Phi, dphi
 
 
@@ -158,9 +175,10 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
     omega = np.asarray(omega, float)
     Y_raw = np.atleast_2d(np.asarray(response, complex))
     n_ch = Y_raw.shape[0]
-    ch_scale = np.abs(Y_raw).max(axis=1)
-    ch_scale[ch_scale == 0] = 1.0
-    Y = np.ascontiguousarray((Y_raw / ch_scale[:, None]).T)  # (n_freq, n_ch), each channel scaled to max 1
+    peak = np.abs(Y_raw).max(axis=1)
+    ch_scale = np.where(peak > 0, peak, 1.0)
+    # (n_freq, n_ch), each channel scaled to max 1 (divided and transposed in one pass)
+    Y = np.divide(Y_raw.T, ch_scale[None, :], out=np.empty((Y_raw.shape[1], n_ch), dtype=complex))
     w_ref = float(np.median(np.atleast_1d(omega_n0)))
     x = omega / w_ref
     n_regions = 0 if region is None else int(region.max()) + 1
@@ -192,8 +210,10 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
         Y = Y * weight if compressed else Y_full
         background = background * weight
 
+    kind, x2 = (1j * x) ** power, x**2  # what the design takes from the lines alone
+
     def evaluate(p):
-        Phi, dphi = _design(x, p, power, background)
+        Phi, dphi = _design(x, p, power, background, kind, x2)
         if weight is not None:  # the modes' columns (the background's are weighted once, above)
             Phi[:, :n_modes] *= weight
             dphi = dphi * weight
@@ -259,11 +279,13 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
     if Y is not Y_full:  # back to the channels: one projection of the full data
         Y = Y_full
         QhY = Q.conj().T @ Y
-        res = Y - Q @ QhY
+        res = np.subtract(Y, Q @ QhY)
     n_freq = x.size
     n_b = Phi.shape[1]
     C = np.linalg.solve(R, QhY)
-    rss = np.sum(np.abs(res) ** 2, axis=0)
+    parts = np.ascontiguousarray(res).view(float)  # Re, Im side by side: |r|² summed without a temporary per line
+    rss = np.einsum("ij,ij->j", parts, parts)
+    rss = rss[0::2] + rss[1::2]
     dof = n_freq - n_b - n_theta / (2 * n_ch)
     noise_var = rss / dof if dof > 0 else np.full(n_ch, np.nan)
     # Fisher information of the poles (Schur complement via the projected Jacobian)
@@ -324,6 +346,8 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
         noise_var=noise_var * ch_scale**2,
         converged=bool(converged),
         n_iter=n_iter,
+        residual=res,
+        channel_scale=peak,
     )
 
 
