@@ -28,19 +28,21 @@ because a mode found this way has not passed peak detection.
 """
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
 from scipy import special
 
+from .frf import line_spacing
 from .model import mode_basis, solve_linear
 from .nls import fit_modes
 from .peaks import neighbour_noise_std
 from .units import TWO_PI
 
 __all__ = [
-    "MissingMode", "find_missing_mode", "fit_residual_noise_std", "residual_noise_std", "residual_structure",
-    "restart_pole", "SIGNIFICANCE",
+    "MissingMode", "find_missing_mode", "fit_residual", "fit_residual_noise_std", "residual_noise_std",
+    "residual_structure", "restart_pole", "SIGNIFICANCE",
 ]
 
 #: false-alarm probability of each test for one added mode
@@ -100,10 +102,29 @@ def _residual(omega, response, omega_n, zeta, power, region):
     return response - (design @ coef).T
 
 
+def fit_residual(omega: np.ndarray, response: np.ndarray, power: int, region: np.ndarray,
+                 omega_n, damping_ratio) -> np.ndarray:
+    """Residual (n_channels, n_freq) of the modes at the given poles, their constants and one
+    complex offset per region solved linearly: what every check here measures."""
+    omega_n = np.atleast_1d(np.asarray(omega_n, float))
+    zeta = np.atleast_1d(np.asarray(damping_ratio, float))
+    return _residual(omega, response, omega_n, zeta, power, region)
+
+
+def _strongest(score: np.ndarray) -> np.ndarray:
+    """Indices of the ``CHECK_CHANNELS`` highest scores, highest first."""
+    if score.size == 1:
+        return np.zeros(1, dtype=int)
+    return np.argsort(score)[::-1][:CHECK_CHANNELS]
+
+
 def _smoothed(values: np.ndarray, region: np.ndarray, width: int) -> np.ndarray:
     """Moving average over ``width`` lines within each region (no mixing across gaps)."""
-    out = np.empty_like(values)
     kernel = np.ones(width) / width
+    if not region.size or region.min() == region.max():  # one region
+        w = min(width, values.size)
+        return np.convolve(values, kernel[:w] * width / w, mode="same")
+    out = np.empty_like(values)
     for r in np.unique(region):
         sel = region == r
         seg = values[sel]
@@ -118,7 +139,13 @@ def _level(energy: np.ndarray, n_channels: int) -> float:
     The mean of ``n_channels`` Exp(1) variables is Gamma(n, 1/n), with median
     ``gammaincinv(n, 0.5)/n``: ln 2 for one channel, 0.96 for eight.
     """
-    return float(np.median(energy)) / (float(special.gammaincinv(n_channels, 0.5)) / n_channels)
+    return float(np.median(energy)) / _exp_mean_median(n_channels)
+
+
+@functools.lru_cache(maxsize=64)
+def _exp_mean_median(n_channels: int) -> float:
+    """Median of the mean of ``n_channels`` Exp(1) variables: gammaincinv(n, 1/2)/n."""
+    return float(special.gammaincinv(n_channels, 0.5)) / n_channels
 
 
 def _seen_through(res, omega, response, noise_std):
@@ -127,7 +154,7 @@ def _seen_through(res, omega, response, noise_std):
 
 
 def residual_noise_std(omega: np.ndarray, response: np.ndarray, power: int, region: np.ndarray,
-                       omega_n, damping_ratio, noise_std) -> np.ndarray:
+                       omega_n, damping_ratio, noise_std, residual: np.ndarray | None = None) -> np.ndarray:
     """Noise σ per channel as the fit's residual shows it.
 
     The raw-data estimate (:func:`modal.peaks.estimate_noise_std`) takes in the
@@ -145,14 +172,14 @@ def residual_noise_std(omega: np.ndarray, response: np.ndarray, power: int, regi
         As for :func:`find_missing_mode`.
     noise_std : ndarray, shape (n_channels,)
         Raw-data estimate per channel.
+    residual : ndarray, shape (n_channels, n_freq), optional
+        The fit's residual if the caller has it (:func:`fit_residual`); computed otherwise.
 
     Returns
     -------
     ndarray, shape (n_channels,)
     """
-    omega_n = np.atleast_1d(np.asarray(omega_n, float))
-    zeta = np.atleast_1d(np.asarray(damping_ratio, float))
-    res = _residual(omega, response, omega_n, zeta, power, region)
+    res = residual if residual is not None else fit_residual(omega, response, power, region, omega_n, damping_ratio)
     return _seen_through(res, omega, response, np.asarray(noise_std, float))
 
 
@@ -179,7 +206,8 @@ def fit_residual_noise_std(omega: np.ndarray, fit, noise_std) -> np.ndarray:
 
 
 def residual_structure(omega: np.ndarray, response: np.ndarray, power: int, region: np.ndarray,
-                       omega_n, damping_ratio, peak: np.ndarray | None = None) -> float:
+                       omega_n, damping_ratio, residual: np.ndarray | None = None,
+                       peak: np.ndarray | None = None) -> float:
     """How far the fit's residual is from white: its variance over its line-to-line noise.
 
     The residual variance (sum of squares over the degrees of freedom) is
@@ -191,7 +219,7 @@ def residual_structure(omega: np.ndarray, response: np.ndarray, power: int, regi
 
     Parameters
     ----------
-    omega, response, power, region, omega_n, damping_ratio, peak
+    omega, response, power, region, omega_n, damping_ratio, residual, peak
         As for :func:`find_missing_mode`.
 
     Returns
@@ -202,14 +230,19 @@ def residual_structure(omega: np.ndarray, response: np.ndarray, power: int, regi
     omega_n = np.atleast_1d(np.asarray(omega_n, float))
     zeta = np.atleast_1d(np.asarray(damping_ratio, float))
     peak = np.max(np.abs(response), axis=1) if peak is None else peak
-    strongest = np.argsort(peak)[::-1][:CHECK_CHANNELS]
-    res = _residual(omega, response[strongest], omega_n, zeta, power, region)
+    strongest = _strongest(peak)
+    if residual is not None:
+        res = residual[strongest]
+    else:
+        res = _residual(omega, response[strongest], omega_n, zeta, power, region)
     dof = omega.size - omega_n.size - (int(region.max()) + 1) - omega_n.size / res.shape[0]
     if dof <= 0:
         return np.nan
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = np.sum(np.abs(res) ** 2, axis=1) / dof / neighbour_noise_std(omega, res) ** 2
     ratio = ratio[np.isfinite(ratio)]
+    if ratio.size == 1:
+        return float(ratio[0])
     return float(np.median(ratio)) if ratio.size else np.nan
 
 
@@ -241,7 +274,7 @@ def restart_pole(omega: np.ndarray, response: np.ndarray, power: int, region: np
     if np.count_nonzero(in_band) < 3 or omega_n.size == 0:
         return None
     scale = np.max(np.abs(response), axis=1)
-    strongest = np.argsort(scale)[::-1][:CHECK_CHANNELS]
+    strongest = _strongest(scale)
     scale = np.where(scale[strongest] > 0, scale[strongest], 1.0)
     res = _residual(omega, response[strongest], omega_n, zeta, power, region)
     energy = np.mean(np.abs(res) ** 2 / scale[:, None] ** 2, axis=0)
@@ -253,6 +286,8 @@ def restart_pole(omega: np.ndarray, response: np.ndarray, power: int, region: np
 
 def find_missing_mode(omega: np.ndarray, response: np.ndarray, power: int, region: np.ndarray,
                       omega_n, damping_ratio, noise_std, bands_rad,
+                      residual: np.ndarray | None = None,
+                      residual_noise: np.ndarray | None = None,
                       peak: np.ndarray | None = None) -> MissingMode | None:
     """Test the residual of fitted modes for one more mode.
 
@@ -273,6 +308,12 @@ def find_missing_mode(omega: np.ndarray, response: np.ndarray, power: int, regio
         noise as the residual shows it (:func:`residual_noise_std`).
     bands_rad : list of (low, high)
         The fitting bands, rad/s.
+    residual : ndarray, shape (n_channels, n_freq), optional
+        The residual of the fitted modes if the caller has it (:func:`fit_residual`);
+        computed otherwise.
+    residual_noise : ndarray, shape (n_channels,), optional
+        :func:`residual_noise_std` of that residual if the caller has it (it is per
+        channel, so the strongest channels' values are the same); computed otherwise.
     peak : ndarray, shape (n_channels,), optional
         max |H| of each channel on these lines, when the caller has it (a fit's
         ``channel_scale``): the strongest channels are chosen by it.
@@ -287,16 +328,20 @@ def find_missing_mode(omega: np.ndarray, response: np.ndarray, power: int, regio
     if not (np.all(np.isfinite(noise_std)) and np.all(noise_std > 0) and omega.size > 8):
         return None
     peak = np.max(np.abs(response), axis=1) if peak is None else peak
-    strongest = np.argsort(peak / noise_std)[::-1][:CHECK_CHANNELS]
+    strongest = _strongest(peak / noise_std)
     Y = response[strongest]
     n_ch = Y.shape[0]
-    res = _residual(omega, Y, omega_n, zeta, power, region)
-    sigma2 = _seen_through(res, omega, Y, noise_std[strongest]) ** 2
+    res = residual[strongest] if residual is not None else _residual(omega, Y, omega_n, zeta, power, region)
+    if residual_noise is not None:
+        sigma2 = np.asarray(residual_noise, float)[strongest] ** 2
+    else:
+        sigma2 = _seen_through(res, omega, Y, noise_std[strongest]) ** 2
     if not np.all(sigma2 > 0):
         return None
     energy = np.mean(np.abs(res) ** 2 / sigma2[:, None], axis=0)
-    spacing = float(np.median(np.diff(omega)))
-    width = int(np.clip(np.round(np.median(2 * zeta * omega_n) / spacing), 3, max(3, omega.size // 4)))
+    spacing = line_spacing(omega)
+    half_power = float(np.median(2 * zeta * omega_n)) if zeta.size > 1 else float(2 * zeta[0] * omega_n[0])
+    width = int(min(max(round(half_power / spacing), 3), max(3, omega.size // 4)))
     smooth = _smoothed(energy, region, width)
     # screen (cheap): the smoothed residual must rise above its noise level by 4 of its
     # standard deviations (1/sqrt(lines × channels) of an Exp(1) mean); the level is the

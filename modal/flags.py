@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .frf import line_spacing
 from .results import FLAG_TEXT
 
 __all__ = ["CHI2_LIMIT", "RELATIVE_MISFIT", "lines_near_mode", "FLAG_ACTION", "INFORMATIONAL", "DRIVING_POINT_ONLY", "TRANSFER_ONLY", "channel_flags", "contradictions",
@@ -27,7 +28,7 @@ RELATIVE_MISFIT = 0.03
 def lines_near_mode(omega: np.ndarray, omega_n: float, damping_ratio: float) -> np.ndarray:
     """The lines (mask over ``omega``, rad/s) where :data:`RELATIVE_MISFIT` is measured for a mode at
     ``omega_n`` (rad/s): within ±3 half-power widths of it, at least ±3 line spacings."""
-    spacing = float(np.median(np.diff(omega))) if omega.size > 1 else 0.0
+    spacing = line_spacing(omega) if omega.size > 1 else 0.0
     return np.abs(omega - omega_n) <= max(3 * 2 * damping_ratio * omega_n, 3 * spacing)
 
 #: What to do when a flag is raised.

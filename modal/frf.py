@@ -24,6 +24,19 @@ KIND_POWER = {"receptance": 0, "mobility": 1, "accelerance": 2}
 DEFAULT_UNITS = {"receptance": "m/N", "mobility": "m/s/N", "accelerance": "m/s^2/N"}
 
 
+def line_spacing(omega: np.ndarray) -> float:
+    """Median spacing of a frequency axis (any unit; the axis has at least two lines).
+
+    The common case, an evenly spaced axis, is recognised from the extreme spacings without
+    sorting (the median of ``numpy.diff`` costs a partition on every call of the checks).
+    """
+    steps = omega[1:] - omega[:-1]
+    low, high = float(steps.min()), float(steps.max())
+    if high - low <= 1e-9 * abs(high):
+        return (low + high) / 2
+    return float(np.median(steps))
+
+
 def kind_factor(omega_rad_s: np.ndarray, kind: str) -> np.ndarray:
     """Factor (iω)**p that turns a receptance into an FRF of ``kind``.
 

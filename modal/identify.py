@@ -6,15 +6,17 @@ import warnings
 
 import numpy as np
 
-from .checks import find_missing_mode, fit_residual_noise_std, residual_noise_std, residual_structure, restart_pole
+from .checks import (find_missing_mode, fit_residual, fit_residual_noise_std, residual_noise_std, residual_structure,
+                     restart_pole)
 from .circlefit import circle_fit_curve
 from .errors import IdentificationError, QualityWarning, ResolutionWarning, warn
 from .estimate.correction import remove_window_damping
 from .flags import CHI2_LIMIT, RELATIVE_MISFIT, lines_near_mode
-from .frf import FRF, KIND_POWER
+from .frf import FRF, KIND_POWER, line_spacing
 from .halfpower import half_power_curve
 from .model import mode_basis, solve_linear
 from .nls import fit_modes, truncation_shift
+from .rational import rational_pole
 from .propagate import combine_poles, constant_covariance, magnitude_to_complex
 from .peaks import ModeBand, bands_from_hz, estimate_noise_std, find_modes
 from .results import FLAG_TEXT, IdentificationResult, ModeResult, ModeStd, correlation_of, physical_covariance, physical_parameters
@@ -328,6 +330,67 @@ def _principal_start(frf, band, power, noise):
     return wn, zeta
 
 
+def _quick_start(frf, band, power, noise):
+    """(ωn, ζ) of a band's one-mode rational fit (:func:`modal.rational.rational_pole`) on its
+    strongest channels, or None when it gives no pole inside the band."""
+    keep = (frf.frequency_hz >= band.low_hz) & (frf.frequency_hz <= band.high_hz)
+    omega, h = frf.omega_rad_s[keep], frf.channels
+    if h.shape[0] > START_CHANNELS:  # the strongest channels first: no copy of every channel's band
+        strongest = np.argsort(_channel_weights(frf, band, noise))[::-1][:START_CHANNELS]
+        h, noise = h[strongest], np.asarray(noise)[strongest]
+    h = h[:, keep]
+    with np.errstate(all="ignore"):
+        pole = rational_pole(omega, h, noise)
+    if pole is None or not (TWO_PI * band.low_hz <= pole[0] <= TWO_PI * band.high_hz and 0 < pole[1] < 1):
+        return None
+    return pole
+
+
+def _doubtful(fit, bands) -> bool:
+    """Whether a band-wise NLS fit shows a sign of a poor start: not converged, a pole outside
+    its band, ζ at or past critical or not resolved (relative error above ``REL_STD_LIMIT``)."""
+    if not fit.converged or not np.all(np.isfinite(fit.noise_var)):
+        return True
+    wn, zeta = np.sort(fit.omega_n), fit.damping_ratio[np.argsort(fit.omega_n)]
+    s_zeta = np.sqrt(np.abs(fit.mode_cov[np.argsort(fit.omega_n), 0, 1, 1]))
+    low = TWO_PI * np.array([b.low_hz for b in bands])
+    high = TWO_PI * np.array([b.high_hz for b in bands])
+    return not (np.all((wn >= low) & (wn <= high)) and np.all((zeta > 0) & (zeta < 1))
+                and np.all(s_zeta <= REL_STD_LIMIT * zeta))
+
+
+def _nls_fit(frf, bands, power, noise, data=None):
+    """The band-wise NLS fit of every band's mode, from the cheapest start that serves.
+
+    Each band starts from its one-mode rational fit (a few linear solves); a band where
+    that gives no pole, or a fit that looks doubtful (:func:`_doubtful`), takes the
+    half-power and circle starts of :func:`_start_pole` as well (of :func:`_principal_start`,
+    one curve per band, for many channels), and the fit with the lower residual is kept.
+    ``data``: the :func:`_band_data` of the bands, when the caller has it.
+    """
+    quick = [_quick_start(frf, band, power, noise) for band in bands]
+    if all(q is not None for q in quick):
+        fit = _fit_bands(frf, bands, power, [q[0] for q in quick], [q[1] for q in quick], data=data)
+        if not _doubtful(fit, bands):
+            return fit
+    else:
+        fit = None
+    start = _principal_start if frf.n_channels > 1 else _start_pole
+    starts = [start(frf, band, power, noise) for band in bands]
+    careful = _fit_bands(frf, bands, power, [s[0] for s in starts], [s[1] for s in starts], data=data)
+    if fit is None or _fit_cost(careful) <= _fit_cost(fit):
+        return careful
+    return fit
+
+
+def _fit_cost(fit) -> float:
+    """Residual of a band-wise fit summed over channels, each scaled by its largest value."""
+    if not np.all(np.isfinite(fit.noise_var)):
+        return np.inf
+    scale = np.where(fit.channel_scale > 0, fit.channel_scale, 1.0)  # max |H| of each channel on the lines
+    return float(np.sum(fit.noise_var / scale**2))
+
+
 def _bandwise_covariance(frf, bands, power, poles, noise, own_constants=None):
     """Covariance (n_modes, n_ch, 4, 4) of (ωn, ζ, Re A, Im A) of the half-power or circle result.
 
@@ -461,7 +524,10 @@ def _chi2(residual_var, noise_std) -> float:
     """Median over channels of the residual variance over the estimated noise variance."""
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = residual_var / np.where(noise_std > 0, noise_std, np.nan) ** 2
-    return float(np.nanmedian(ratio)) if np.isfinite(ratio).any() else np.nan
+    if not np.isfinite(ratio).any():
+        return np.nan
+    kept = ratio[~np.isnan(ratio)]  # the nan-median, without its cost on one channel
+    return float(kept[0]) if kept.size == 1 else float(np.median(kept))
 
 
 def _band_noise(frf, bands, line_noise):
@@ -509,13 +575,14 @@ def _local_misfit(frf, bands, power, omega_n, damping_ratio, data=None) -> np.nd
     return out
 
 
-def _fit_noise(frf, bands, power, omega_n, damping_ratio, estimated_noise, channels=None, known=False, fit=None,
-               data=None):
+def _fit_noise(frf, bands, power, omega_n, damping_ratio, estimated_noise, channels=None, known=False, residual=None,
+               fit=None, data=None):
     """:func:`modal.checks.residual_noise_std` on the lines of the bands (all or some channels).
 
     ``known``: the noise came with the FRF (an estimate from time data) and is taken as it is.
-    ``fit``: the :func:`_fit_bands` fit of these poles on the same lines and channels, whose
-    residual is then used as it is (when it is unweighted); ``data``: :func:`_band_data` of them.
+    ``residual``: the fit's residual on those lines and channels, if the caller has it.
+    ``fit``: the :func:`_fit_bands` fit of these poles on the same lines and channels, whose own
+    residual is then used (when it is unweighted); ``data``: :func:`_band_data` of them.
     """
     rows = slice(None) if channels is None else channels
     if known:
@@ -526,7 +593,8 @@ def _fit_noise(frf, bands, power, omega_n, damping_ratio, estimated_noise, chann
             return fit_residual_noise_std(omega, fit, np.asarray(estimated_noise, float)[rows])
     omega, response, region = _band_data(frf, bands, channels) if data is None else data
     with np.errstate(all="ignore"):
-        return residual_noise_std(omega, response, power, region, omega_n, damping_ratio, estimated_noise[rows])
+        return residual_noise_std(omega, response, power, region, omega_n, damping_ratio, estimated_noise[rows],
+                                  residual)
 
 
 def _line_weight(frf, bands):
@@ -595,7 +663,7 @@ def _fit_bands(frf, bands, power, omega_n0, damping_ratio0, channels=None, data=
     return fit
 
 
-def _truncation(frf, bands, power, fit, channels=None, data=None):
+def _truncation(frf, bands, power, fit, channels=None, residual=None, data=None):
     """Shift of the fit when the band backgrounds gain a slope and a curvature, or None.
 
     Measured only where the residual is smooth across the lines (ratio of
@@ -604,12 +672,13 @@ def _truncation(frf, bands, power, fit, channels=None, data=None):
     truncation bias of the modes outside the bands (:func:`modal.nls.truncation_shift`).
     With white residuals the shift would be noise only and is not measured.
     Returns (pole shift (n_modes, 2), constant shift (n_modes, n_channels)) in
-    the fit's order of modes. ``data``: the :func:`_band_data` of these bands and channels.
+    the fit's order of modes. ``residual``: the fit's residual, if the caller has it; ``data``: the
+    :func:`_band_data` of these bands and channels.
     """
     omega, response, region = _band_data(frf, bands, channels) if data is None else data
     with np.errstate(all="ignore"):
-        structure = residual_structure(omega, response, power, region, fit.omega_n, fit.damping_ratio,
-                                       fit.channel_scale)
+        structure = residual_structure(omega, response, power, region, fit.omega_n, fit.damping_ratio, residual,
+                                       peak=fit.channel_scale)
     if not structure > STRUCTURED_RATIO:
         return None
     return truncation_shift(omega, response, power, region, fit)
@@ -622,14 +691,16 @@ def _with_shift(cov, pole_shift, constant_shift):
     return cov + d[:, :, None] * d[:, None, :]
 
 
-def _missing_mode(frf, bands, power, omega_n, damping_ratio, estimated_noise, data=None, peak=None):
-    """:func:`modal.checks.find_missing_mode` on the lines of the bands (``data``: their :func:`_band_data`;
-    ``peak``: max |H| of each channel there)."""
+def _missing_mode(frf, bands, power, omega_n, damping_ratio, estimated_noise, residual=None, residual_noise=None,
+                  data=None, peak=None):
+    """:func:`modal.checks.find_missing_mode` on the lines of the bands (``residual`` and ``residual_noise``:
+    the fit's residual and its :func:`modal.checks.residual_noise_std`, if known; ``data``: the bands'
+    :func:`_band_data`; ``peak``: max |H| of each channel there)."""
     omega, response, region = _band_data(frf, bands) if data is None else data
     bands_rad = [(TWO_PI * b.low_hz, TWO_PI * b.high_hz) for b in bands]
     with np.errstate(all="ignore"):
         return find_missing_mode(omega, response, power, region, omega_n, damping_ratio, estimated_noise,
-                                 bands_rad, peak)
+                                 bands_rad, residual, residual_noise, peak)
 
 
 def _overlap(per_mode, index) -> float:
@@ -723,7 +794,9 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
         data, else ``"nls"`` (:func:`choose_method`); ``result.method`` says
         which ran.
         ``"nls"``: complex nonlinear least squares of all modes
-        together, started from the better of half-power and circle fit.
+        together, each band started from its one-mode rational fit
+            (:func:`modal.rational.rational_pole`; from the better of half-power and
+            circle fit where that gives no pole or a doubtful fit).
         ``"global"``: poly-reference LSCF (PolyMAX) poles with a stabilisation
         diagram, then a joint refinement of all poles, modal constants and
         residual terms over the whole band (:func:`modal.global_.identify_global`;
@@ -882,17 +955,25 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
                 reference = (wn - d_wn, zeta - d_z, np.where(const_biased, const - d_const, const), noise_cov)
             per_mode.append((wn, zeta, const, cov, s_wn, s_z, flags, q, chi2, reference))
     else:
-        start = _principal_start if n_ch > 1 else _start_pole  # many channels: one curve per band
-        starts = [start(frf, band, power, noise) for band in bands]
         data = _band_data(frf, bands)  # the lines of the bands, taken out once
-        fit = _fit_bands(frf, bands, power, [s[0] for s in starts], [s[1] for s in starts], data=data)
-        chi2 = _chi2(fit.noise_var, _fit_noise(frf, bands, power, fit.omega_n, fit.damping_ratio,
-                                               estimated_noise, known=known_noise, fit=fit))
-        missing_mode = _missing_mode(frf, bands, power, fit.omega_n, fit.damping_ratio, estimated_noise, data,
-                                     fit.channel_scale)
+        fit = _nls_fit(frf, bands, power, noise, data)
+        # the checks all measure the residual of the same modes on the same lines: the fit's own when it is
+        # unweighted (no second solve), else computed once
+        own = fit.residual is not None and _line_weight(frf, bands) is None
+        if own:
+            residual = (fit.residual * np.where(fit.channel_scale > 0, fit.channel_scale, 1.0)).T
+        else:
+            with np.errstate(all="ignore"):
+                residual = fit_residual(data[0], data[1], power, data[2], fit.omega_n, fit.damping_ratio)
+        fit_noise = _fit_noise(frf, bands, power, fit.omega_n, fit.damping_ratio, estimated_noise, known=known_noise,
+                               residual=residual, fit=fit if own else None, data=data)
+        chi2 = _chi2(fit.noise_var, fit_noise)
+        # the check's noise is the residual's own: with a known noise (time data) it computes it itself
+        missing_mode = _missing_mode(frf, bands, power, fit.omega_n, fit.damping_ratio, estimated_noise, residual,
+                                     None if known_noise else fit_noise, data, fit.channel_scale)
         # near-exact data: the offset's truncation (modes outside the bands) biases the poles
         # beyond their white-noise errors; its measured shift is added to them (finding 26)
-        shift = _truncation(frf, bands, power, fit, data=data)
+        shift = _truncation(frf, bands, power, fit, residual=residual, data=data)
         order = np.argsort(fit.omega_n)  # two close poles may cross during the fit
         relative = _local_misfit(frf, bands, power, fit.omega_n[order], fit.damping_ratio[order], data)
         for b, (band, r) in enumerate(zip(bands, order)):
@@ -928,7 +1009,7 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
         if assumed:
             flags.add("driving_point_assumed")
         omega_b = frf.omega_rad_s[(frf.frequency_hz >= band.low_hz) & (frf.frequency_hz <= band.high_hz)]
-        spacing = float(np.median(np.diff(omega_b))) if omega_b.size > 1 else np.nan
+        spacing = line_spacing(omega_b) if omega_b.size > 1 else np.nan
         lines_per_bw = 2 * zeta * wn / spacing if spacing > 0 else np.nan
         others = [b.peak_hz for b in bands if b is not band and band.low_hz < b.peak_hz < band.high_hz]
         if _overlap(per_mode, index) > OVERLAP_LIMIT:

@@ -15,6 +15,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.linalg import lapack
 
 __all__ = ["NLSFit", "fit_modes", "truncation_shift"]
 
@@ -56,6 +57,8 @@ class NLSFit:
     channel_scale: np.ndarray | None = None
 
 
+_GEQRF, _UNGQR, _TRTRS, _POSV = lapack.zgeqrf, lapack.zungqr, lapack.ztrtrs, lapack.dposv
+
 #: largest damping ratio the fit may reach (far past critical: the mode is then a slope)
 ZETA_MAX = 10.0
 
@@ -69,6 +72,10 @@ def _background(x, region, n_regions, powers):
     """
     if not n_regions:
         return np.zeros((x.size, 0), dtype=complex)
+    if tuple(powers) == (0,):  # one complex offset per region
+        cols = np.zeros((x.size, n_regions), dtype=complex)
+        cols[np.arange(x.size), region] = 1.0
+        return cols
     lo = np.full(n_regions, np.inf)
     hi = np.full(n_regions, -np.inf)
     np.minimum.at(lo, region, x)
@@ -81,27 +88,22 @@ def _background(x, region, n_regions, powers):
     return cols.reshape(x.size, -1)
 
 
-def _design(x, params, power, background, kind=None, x2=None):
-    """Design (n_freq, n_modes + n_background) and its pole derivatives (n_freq, 2 n_modes).
+def _design(x, numerator, x_squared, params, out, dphi):
+    """Basis Φ = [modes | background] and ∂Φ/∂θ of the mode columns, written into ``out`` and ``dphi``.
 
-    :func:`modal.model.mode_basis` and :func:`modal.model.mode_basis_derivatives` (the same
-    arithmetic, so the same values), with the denominator formed once and, given ``kind``
-    = (i x)^p and ``x2`` = x², nothing recomputed that does not depend on the poles.
+    ``numerator`` is (i x)^p and ``x_squared`` x², computed once per fit; ``out`` holds the
+    background columns already (they do not depend on the poles).
     """
     n_modes = params.size // 2
-    xr, zeta = params[0::2][None, :], params[1::2][None, :]
-    w = x[:, None]
-    kind = ((1j * x) ** power if kind is None else kind)[:, None]
-    w2 = (x**2 if x2 is None else x2)[:, None]
-    denom = xr**2 - w2 + 2j * zeta * xr * w
-    Phi = np.empty((x.size, n_modes + background.shape[1]), dtype=complex)
-    np.divide(kind, denom, out=Phi[:, :n_modes])
-    Phi[:, n_modes:] = background
-    num = kind / denom**2
-    dphi = np.empty((x.size, 2 * n_modes), dtype=complex)
-    dphi[:, 0::2] = -num * (2 * xr + 2j * zeta * w)
-    dphi[:, 1::2] = -num * (2j * xr * w)
-    return Phi, dphi
+    xr, zeta = params[0::2, None], params[1::2, None]
+    damping = 2j * zeta * x  # (n_modes, n_freq)
+    denom = xr * xr - x_squared + damping * xr
+    phi = numerator / denom
+    slope = phi / denom
+    out[:, :n_modes] = phi.T
+    dphi[:, 0::2] = (-slope * (2 * xr + damping)).T
+    dphi[:, 1::2] = (-slope * (2j * xr * x)).T
+    return out, dphi
 
 
 def _compress(Y: np.ndarray, probes: np.ndarray) -> np.ndarray:
@@ -124,8 +126,39 @@ def _compress(Y: np.ndarray, probes: np.ndarray) -> np.ndarray:
     return Y @ V
 
 
+def _thin_qr(A: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Reduced QR of a complex (m, n) matrix; LAPACK's geqrf/ungqr called directly when m ≥ n
+    (half the call overhead of ``numpy.linalg.qr``, which dominates on a one-mode band)."""
+    m, n = A.shape
+    if m < n or n == 0:
+        return np.linalg.qr(A)
+    packed, tau, _work, info = _GEQRF(A)
+    if info != 0:
+        return np.linalg.qr(A)
+    R = np.triu(packed[:n])
+    Q, _work, info = _UNGQR(packed, tau, overwrite_a=1)
+    if info != 0:
+        return np.linalg.qr(A)
+    return Q, R
+
+
+def _solve_upper(R: np.ndarray, B: np.ndarray) -> np.ndarray:
+    """R⁻¹ B for an upper-triangular R (raises LinAlgError on an exactly singular R, as ``solve``)."""
+    X, info = _TRTRS(R, B)
+    if info != 0:
+        raise np.linalg.LinAlgError("singular triangular factor in the least-squares basis")
+    return X
+
+
+def _solve_spd(A: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """A⁻¹ b for the damped normal equations (symmetric positive definite): Cholesky through
+    LAPACK's posv, with ``numpy.linalg.solve`` where rounding leaves A not positive definite."""
+    _c, x, info = _POSV(A, b)
+    return x if info == 0 else np.linalg.solve(A, b)
+
+
 def _project(Phi, Y):
-    Q, R = np.linalg.qr(Phi)
+    Q, R = _thin_qr(Phi)
     Q = np.ascontiguousarray(Q)
     QhY = Q.conj().T @ Y
     res = Y - Q @ QhY
@@ -178,7 +211,8 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
     ch_scale = np.where(peak > 0, peak, 1.0)
     # (n_freq, n_ch), each channel scaled to max 1 (divided and transposed in one pass)
     Y = np.divide(Y_raw.T, ch_scale[None, :], out=np.empty((Y_raw.shape[1], n_ch), dtype=complex))
-    w_ref = float(np.median(np.atleast_1d(omega_n0)))
+    w_ref = np.atleast_1d(np.asarray(omega_n0, float))
+    w_ref = float(w_ref[0] if w_ref.size == 1 else np.median(w_ref))
     x = omega / w_ref
     n_regions = 0 if region is None else int(region.max()) + 1
     params = np.empty(2 * np.size(omega_n0))
@@ -190,61 +224,69 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
     x_lo, x_hi = 0.5 * x.min(), 2.0 * x.max()
     # a mode below the noise can be driven towards ζ = 0 step after step; it stops at a
     # half-power width of 1e-6 line spacings, far below anything the lines resolve
-    zeta_lo = 1e-6 * float(np.min(np.diff(x))) / (2 * x.max()) if x.size > 1 else 1e-12
-    params[0::2] = np.clip(params[0::2], x_lo, x_hi)
-    params[1::2] = np.clip(params[1::2], zeta_lo, ZETA_MAX)
+    zeta_lo = 1e-6 * float((x[1:] - x[:-1]).min()) / (2 * x.max()) if x.size > 1 else 1e-12
+    params[0::2] = np.minimum(np.maximum(params[0::2], x_lo), x_hi)
+    params[1::2] = np.minimum(np.maximum(params[1::2], zeta_lo), ZETA_MAX)
     Y_full = Y
     background = _background(x, region, n_regions, background_powers)
     if residual_terms:
         kind = (1j * x) ** power
         background = np.hstack([background, kind[:, None], (kind / -(x**2))[:, None]])
-    kind, x2 = (1j * x) ** power, x**2  # what the design takes from the lines alone
+    numerator, x_squared = (1j * x) ** power, x * x  # what the design takes from the lines alone
+    n_b = n_modes + background.shape[1]
 
     weight = None
     if line_weight is not None:
         weight = np.asarray(line_weight, float)[:, None]
         Y_full = Y = Y_full * weight
         background = background * weight
-    if n_ch > 2 * (2 * (n_modes + background.shape[1]) + 8):  # many channels: fit on fewer combinations
-        Phi0, dphi0 = _design(x, params, power, background, kind, x2)
+    if n_ch > 2 * (2 * n_b + 8):  # many channels: fit on fewer combinations
+        Phi0 = np.empty((x.size, n_b), dtype=complex)
+        Phi0[:, n_modes:] = background
+        Phi0, dphi0 = _design(x, numerator, x_squared, params, Phi0, np.empty((x.size, n_theta), complex))
         if weight is not None:
             Phi0[:, :n_modes] *= weight
-            dphi0 = dphi0 * weight
+            dphi0 *= weight
         Y = _compress(Y_full, np.hstack([Phi0, dphi0]))
 
     def evaluate(p):
-        Phi, dphi = _design(x, p, power, background, kind, x2)
+        Phi = np.empty((x.size, n_b), dtype=complex)
+        Phi[:, n_modes:] = background
+        Phi, dphi = _design(x, numerator, x_squared, p, Phi, np.empty((x.size, n_theta), complex))
         if weight is not None:  # the modes' columns (the background's are weighted once, above)
             Phi[:, :n_modes] *= weight
-            dphi = dphi * weight
+            dphi *= weight
         Q, R, QhY, res = _project(Phi, Y)
-        return Phi, dphi, Q, R, QhY, res, float(np.sum(res.real**2) + np.sum(res.imag**2))
+        return Phi, dphi, Q, R, QhY, res, float(np.vdot(res, res).real)
 
     state = evaluate(params)
+    mode_of = np.repeat(np.arange(n_modes), 2)
+    diagonal = np.arange(n_theta)
     lam = 1e-4
     converged = False
     n_iter = 0
     for n_iter in range(1, max_iter + 1):
         Phi, dphi, Q, R, QhY, res, cost = state
-        C = np.linalg.solve(R, QhY)  # (n_b, n_ch)
+        C = _solve_upper(R, QhY)  # (n_b, n_ch)
         E = dphi - Q @ (Q.conj().T @ dphi)  # projected basis derivatives, (n_freq, n_theta)
-        mode_of = np.repeat(np.arange(n_modes), 2)
         Cm = C[mode_of]  # (n_theta, n_ch): the coefficient multiplying each derivative
         EhE = E.conj().T @ E
         CCh = Cm.conj() @ Cm.T
         JtJ = np.real(EhE * CCh)
         g = -np.real(np.sum((E.conj().T @ Y) * Cm.conj(), axis=1))
-        diag = np.diag(JtJ).copy()
-        diag[diag <= 0] = 1e-300
+        diag = np.maximum(JtJ.diagonal(), 1e-300)
         accepted = False
         for _ in range(40):
             try:
-                step = np.linalg.solve(JtJ + lam * np.diag(diag), -g)
+                damped = JtJ.copy()
+                damped[diagonal, diagonal] += lam * diag
+                step = _solve_spd(damped, -g)
             except np.linalg.LinAlgError:
                 lam *= 10
                 continue
             trial = params + step
-            if lam <= 1e-2 and np.max(np.abs(step) / np.maximum(np.abs(params), 1e-300)) < step_tol:
+            rel_step = float(np.max(np.abs(step) / np.maximum(np.abs(params), 1e-300)))
+            if lam <= 1e-2 and rel_step < step_tol:
                 break  # the Gauss–Newton step is below rounding: converged, nothing to evaluate
             # a pole the step would push to ζ ≤ 0 (a mode below the noise sliding onto a
             # spike) moves to a tenth of its value instead; rejecting the whole step drove λ
@@ -252,22 +294,24 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
             # kept inside a box (ωn within a factor 2 of the lines, ζ ≤ ZETA_MAX) move halfway
             # to the bound, so an unidentifiable mode cannot run off to overflow
             x_r, zeta_t = trial[0::2], trial[1::2]
-            x_r = np.where(x_r < x_lo, (params[0::2] + x_lo) / 2, np.where(x_r > x_hi, (params[0::2] + x_hi) / 2, x_r))
-            zeta_t = np.where(zeta_t > 0, zeta_t, np.maximum(params[1::2] / 10, zeta_lo))
-            zeta_t = np.where(zeta_t > ZETA_MAX, (params[1::2] + ZETA_MAX) / 2, zeta_t)
-            trial[0::2], trial[1::2] = x_r, zeta_t
-            step = trial - params
-            if np.all(np.isfinite(trial)):
+            if x_r.min() < x_lo or x_r.max() > x_hi or zeta_t.min() <= 0 or zeta_t.max() > ZETA_MAX:
+                x_r = np.where(x_r < x_lo, (params[0::2] + x_lo) / 2,
+                               np.where(x_r > x_hi, (params[0::2] + x_hi) / 2, x_r))
+                zeta_t = np.where(zeta_t > 0, zeta_t, np.maximum(params[1::2] / 10, zeta_lo))
+                zeta_t = np.where(zeta_t > ZETA_MAX, (params[1::2] + ZETA_MAX) / 2, zeta_t)
+                trial[0::2], trial[1::2] = x_r, zeta_t
+                step = trial - params
+                rel_step = float(np.max(np.abs(step) / np.maximum(np.abs(params), 1e-300)))
+            if np.isfinite(trial).all():
                 new_state = evaluate(trial)
                 if new_state[-1] <= cost:
                     accepted = True
                     break
             lam *= 4
         if not accepted:
-            small = np.max(np.abs(step) / np.maximum(np.abs(params), 1e-300)) < step_tol
+            small = rel_step < step_tol
             converged = bool(small or cost <= 1e-28 * np.vdot(Y, Y).real)
             break
-        rel_step = np.max(np.abs(step) / np.maximum(np.abs(params), 1e-300))
         params, state = trial, new_state
         lam = max(lam / 3, 1e-12)
         flat = cost - new_state[-1] <= 1e-13 * cost  # no decrease left above rounding
@@ -282,7 +326,7 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
         res = np.subtract(Y, Q @ QhY)
     n_freq = x.size
     n_b = Phi.shape[1]
-    C = np.linalg.solve(R, QhY)
+    C = _solve_upper(R, QhY)
     parts = np.ascontiguousarray(res).view(float)  # Re, Im side by side: |r|² summed without a temporary per line
     rss = np.einsum("ij,ij->j", parts, parts)
     rss = rss[0::2] + rss[1::2]
@@ -290,7 +334,6 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
     noise_var = rss / dof if dof > 0 else np.full(n_ch, np.nan)
     # Fisher information of the poles (Schur complement via the projected Jacobian)
     E = dphi - Q @ (Q.conj().T @ dphi)
-    mode_of = np.repeat(np.arange(n_modes), 2)
     Cm = C[mode_of]
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         weights = np.where(noise_var > 0, 1.0 / noise_var, np.inf)
@@ -317,7 +360,7 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
         g_re, g_im = G.real, G.imag
         blk = mode_cov[r]
         idx = [2 * r, 2 * r + 1]
-        blk[:, :2, :2] = cov_theta[np.ix_(idx, idx)]
+        blk[:, :2, :2] = cov_theta[2 * r:2 * r + 2, 2 * r:2 * r + 2]
         cross_re = cov_theta[idx] @ g_re  # (2, n_ch)
         cross_im = cov_theta[idx] @ g_im
         blk[:, :2, 2] = cross_re.T

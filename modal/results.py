@@ -353,11 +353,12 @@ def physical_covariance(omega_n, damping_ratio, modal_constant, cov):
         k = m * omega_n**2
         c = 2.0 * damping_ratio * m * omega_n
         da_dre, da_dim = A.real / a, A.imag / a
-        # gradients with respect to (ωn, ζ, Re A, Im A)
-        zeros = np.zeros(A.shape)
-        g_m = np.stack([zeros, zeros, -m**2 * da_dre, -m**2 * da_dim], axis=-1)
-        g_k = np.stack([2 * m * omega_n + zeros, zeros, -k * m * da_dre, -k * m * da_dim], axis=-1)
-        g_c = np.stack([2 * damping_ratio * m + zeros, 2 * m * omega_n + zeros,
-                        -c * m * da_dre, -c * m * da_dim], axis=-1)
-        grad = np.stack([g_k, g_c, g_m], axis=-2)  # (..., 3, 4)
-        return np.einsum("...ai,...ij,...bj->...ab", grad, np.asarray(cov, float), grad)
+        # gradients of (k, c, m) with respect to (ωn, ζ, Re A, Im A): (..., 3, 4)
+        grad = np.zeros(A.shape + (3, 4))
+        grad[..., 0, 0] = 2 * m * omega_n
+        grad[..., 1, 0] = 2 * damping_ratio * m
+        grad[..., 1, 1] = 2 * m * omega_n
+        for row, value in enumerate((k, c, m)):
+            grad[..., row, 2] = -value * m * da_dre
+            grad[..., row, 3] = -value * m * da_dim
+        return grad @ np.asarray(cov, float) @ np.swapaxes(grad, -1, -2)
