@@ -19,8 +19,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from .nls import _thin_qr
-
 __all__ = ["rational_pole"]
 
 #: Sanathanan–Koerner re-weighting passes after Levy's fit
@@ -68,7 +66,7 @@ def rational_pole(omega: np.ndarray, response: np.ndarray, noise_std=None,
     weight = np.ones(omega.size)
     a0 = a1 = np.nan
     for _ in range(passes + 1):
-        q, _r = _thin_qr(basis * weight[:, None])
+        q, _r = np.linalg.qr(basis * weight[:, None])
         qh = q.conj().T
         # columns H·1, H·s and the right-hand side −H·s², weighted, numerators projected out
         cols = np.stack([h, hs, rhs], axis=2) * weight[None, :, None]  # (n_ch, n_freq, 3)
