@@ -41,7 +41,8 @@ from .peaks import neighbour_noise_std
 from .units import TWO_PI
 
 __all__ = [
-    "MissingMode", "find_missing_mode", "fit_residual", "residual_noise_std", "residual_structure", "restart_pole", "SIGNIFICANCE",
+    "MissingMode", "find_missing_mode", "fit_residual", "fit_residual_noise_std", "residual_noise_std",
+    "residual_structure", "restart_pole", "SIGNIFICANCE",
 ]
 
 #: false-alarm probability of each test for one added mode
@@ -182,8 +183,31 @@ def residual_noise_std(omega: np.ndarray, response: np.ndarray, power: int, regi
     return _seen_through(res, omega, response, np.asarray(noise_std, float))
 
 
+def fit_residual_noise_std(omega: np.ndarray, fit, noise_std) -> np.ndarray:
+    """:func:`residual_noise_std` from the residual a fit already holds (no second solve).
+
+    Parameters
+    ----------
+    omega : ndarray, shape (n_freq,)
+        The lines of the fit, rad/s.
+    fit : modal.nls.NLSFit
+        An unweighted fit with the offset per region (``background_powers=(0,)``, the model
+        of :func:`residual_noise_std`), holding ``residual`` and ``channel_scale``.
+    noise_std : ndarray, shape (n_channels,)
+        Raw-data estimate per channel.
+
+    Returns
+    -------
+    ndarray, shape (n_channels,)
+    """
+    peak = np.asarray(fit.channel_scale, float)
+    seen = neighbour_noise_std(omega, fit.residual, axis=0) * np.where(peak > 0, peak, 1.0)
+    return np.maximum(np.minimum(np.asarray(noise_std, float), seen), ARITHMETIC_FLOOR * peak)
+
+
 def residual_structure(omega: np.ndarray, response: np.ndarray, power: int, region: np.ndarray,
-                       omega_n, damping_ratio, residual: np.ndarray | None = None) -> float:
+                       omega_n, damping_ratio, residual: np.ndarray | None = None,
+                       peak: np.ndarray | None = None) -> float:
     """How far the fit's residual is from white: its variance over its line-to-line noise.
 
     The residual variance (sum of squares over the degrees of freedom) is
@@ -195,7 +219,7 @@ def residual_structure(omega: np.ndarray, response: np.ndarray, power: int, regi
 
     Parameters
     ----------
-    omega, response, power, region, omega_n, damping_ratio, residual
+    omega, response, power, region, omega_n, damping_ratio, residual, peak
         As for :func:`find_missing_mode`.
 
     Returns
@@ -205,7 +229,8 @@ def residual_structure(omega: np.ndarray, response: np.ndarray, power: int, regi
     """
     omega_n = np.atleast_1d(np.asarray(omega_n, float))
     zeta = np.atleast_1d(np.asarray(damping_ratio, float))
-    strongest = _strongest(np.max(np.abs(response), axis=1))
+    peak = np.max(np.abs(response), axis=1) if peak is None else peak
+    strongest = _strongest(peak)
     if residual is not None:
         res = residual[strongest]
     else:
@@ -262,7 +287,8 @@ def restart_pole(omega: np.ndarray, response: np.ndarray, power: int, region: np
 def find_missing_mode(omega: np.ndarray, response: np.ndarray, power: int, region: np.ndarray,
                       omega_n, damping_ratio, noise_std, bands_rad,
                       residual: np.ndarray | None = None,
-                      residual_noise: np.ndarray | None = None) -> MissingMode | None:
+                      residual_noise: np.ndarray | None = None,
+                      peak: np.ndarray | None = None) -> MissingMode | None:
     """Test the residual of fitted modes for one more mode.
 
     Parameters
@@ -288,6 +314,9 @@ def find_missing_mode(omega: np.ndarray, response: np.ndarray, power: int, regio
     residual_noise : ndarray, shape (n_channels,), optional
         :func:`residual_noise_std` of that residual if the caller has it (it is per
         channel, so the strongest channels' values are the same); computed otherwise.
+    peak : ndarray, shape (n_channels,), optional
+        max |H| of each channel on these lines, when the caller has it (a fit's
+        ``channel_scale``): the strongest channels are chosen by it.
 
     Returns
     -------
@@ -298,7 +327,8 @@ def find_missing_mode(omega: np.ndarray, response: np.ndarray, power: int, regio
     noise_std = np.asarray(noise_std, float)
     if not (np.all(np.isfinite(noise_std)) and np.all(noise_std > 0) and omega.size > 8):
         return None
-    strongest = _strongest(np.max(np.abs(response), axis=1) / noise_std)
+    peak = np.max(np.abs(response), axis=1) if peak is None else peak
+    strongest = _strongest(peak / noise_std)
     Y = response[strongest]
     n_ch = Y.shape[0]
     res = residual[strongest] if residual is not None else _residual(omega, Y, omega_n, zeta, power, region)

@@ -6,7 +6,8 @@ import warnings
 
 import numpy as np
 
-from .checks import find_missing_mode, fit_residual, residual_noise_std, residual_structure, restart_pole
+from .checks import (find_missing_mode, fit_residual, fit_residual_noise_std, residual_noise_std, residual_structure,
+                     restart_pole)
 from .circlefit import circle_fit_curve
 from .errors import IdentificationError, QualityWarning, ResolutionWarning, warn
 from .estimate.correction import remove_window_damping
@@ -298,13 +299,46 @@ def _start_pole(frf, band, power, noise):
     return best
 
 
+def _principal_start(frf, band, power, noise):
+    """:func:`_start_pole` of a many-channel band on one curve: the principal combination of its
+    ``START_CHANNELS`` strongest channels.
+
+    Any linear combination of the channels is an FRF with the same poles. The channels,
+    each divided by its noise σ, are combined with the first left singular vector of
+    their band (the combination of most energy, unit norm: its noise σ is 1), and the
+    start is searched on that one curve (:func:`_start_pole` of a one-channel FRF): two
+    single-channel estimates per band instead of two per channel.
+    """
+    keep = (frf.frequency_hz >= band.low_hz) & (frf.frequency_hz <= band.high_hz)
+    strongest = np.argsort(_channel_weights(frf, band, noise))[::-1][:START_CHANNELS]
+    sigma = np.asarray(noise, float)[strongest]
+    usable = np.isfinite(sigma) & (sigma > 0)
+    if not usable.any():
+        sigma = np.ones_like(sigma)
+    else:  # a channel without a noise level counts as the quietest one
+        sigma = np.where(usable, sigma, np.min(sigma[usable]))
+    h = frf.channels[strongest][:, keep] / sigma[:, None]
+    try:
+        u, _, _ = np.linalg.svd(h, full_matrices=False)
+    except np.linalg.LinAlgError:
+        return _start_pole(frf, band, power, noise)
+    curve = u[:, 0].conj() @ h
+    if not np.all(np.isfinite(curve)):
+        return _start_pole(frf, band, power, noise)
+    one = FRF(frf.frequency_hz[keep], curve, kind=frf.kind, source=frf.source)
+    wn, zeta = _start_pole(one, band, power, np.ones(1))
+    return wn, zeta
+
+
 def _quick_start(frf, band, power, noise):
     """(ωn, ζ) of a band's one-mode rational fit (:func:`modal.rational.rational_pole`) on its
     strongest channels, or None when it gives no pole inside the band."""
-    omega, h = _mode_arrays(frf, band)
-    if h.shape[0] > START_CHANNELS:
+    keep = (frf.frequency_hz >= band.low_hz) & (frf.frequency_hz <= band.high_hz)
+    omega, h = frf.omega_rad_s[keep], frf.channels
+    if h.shape[0] > START_CHANNELS:  # the strongest channels first: no copy of every channel's band
         strongest = np.argsort(_channel_weights(frf, band, noise))[::-1][:START_CHANNELS]
         h, noise = h[strongest], np.asarray(noise)[strongest]
+    h = h[:, keep]
     with np.errstate(all="ignore"):
         pole = rational_pole(omega, h, noise)
     if pole is None or not (TWO_PI * band.low_hz <= pole[0] <= TWO_PI * band.high_hz and 0 < pole[1] < 1):
@@ -325,35 +359,35 @@ def _doubtful(fit, bands) -> bool:
                 and np.all(s_zeta <= REL_STD_LIMIT * zeta))
 
 
-def _nls_fit(frf, bands, power, noise):
+def _nls_fit(frf, bands, power, noise, data=None):
     """The band-wise NLS fit of every band's mode, from the cheapest start that serves.
 
     Each band starts from its one-mode rational fit (a few linear solves); a band where
     that gives no pole, or a fit that looks doubtful (:func:`_doubtful`), takes the
-    half-power and circle starts of :func:`_start_pole` as well, and the fit with the lower
-    residual is kept.
+    half-power and circle starts of :func:`_start_pole` as well (of :func:`_principal_start`,
+    one curve per band, for many channels), and the fit with the lower residual is kept.
+    ``data``: the :func:`_band_data` of the bands, when the caller has it.
     """
     quick = [_quick_start(frf, band, power, noise) for band in bands]
     if all(q is not None for q in quick):
-        fit = _fit_bands(frf, bands, power, [q[0] for q in quick], [q[1] for q in quick])
+        fit = _fit_bands(frf, bands, power, [q[0] for q in quick], [q[1] for q in quick], data=data)
         if not _doubtful(fit, bands):
             return fit
     else:
         fit = None
-    starts = [_start_pole(frf, band, power, noise) for band in bands]
-    careful = _fit_bands(frf, bands, power, [s[0] for s in starts], [s[1] for s in starts])
-    if fit is None or _fit_cost(frf, bands, careful) <= _fit_cost(frf, bands, fit):
+    start = _principal_start if frf.n_channels > 1 else _start_pole
+    starts = [start(frf, band, power, noise) for band in bands]
+    careful = _fit_bands(frf, bands, power, [s[0] for s in starts], [s[1] for s in starts], data=data)
+    if fit is None or _fit_cost(careful) <= _fit_cost(fit):
         return careful
     return fit
 
 
-def _fit_cost(frf, bands, fit) -> float:
+def _fit_cost(fit) -> float:
     """Residual of a band-wise fit summed over channels, each scaled by its largest value."""
     if not np.all(np.isfinite(fit.noise_var)):
         return np.inf
-    keep, _ = _regions(bands, frf.frequency_hz)
-    scale = np.abs(frf.channels[:, keep]).max(axis=1)
-    scale[scale == 0] = 1.0
+    scale = np.where(fit.channel_scale > 0, fit.channel_scale, 1.0)  # max |H| of each channel on the lines
     return float(np.sum(fit.noise_var / scale**2))
 
 
@@ -457,7 +491,7 @@ def _refinement_check(frf, bands, power, poles, consts, noise, estimated_noise, 
         residual["noise_var"][strongest] = fit.noise_var
     # the noise as the fit's residual shows it (the raw estimate takes in curvature on coarse axes)
     chi2 = _chi2(fit.noise_var, _fit_noise(frf, bands, power, fit.omega_n, fit.damping_ratio,
-                                           estimated_noise, strongest, known_noise))
+                                           estimated_noise, strongest, known_noise, fit=fit))
     # the refinement may return the modes in another order (two close poles crossing)
     order = np.argsort(fit.omega_n)
     omega_n, damping_ratio = fit.omega_n[order], fit.damping_ratio[order]
@@ -506,19 +540,26 @@ def _band_noise(frf, bands, line_noise):
     return np.sqrt(np.mean(line_noise[:, lines] ** 2, axis=1))
 
 
-def _local_misfit(frf, bands, power, omega_n, damping_ratio) -> np.ndarray:
+def _local_misfit(frf, bands, power, omega_n, damping_ratio, data=None) -> np.ndarray:
     """Per mode, the misfit near it relative to the data there (RMS over the strongest channels, at most
     ``POLE_CHANNELS``).
 
     In each band every fitted mode and a complex offset are solved linearly at the
     fitted poles; the residual is taken on the lines within ±3 half-power widths
-    (at least ±3 lines) of the band's mode.
+    (at least ±3 lines) of the band's mode. ``data``: the :func:`_band_data` of the bands
+    (each band is a run of its lines).
     """
     out = np.full(len(bands), np.nan)
+    if data is None:
+        freq, omega_all, response = frf.frequency_hz, frf.omega_rad_s, frf.channels
+    else:
+        freq, (omega_all, response, _) = frf.frequency_hz[_regions(bands, frf.frequency_hz)[0]], data
     for b, (band, wn, zeta) in enumerate(zip(bands, omega_n, damping_ratio)):
-        omega, h = _mode_arrays(frf, band)
-        if omega.size < 3:
+        lines = np.flatnonzero((freq >= band.low_hz) & (freq <= band.high_hz))
+        if lines.size < 3:
             continue
+        run = slice(lines[0], lines[-1] + 1)  # a view: no copy of every channel
+        omega, h = omega_all[run], response[:, run]
         if h.shape[0] > POLE_CHANNELS:  # the strong channels carry the misfit that matters; O(1) in channels
             h = h[np.argsort(np.abs(h).max(axis=1))[::-1][:POLE_CHANNELS]]
         basis = mode_basis(omega, omega_n, damping_ratio, power).T
@@ -534,16 +575,23 @@ def _local_misfit(frf, bands, power, omega_n, damping_ratio) -> np.ndarray:
     return out
 
 
-def _fit_noise(frf, bands, power, omega_n, damping_ratio, estimated_noise, channels=None, known=False, residual=None):
+def _fit_noise(frf, bands, power, omega_n, damping_ratio, estimated_noise, channels=None, known=False, residual=None,
+               fit=None, data=None):
     """:func:`modal.checks.residual_noise_std` on the lines of the bands (all or some channels).
 
     ``known``: the noise came with the FRF (an estimate from time data) and is taken as it is.
     ``residual``: the fit's residual on those lines and channels, if the caller has it.
+    ``fit``: the :func:`_fit_bands` fit of these poles on the same lines and channels, whose own
+    residual is then used (when it is unweighted); ``data``: :func:`_band_data` of them.
     """
     rows = slice(None) if channels is None else channels
     if known:
         return np.asarray(estimated_noise, float)[rows]
-    omega, response, region = _band_data(frf, bands, channels)
+    if fit is not None and fit.residual is not None and _line_weight(frf, bands) is None:
+        omega = frf.omega_rad_s[_regions(bands, frf.frequency_hz)[0]]
+        with np.errstate(all="ignore"):
+            return fit_residual_noise_std(omega, fit, np.asarray(estimated_noise, float)[rows])
+    omega, response, region = _band_data(frf, bands, channels) if data is None else data
     with np.errstate(all="ignore"):
         return residual_noise_std(omega, response, power, region, omega_n, damping_ratio, estimated_noise[rows],
                                   residual)
@@ -569,7 +617,7 @@ def _line_weight(frf, bands):
     return ref / np.maximum(sigma, 1e-3 * ref)
 
 
-def _fit_bands(frf, bands, power, omega_n0, damping_ratio0, channels=None):
+def _fit_bands(frf, bands, power, omega_n0, damping_ratio0, channels=None, data=None):
     """:func:`modal.nls.fit_modes` of every band's mode together, with collapsed modes reseated.
 
     A weak mode whose start lies on a noise spike can collapse there inside the
@@ -580,16 +628,16 @@ def _fit_bands(frf, bands, power, omega_n0, damping_ratio0, channels=None):
     ``REL_STD_LIMIT``, or ζ ≥ 1) restarts where the residual of the other
     modes peaks in its band (:func:`modal.checks.restart_pole`), and the joint
     fit runs again. The restart is kept only when its residual is lower: the
-    reported fit is the better least-squares optimum of the same model.
+    reported fit is the better least-squares optimum of the same model. ``data``: the
+    :func:`_band_data` of these bands and channels, when the caller has it.
     """
-    omega, response, region = _band_data(frf, bands, channels)
+    omega, response, region = _band_data(frf, bands, channels) if data is None else data
     weight = _line_weight(frf, bands)
     with np.errstate(all="ignore"):
         fit = fit_modes(omega, response, power, omega_n0, damping_ratio0, region=region, line_weight=weight)
     if len(bands) < 2:
         return fit
-    scale = np.abs(response).max(axis=1)
-    scale[scale == 0] = 1.0
+    scale = np.where(fit.channel_scale > 0, fit.channel_scale, 1.0)  # max |H| of each channel
 
     def cost(f):
         return float(np.sum(f.noise_var / scale**2))
@@ -615,7 +663,7 @@ def _fit_bands(frf, bands, power, omega_n0, damping_ratio0, channels=None):
     return fit
 
 
-def _truncation(frf, bands, power, fit, channels=None, residual=None):
+def _truncation(frf, bands, power, fit, channels=None, residual=None, data=None):
     """Shift of the fit when the band backgrounds gain a slope and a curvature, or None.
 
     Measured only where the residual is smooth across the lines (ratio of
@@ -624,11 +672,13 @@ def _truncation(frf, bands, power, fit, channels=None, residual=None):
     truncation bias of the modes outside the bands (:func:`modal.nls.truncation_shift`).
     With white residuals the shift would be noise only and is not measured.
     Returns (pole shift (n_modes, 2), constant shift (n_modes, n_channels)) in
-    the fit's order of modes. ``residual``: the fit's residual, if the caller has it.
+    the fit's order of modes. ``residual``: the fit's residual, if the caller has it; ``data``: the
+    :func:`_band_data` of these bands and channels.
     """
-    omega, response, region = _band_data(frf, bands, channels)
+    omega, response, region = _band_data(frf, bands, channels) if data is None else data
     with np.errstate(all="ignore"):
-        structure = residual_structure(omega, response, power, region, fit.omega_n, fit.damping_ratio, residual)
+        structure = residual_structure(omega, response, power, region, fit.omega_n, fit.damping_ratio, residual,
+                                       peak=fit.channel_scale)
     if not structure > STRUCTURED_RATIO:
         return None
     return truncation_shift(omega, response, power, region, fit)
@@ -641,14 +691,16 @@ def _with_shift(cov, pole_shift, constant_shift):
     return cov + d[:, :, None] * d[:, None, :]
 
 
-def _missing_mode(frf, bands, power, omega_n, damping_ratio, estimated_noise, residual=None, residual_noise=None):
+def _missing_mode(frf, bands, power, omega_n, damping_ratio, estimated_noise, residual=None, residual_noise=None,
+                  data=None, peak=None):
     """:func:`modal.checks.find_missing_mode` on the lines of the bands (``residual`` and ``residual_noise``:
-    the fit's residual and its :func:`modal.checks.residual_noise_std`, if known)."""
-    omega, response, region = _band_data(frf, bands)
+    the fit's residual and its :func:`modal.checks.residual_noise_std`, if known; ``data``: the bands'
+    :func:`_band_data`; ``peak``: max |H| of each channel there)."""
+    omega, response, region = _band_data(frf, bands) if data is None else data
     bands_rad = [(TWO_PI * b.low_hz, TWO_PI * b.high_hz) for b in bands]
     with np.errstate(all="ignore"):
         return find_missing_mode(omega, response, power, region, omega_n, damping_ratio, estimated_noise,
-                                 bands_rad, residual, residual_noise)
+                                 bands_rad, residual, residual_noise, peak)
 
 
 def _overlap(per_mode, index) -> float:
@@ -903,22 +955,27 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
                 reference = (wn - d_wn, zeta - d_z, np.where(const_biased, const - d_const, const), noise_cov)
             per_mode.append((wn, zeta, const, cov, s_wn, s_z, flags, q, chi2, reference))
     else:
-        fit = _nls_fit(frf, bands, power, noise)
-        # the checks all measure the residual of the same modes on the same lines: computed once
-        with np.errstate(all="ignore"):
-            omega_b, response_b, region_b = _band_data(frf, bands)
-            residual = fit_residual(omega_b, response_b, power, region_b, fit.omega_n, fit.damping_ratio)
+        data = _band_data(frf, bands)  # the lines of the bands, taken out once
+        fit = _nls_fit(frf, bands, power, noise, data)
+        # the checks all measure the residual of the same modes on the same lines: the fit's own when it is
+        # unweighted (no second solve), else computed once
+        own = fit.residual is not None and _line_weight(frf, bands) is None
+        if own:
+            residual = (fit.residual * np.where(fit.channel_scale > 0, fit.channel_scale, 1.0)).T
+        else:
+            with np.errstate(all="ignore"):
+                residual = fit_residual(data[0], data[1], power, data[2], fit.omega_n, fit.damping_ratio)
         fit_noise = _fit_noise(frf, bands, power, fit.omega_n, fit.damping_ratio, estimated_noise, known=known_noise,
-                               residual=residual)
+                               residual=residual, fit=fit if own else None, data=data)
         chi2 = _chi2(fit.noise_var, fit_noise)
         # the check's noise is the residual's own: with a known noise (time data) it computes it itself
         missing_mode = _missing_mode(frf, bands, power, fit.omega_n, fit.damping_ratio, estimated_noise, residual,
-                                     None if known_noise else fit_noise)
+                                     None if known_noise else fit_noise, data, fit.channel_scale)
         # near-exact data: the offset's truncation (modes outside the bands) biases the poles
         # beyond their white-noise errors; its measured shift is added to them (finding 26)
-        shift = _truncation(frf, bands, power, fit, residual=residual)
+        shift = _truncation(frf, bands, power, fit, residual=residual, data=data)
         order = np.argsort(fit.omega_n)  # two close poles may cross during the fit
-        relative = _local_misfit(frf, bands, power, fit.omega_n[order], fit.damping_ratio[order])
+        relative = _local_misfit(frf, bands, power, fit.omega_n[order], fit.damping_ratio[order], data)
         for b, (band, r) in enumerate(zip(bands, order)):
             flags: set[str] = set()
             if not fit.converged:
@@ -951,7 +1008,7 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
             flags.add("high_uncertainty")
         if assumed:
             flags.add("driving_point_assumed")
-        omega_b, _ = _mode_arrays(frf, band)
+        omega_b = frf.omega_rad_s[(frf.frequency_hz >= band.low_hz) & (frf.frequency_hz <= band.high_hz)]
         spacing = line_spacing(omega_b) if omega_b.size > 1 else np.nan
         lines_per_bw = 2 * zeta * wn / spacing if spacing > 0 else np.nan
         others = [b.peak_hz for b in bands if b is not band and band.low_hz < b.peak_hz < band.high_hz]

@@ -36,6 +36,12 @@ class NLSFit:
         Residual estimate of E|n|² per channel.
     converged : bool
     n_iter : int
+    residual : ndarray, shape (n_freq, n_channels), optional
+        Residual of the fit, each channel divided by its ``channel_scale`` (and each line
+        times its weight, for a weighted fit).
+    channel_scale : ndarray, shape (n_channels,), optional
+        max |H| of each channel over the lines, FRF unit (``residual`` is divided by it, or by 1
+        where it is 0).
     """
 
     omega_n: np.ndarray
@@ -46,6 +52,8 @@ class NLSFit:
     noise_var: np.ndarray
     converged: bool
     n_iter: int
+    residual: np.ndarray | None = None
+    channel_scale: np.ndarray | None = None
 
 
 #: largest damping ratio the fit may reach (far past critical: the mode is then a slope)
@@ -95,25 +103,24 @@ def _design(x, numerator, x_squared, params, out, dphi):
     return out, dphi
 
 
-def _compress(Y: np.ndarray, rank: int) -> np.ndarray:
-    """Many channels: replace Y (n_freq, n_ch) by Y V with V (n_ch, rank) orthonormal.
+def _compress(Y: np.ndarray, probes: np.ndarray) -> np.ndarray:
+    """Many channels: replace Y (n_freq, n_ch) by Y V with V (n_ch, k) orthonormal.
 
     The cost ||P⊥ Y V||² and its gradient depend on the channels only through
-    the row space kept by V; a randomised range finder (one power iteration,
-    fixed seed) keeps the signal subspace, whose rank is at most the number of
-    basis columns, plus a margin. With exact data this is lossless; with noise
-    it drops only noise directions that carry no information on the poles.
-    Modal constants and noise levels are computed afterwards on the full data.
+    the row space kept by V. The fitted coefficients Φ⁺Y and, to first order, their
+    change with the poles are combinations of the rows of Q₀ᴴY, Q₀ an orthonormal
+    basis of ``probes`` (n_freq, k): the start's design and its pole derivatives.
+    V is an orthonormal basis of that row space: two products with Y, no random
+    numbers. With exact data this is lossless; with noise it drops directions that
+    carry no information on the poles (on the 1000-channel benchmark the poles
+    stay within 1e-4 of their standard errors of the fit to every channel; a
+    randomised range finder of 20 columns with a power iteration, five products
+    with Y, stayed within 3e-3). Modal constants and noise levels are computed
+    afterwards on the full data.
     """
-    n_ch = Y.shape[1]
-    if n_ch <= 2 * rank:
-        return Y
-    rng = np.random.default_rng(12345)
-    omega = rng.standard_normal((n_ch, rank)) + 1j * rng.standard_normal((n_ch, rank))
-    U, _ = np.linalg.qr(Y @ omega)
-    U, _ = np.linalg.qr(Y @ (Y.conj().T @ U))  # one power iteration sharpens the subspace
-    V, _ = np.linalg.qr(Y.conj().T @ U)  # (n_ch, rank) orthonormal basis of the row space
-    return np.ascontiguousarray(Y @ V)
+    basis, _ = np.linalg.qr(probes)
+    V, _ = np.linalg.qr((basis.conj().T @ Y).conj().T)  # (n_ch, k) orthonormal
+    return Y @ V
 
 
 def _project(Phi, Y):
@@ -166,9 +173,10 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
     omega = np.asarray(omega, float)
     Y_raw = np.atleast_2d(np.asarray(response, complex))
     n_ch = Y_raw.shape[0]
-    ch_scale = np.abs(Y_raw).max(axis=1)
-    ch_scale[ch_scale == 0] = 1.0
-    Y = np.ascontiguousarray((Y_raw / ch_scale[:, None]).T)  # (n_freq, n_ch), each channel scaled to max 1
+    peak = np.abs(Y_raw).max(axis=1)
+    ch_scale = np.where(peak > 0, peak, 1.0)
+    # (n_freq, n_ch), each channel scaled to max 1 (divided and transposed in one pass)
+    Y = np.divide(Y_raw.T, ch_scale[None, :], out=np.empty((Y_raw.shape[1], n_ch), dtype=complex))
     w_ref = np.atleast_1d(np.asarray(omega_n0, float))
     w_ref = float(w_ref[0] if w_ref.size == 1 else np.median(w_ref))
     x = omega / w_ref
@@ -190,19 +198,22 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
     if residual_terms:
         kind = (1j * x) ** power
         background = np.hstack([background, kind[:, None], (kind / -(x**2))[:, None]])
-    n_b_guess = n_modes + background.shape[1]
-    Y = _compress(Y, 2 * n_b_guess + 8)
+    numerator, x_squared = (1j * x) ** power, x * x  # what the design takes from the lines alone
+    n_b = n_modes + background.shape[1]
 
     weight = None
     if line_weight is not None:
         weight = np.asarray(line_weight, float)[:, None]
-        compressed = Y is not Y_full
-        Y_full = Y_full * weight  # row weights commute with the channel compression
-        Y = Y * weight if compressed else Y_full
+        Y_full = Y = Y_full * weight
         background = background * weight
-
-    numerator, x_squared = (1j * x) ** power, x * x
-    n_b = n_modes + background.shape[1]
+    if n_ch > 2 * (2 * n_b + 8):  # many channels: fit on fewer combinations
+        Phi0 = np.empty((x.size, n_b), dtype=complex)
+        Phi0[:, n_modes:] = background
+        Phi0, dphi0 = _design(x, numerator, x_squared, params, Phi0, np.empty((x.size, n_theta), complex))
+        if weight is not None:
+            Phi0[:, :n_modes] *= weight
+            dphi0 *= weight
+        Y = _compress(Y_full, np.hstack([Phi0, dphi0]))
 
     def evaluate(p):
         Phi = np.empty((x.size, n_b), dtype=complex)
@@ -285,11 +296,13 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
     if Y is not Y_full:  # back to the channels: one projection of the full data
         Y = Y_full
         QhY = Q.conj().T @ Y
-        res = Y - Q @ QhY
+        res = np.subtract(Y, Q @ QhY)
     n_freq = x.size
     n_b = Phi.shape[1]
     C = np.linalg.solve(R, QhY)
-    rss = np.sum(np.abs(res) ** 2, axis=0)
+    parts = np.ascontiguousarray(res).view(float)  # Re, Im side by side: |r|² summed without a temporary per line
+    rss = np.einsum("ij,ij->j", parts, parts)
+    rss = rss[0::2] + rss[1::2]
     dof = n_freq - n_b - n_theta / (2 * n_ch)
     noise_var = rss / dof if dof > 0 else np.full(n_ch, np.nan)
     # Fisher information of the poles (Schur complement via the projected Jacobian)
@@ -349,6 +362,8 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
         noise_var=noise_var * ch_scale**2,
         converged=bool(converged),
         n_iter=n_iter,
+        residual=res,
+        channel_scale=peak,
     )
 
 

@@ -11,24 +11,68 @@ from .frf import FRF
 __all__ = ["estimate_noise_std", "neighbour_noise_std", "local_noise_std", "mode_indicator", "find_modes", "ModeBand", "bands_from_hz"]
 
 
-def _misfit_power(frequency: np.ndarray, values: np.ndarray) -> np.ndarray:
+def _misfit_power(frequency: np.ndarray, values: np.ndarray, axis: int = -1) -> np.ndarray:
     """Each inner line's squared misfit to the straight line through its neighbours, over
-    (1 + w_l² + w_r²), so that white noise of variance σ² gives E = σ²; shape (n_rows, n_freq − 2)."""
+    (1 + w_l² + w_r²), so that white noise of variance σ² gives E = σ²; shape (n_rows, n_freq − 2).
+
+    ``axis``: the lines along the last axis (``values`` (n_rows, n_freq), the default) or
+    along the first (``values`` (n_freq, n_rows); the result is then (n_freq − 2, n_rows)).
+    """
     step = np.diff(np.asarray(frequency, float))
     w_left = step[1:] / (step[:-1] + step[1:])
     w_right = 1.0 - w_left
-    # in place: 1000 channels × 2000 lines are 32 MB per temporary
-    misfit = np.multiply(values[:, :-2], w_left, out=np.empty((values.shape[0], w_left.size), complex))
-    misfit += values[:, 2:] * w_right
-    np.subtract(values[:, 1:-1], misfit, out=misfit)
-    parts = misfit.view(float)
-    np.square(parts, out=parts)
-    power = parts[:, 0::2] + parts[:, 1::2]
-    power *= 1.0 / (1.0 + w_left**2 + w_right**2)
+    norm = 1.0 / (1.0 + w_left**2 + w_right**2)
+    values = np.ascontiguousarray(values, dtype=complex)
+    # on the real view (real and imaginary parts side by side), in place: 1000 channels ×
+    # 2000 lines are 32 MB per temporary, and complex-by-real products cost twice as much
+    parts = values.view(float)
+    if axis == 0:
+        left, right = w_left[:, None], w_right[:, None]
+        misfit = np.multiply(parts[:-2], left)
+        misfit += parts[2:] * right
+        np.subtract(parts[1:-1], misfit, out=misfit)
+        misfit *= misfit
+        power = np.add(misfit[:, 0::2], misfit[:, 1::2])
+        power *= norm[:, None]
+        return power
+    left, right = np.repeat(w_left, 2), np.repeat(w_right, 2)
+    misfit = np.multiply(parts[:, :-4], left)
+    misfit += parts[:, 4:] * right
+    np.subtract(parts[:, 2:-2], misfit, out=misfit)
+    misfit *= misfit
+    power = np.add(misfit[:, 0::2], misfit[:, 1::2])
+    power *= norm
     return power
 
 
-def neighbour_noise_std(frequency: np.ndarray, values: np.ndarray) -> np.ndarray:
+#: rows of :func:`neighbour_noise_std` computed together (their misfit, 2 MB at 2000 lines, stays in the cache)
+_ROWS_AT_ONCE = 128
+
+
+#: rows of :func:`neighbour_noise_std` computed together (their misfit, 2 MB at 2000 lines, stays in the cache)
+_ROWS_AT_ONCE = 128
+
+
+def _misfit_power_at(frequency: np.ndarray, values: np.ndarray, centre: np.ndarray, step: int) -> np.ndarray:
+    """:func:`_misfit_power` of the lines ``centre`` against their neighbours ``step`` lines away
+    (the same arithmetic as on the axis subsampled by ``step``); shape (n_rows, centre.size)."""
+    f_centre = frequency[centre]
+    before = f_centre - frequency[centre - step]
+    after = frequency[centre + step] - f_centre
+    w_left = after / (before + after)
+    w_right = 1.0 - w_left
+    norm = 1.0 / (1.0 + w_left**2 + w_right**2)
+    left, right = np.repeat(w_left, 2), np.repeat(w_right, 2)
+    misfit = np.multiply(values.take(centre - step, axis=1).view(float), left)
+    misfit += values.take(centre + step, axis=1).view(float) * right
+    np.subtract(values.take(centre, axis=1).view(float), misfit, out=misfit)
+    misfit *= misfit
+    power = np.add(misfit[:, 0::2], misfit[:, 1::2])
+    power *= norm
+    return power
+
+
+def neighbour_noise_std(frequency: np.ndarray, values: np.ndarray, axis: int = -1) -> np.ndarray:
     """Noise standard deviation per row (E|n|² = σ²), from each line's misfit to its neighbours.
 
     Each inner line is compared with the straight line through its two
@@ -46,13 +90,27 @@ def neighbour_noise_std(frequency: np.ndarray, values: np.ndarray) -> np.ndarray
         Increasing axis (any unit).
     values : ndarray, shape (n_rows, n_freq)
         Complex data per row; at least 5 lines, else NaN.
+    axis : {-1, 0}
+        The axis of the lines: -1 as above, 0 for ``values`` of shape (n_freq, n_rows).
     """
     values = np.atleast_2d(np.asarray(values, dtype=complex))
+    if axis == 0:
+        if values.shape[0] < 5:
+            return np.full(values.shape[1], np.nan)
+        median = np.empty(values.shape[1])
+        for start in range(0, values.shape[1], _ROWS_AT_ONCE):  # a block of columns stays in the cache
+            block = values[:, start:start + _ROWS_AT_ONCE]
+            power = np.ascontiguousarray(_misfit_power(frequency, block, axis=0).T)
+            mid = power.shape[1] // 2
+            median[start:start + _ROWS_AT_ONCE] = np.partition(power, mid, axis=1)[:, mid]
+        return np.sqrt(median / np.log(2))
     if values.shape[1] < 5:
         return np.abs(values).max(axis=1) * np.nan
-    power = _misfit_power(frequency, values)
-    mid = power.shape[1] // 2
-    median = np.partition(power, mid, axis=1)[:, mid]
+    median = np.empty(values.shape[0])
+    for start in range(0, values.shape[0], _ROWS_AT_ONCE):  # a block of rows stays in the cache
+        power = _misfit_power(frequency, values[start:start + _ROWS_AT_ONCE])
+        mid = power.shape[1] // 2
+        median[start:start + _ROWS_AT_ONCE] = np.partition(power, mid, axis=1)[:, mid]
     return np.sqrt(median / np.log(2))
 
 
@@ -68,10 +126,16 @@ def estimate_noise_std(frf: FRF) -> np.ndarray:
 
 def mode_indicator(frf: FRF) -> np.ndarray:
     """RMS over channels of |H| normalised by each channel's maximum (1-D, n_freq)."""
+    return _indicator_and_peak(frf)[0]
+
+
+def _indicator_and_peak(frf: FRF) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`mode_indicator` and each channel's max |H| (n_channels,), from one |H| (in place)."""
     mag = np.abs(frf.channels)
-    peak = mag.max(axis=1, keepdims=True)
-    peak[peak == 0] = 1.0
-    return np.sqrt(np.mean((mag / peak) ** 2, axis=0))
+    peak = mag.max(axis=1)
+    mag /= np.where(peak > 0, peak, 1.0)[:, None]
+    mag *= mag
+    return np.sqrt(np.mean(mag, axis=0)), peak
 
 
 @dataclass(frozen=True)
@@ -96,15 +160,25 @@ def _half_power_width(freq, ind, i):
     return freq[hi] - freq[lo]
 
 
-def _nearest_higher(y: np.ndarray, order) -> np.ndarray:
-    """Index of the nearest strictly higher sample in the order given (−1 if none), by a monotonic stack."""
-    out = np.full(y.size, -1)
-    stack: list[int] = []
-    for i in order:
-        while stack and y[stack[-1]] <= y[i]:
-            stack.pop()
-        out[i] = stack[-1] if stack else -1
-        stack.append(i)
+def _range_tables(y: np.ndarray, op) -> list[np.ndarray]:
+    """Sparse table of ``y``: entry k holds ``op`` over every run y[i:i + 2**k] (O(n log n), exact)."""
+    tables = [y]
+    while 2 ** len(tables) <= y.size:
+        half = 2 ** (len(tables) - 1)
+        tables.append(op(tables[-1][:-half], tables[-1][half:]))
+    return tables
+
+
+def _range_query(tables: list[np.ndarray], lo: np.ndarray, hi: np.ndarray, op) -> np.ndarray:
+    """``op`` over y[lo:hi] for arrays of bounds (hi > lo): two overlapping runs of a power of two."""
+    length = hi - lo
+    k = np.floor(np.log2(length)).astype(int)
+    k = np.where(2 ** (k + 1) <= length, k + 1, k)  # log2 rounded at a power of two
+    k = np.where(2**k > length, k - 1, k)
+    out = np.empty(lo.size)
+    for level in np.unique(k):
+        sel = k == level
+        out[sel] = op(tables[level][lo[sel]], tables[level][hi[sel] - 2**level])
     return out
 
 
@@ -113,7 +187,9 @@ def _peaks_with_prominence(y: np.ndarray, min_prominence: float) -> np.ndarray:
 
     Prominence as in ``scipy.signal.peak_prominences``: the peak height minus the
     higher of the two lowest points between the peak and the nearest higher
-    sample (or the end of the data) on each side.
+    sample (or the end of the data) on each side. Vectorised over the peaks with
+    sparse tables of running maxima and minima: the run of samples not above a
+    peak on each side is found by descending powers of two (its length in binary).
     """
     n = y.size
     if n < 3:
@@ -121,16 +197,24 @@ def _peaks_with_prominence(y: np.ndarray, min_prominence: float) -> np.ndarray:
     inner = np.flatnonzero((y[1:-1] > y[:-2]) & (y[1:-1] >= y[2:])) + 1
     if inner.size == 0:
         return inner
-    left = _nearest_higher(y, range(n))
-    right = _nearest_higher(y, range(n - 1, -1, -1))
-    right[right < 0] = n
-    keep = []
-    for p in inner:
-        left_base = y[left[p] + 1:p + 1].min()
-        right_base = y[p:right[p]].min()
-        if y[p] - max(left_base, right_base) >= min_prominence:
-            keep.append(p)
-    return np.array(keep, dtype=int)
+    top = _range_tables(y, np.maximum)
+    low = _range_tables(y, np.minimum)
+    level = y[inner]
+    start = inner.copy()  # y[start:p] all <= y[p]
+    stop = inner + 1  # y[p + 1:stop] all <= y[p]
+    for k in range(len(top) - 1, -1, -1):
+        width, t = 2**k, top[k]
+        can = start - width >= 0
+        move = can & (t[np.where(can, start - width, 0)] <= level)
+        start = np.where(move, start - width, start)
+        can = stop + width <= n
+        move = can & (t[np.where(can, stop, 0)] <= level)
+        stop = np.where(move, stop + width, stop)
+    # the lowest point between the peak and the nearest higher sample (start − 1, or none) on the left,
+    # and up to it (stop, or the end) on the right
+    left_base = _range_query(low, start, inner + 1, np.minimum)
+    right_base = _range_query(low, inner, stop, np.minimum)
+    return inner[level - np.maximum(left_base, right_base) >= min_prominence]
 
 
 #: half-width (lines) of the window in which the local noise level around a peak is measured
@@ -139,6 +223,18 @@ LOCAL_NOISE_LINES = 64
 PEAK_SIGMAS = 3.0
 #: line steps of the neighbour stencils whose largest noise level counts (correlated noise)
 STENCIL_STEPS = (1, 2, 4)
+
+
+def _row_median(values: np.ndarray) -> np.ndarray:
+    """``np.median(values, axis=1)`` of a finite 2-D array by one sort of the rows (the same values;
+    numpy's median partitions a copy around two indices, ten times slower on a few hundred columns)."""
+    if not np.all(np.isfinite(values)):
+        return np.median(values, axis=1)
+    ordered = np.sort(values, axis=1)
+    n = ordered.shape[1]
+    if n % 2:
+        return ordered[:, n // 2]
+    return (ordered[:, n // 2 - 1] + ordered[:, n // 2]) / 2
 
 
 def local_noise_std(frequency: np.ndarray, values: np.ndarray, lines, exclude,
@@ -166,7 +262,7 @@ def local_noise_std(frequency: np.ndarray, values: np.ndarray, lines, exclude,
             powers = [_misfit_power(frequency[lo:hi:step], values[:, lo:hi:step])
                       for lo, hi in sides if (hi - lo) // step >= 5]
             if powers:
-                levels.append(np.median(np.concatenate(powers, axis=1), axis=1) / np.log(2))
+                levels.append(_row_median(np.concatenate(powers, axis=1)) / np.log(2))
         if levels:
             out[:, k] = np.sqrt(np.max(levels, axis=0))
     return out
@@ -187,9 +283,8 @@ def find_modes(frf: FRF, min_prominence_db: float = 6.0, noise_factor: float = 1
     moved halfway between lines (see :func:`_edges_between_lines`).
     """
     freq = frf.frequency_hz
-    ind = mode_indicator(frf)
+    ind, peak_mag = _indicator_and_peak(frf)
     noise = estimate_noise_std(frf) if noise_std is None else noise_std
-    peak_mag = np.abs(frf.channels).max(axis=1)
     with np.errstate(invalid="ignore", divide="ignore"):
         noise_rel = float(np.sqrt(np.nanmean((noise / peak_mag) ** 2)))
     floor = noise_factor * noise_rel if np.isfinite(noise_rel) else 0.0
