@@ -551,11 +551,13 @@ def _local_misfit(frf, bands, power, omega_n, damping_ratio, data=None) -> np.nd
     """
     out = np.full(len(bands), np.nan)
     if data is None:
-        freq, omega_all, response = frf.frequency_hz, frf.omega_rad_s, frf.channels
+        omega_all, response = frf.omega_rad_s, frf.channels
     else:
-        freq, (omega_all, response, _) = frf.frequency_hz[_regions(bands, frf.frequency_hz)[0]], data
+        omega_all, response, _ = data
     for b, (band, wn, zeta) in enumerate(zip(bands, omega_n, damping_ratio)):
-        lines = np.flatnonzero((freq >= band.low_hz) & (freq <= band.high_hz))
+        # band edges lie halfway between lines (peaks._edges_between_lines): no rounding of 2π f can
+        # move a line across one
+        lines = np.flatnonzero((omega_all >= TWO_PI * band.low_hz) & (omega_all <= TWO_PI * band.high_hz))
         if lines.size < 3:
             continue
         run = slice(lines[0], lines[-1] + 1)  # a view: no copy of every channel
