@@ -96,19 +96,15 @@ def _design(omega, omega_n, zeta, power, region):
     return np.hstack([phi, offsets])
 
 
-def _residual(omega, response, omega_n, zeta, power, region):
-    design = _design(omega, omega_n, zeta, power, region)
-    coef = solve_linear(design, response.T)
-    return response - (design @ coef).T
-
-
 def fit_residual(omega: np.ndarray, response: np.ndarray, power: int, region: np.ndarray,
                  omega_n, damping_ratio) -> np.ndarray:
     """Residual (n_channels, n_freq) of the modes at the given poles, their constants and one
     complex offset per region solved linearly: what every check here measures."""
     omega_n = np.atleast_1d(np.asarray(omega_n, float))
     zeta = np.atleast_1d(np.asarray(damping_ratio, float))
-    return _residual(omega, response, omega_n, zeta, power, region)
+    design = _design(omega, omega_n, zeta, power, region)
+    coef = solve_linear(design, response.T)
+    return response - (design @ coef).T
 
 
 def _strongest(score: np.ndarray) -> np.ndarray:
@@ -234,7 +230,7 @@ def residual_structure(omega: np.ndarray, response: np.ndarray, power: int, regi
     if residual is not None:
         res = residual[strongest]
     else:
-        res = _residual(omega, response[strongest], omega_n, zeta, power, region)
+        res = fit_residual(omega, response[strongest], power, region, omega_n, zeta)
     dof = omega.size - omega_n.size - (int(region.max()) + 1) - omega_n.size / res.shape[0]
     if dof <= 0:
         return np.nan
@@ -276,7 +272,7 @@ def restart_pole(omega: np.ndarray, response: np.ndarray, power: int, region: np
     scale = np.max(np.abs(response), axis=1)
     strongest = _strongest(scale)
     scale = np.where(scale[strongest] > 0, scale[strongest], 1.0)
-    res = _residual(omega, response[strongest], omega_n, zeta, power, region)
+    res = fit_residual(omega, response[strongest], power, region, omega_n, zeta)
     energy = np.mean(np.abs(res) ** 2 / scale[:, None] ** 2, axis=0)
     spacing = float(np.median(np.diff(omega)))
     width = int(np.clip(np.round(np.median(2 * zeta * omega_n) / spacing), 1, max(1, omega.size // 4)))
@@ -331,7 +327,7 @@ def find_missing_mode(omega: np.ndarray, response: np.ndarray, power: int, regio
     strongest = _strongest(peak / noise_std)
     Y = response[strongest]
     n_ch = Y.shape[0]
-    res = residual[strongest] if residual is not None else _residual(omega, Y, omega_n, zeta, power, region)
+    res = residual[strongest] if residual is not None else fit_residual(omega, Y, power, region, omega_n, zeta)
     if residual_noise is not None:
         sigma2 = np.asarray(residual_noise, float)[strongest] ** 2
     else:
@@ -373,7 +369,7 @@ def find_missing_mode(omega: np.ndarray, response: np.ndarray, power: int, regio
     overlap = 2 * np.maximum(others_zeta * others_wn, new_zeta * new_wn) / np.abs(others_wn - new_wn)
     if np.any(overlap > SPLIT_OVERLAP):
         return None  # too close to a fitted mode to tell from a split of it
-    res1 = _residual(omega, Y, fit.omega_n, fit.damping_ratio, power, region)
+    res1 = fit_residual(omega, Y, power, region, fit.omega_n, fit.damping_ratio)
     rss0 = np.sum(np.abs(res) ** 2, axis=1)
     rss1 = np.sum(np.abs(res1) ** 2, axis=1)
     n_b = omega_n.size + int(region.max()) + 1

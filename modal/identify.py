@@ -351,8 +351,9 @@ def _doubtful(fit, bands) -> bool:
     its band, ζ at or past critical or not resolved (relative error above ``REL_STD_LIMIT``)."""
     if not fit.converged or not np.all(np.isfinite(fit.noise_var)):
         return True
-    wn, zeta = np.sort(fit.omega_n), fit.damping_ratio[np.argsort(fit.omega_n)]
-    s_zeta = np.sqrt(np.abs(fit.mode_cov[np.argsort(fit.omega_n), 0, 1, 1]))
+    order = np.argsort(fit.omega_n)  # bands go up in frequency
+    wn, zeta = fit.omega_n[order], fit.damping_ratio[order]
+    s_zeta = np.sqrt(np.abs(fit.mode_cov[order, 0, 1, 1]))
     low = TWO_PI * np.array([b.low_hz for b in bands])
     high = TWO_PI * np.array([b.high_hz for b in bands])
     return not (np.all((wn >= low) & (wn <= high)) and np.all((zeta > 0) & (zeta < 1))
@@ -583,14 +584,14 @@ def _fit_noise(frf, bands, power, omega_n, damping_ratio, estimated_noise, chann
 
     ``known``: the noise came with the FRF (an estimate from time data) and is taken as it is.
     ``residual``: the fit's residual on those lines and channels, if the caller has it.
-    ``fit``: the :func:`_fit_bands` fit of these poles on the same lines and channels, whose own
-    residual is then used (when it is unweighted); ``data``: :func:`_band_data` of them.
+    ``fit``: an unweighted :func:`_fit_bands` fit of these poles on the same lines and channels,
+    whose own residual is then used; ``data``: :func:`_band_data` of them.
     """
     rows = slice(None) if channels is None else channels
     if known:
         return np.asarray(estimated_noise, float)[rows]
-    if fit is not None and fit.residual is not None and _line_weight(frf, bands) is None:
-        omega = frf.omega_rad_s[_regions(bands, frf.frequency_hz)[0]]
+    if fit is not None:
+        omega = frf.omega_rad_s[_regions(bands, frf.frequency_hz)[0]] if data is None else data[0]
         with np.errstate(all="ignore"):
             return fit_residual_noise_std(omega, fit, np.asarray(estimated_noise, float)[rows])
     omega, response, region = _band_data(frf, bands, channels) if data is None else data
@@ -639,11 +640,6 @@ def _fit_bands(frf, bands, power, omega_n0, damping_ratio0, channels=None, data=
         fit = fit_modes(omega, response, power, omega_n0, damping_ratio0, region=region, line_weight=weight)
     if len(bands) < 2:
         return fit
-    scale = np.where(fit.channel_scale > 0, fit.channel_scale, 1.0)  # max |H| of each channel
-
-    def cost(f):
-        return float(np.sum(f.noise_var / scale**2))
-
     for r in range(len(bands)):
         zeta, s_zeta = fit.damping_ratio[r], np.sqrt(abs(fit.mode_cov[r, 0, 1, 1]))
         if zeta < 1 and s_zeta <= REL_STD_LIMIT * zeta:
@@ -660,7 +656,7 @@ def _fit_bands(frf, bands, power, omega_n0, damping_ratio0, channels=None, data=
         start_wn[r], start_zeta[r] = start
         with np.errstate(all="ignore"):
             restart = fit_modes(omega, response, power, start_wn, start_zeta, region=region, line_weight=weight)
-        if np.all(np.isfinite(restart.noise_var)) and cost(restart) < cost(fit):
+        if _fit_cost(restart) < _fit_cost(fit):
             fit = restart
     return fit
 

@@ -198,6 +198,23 @@ def _fork_quietly() -> int:
     return pid
 
 
+def _report_and_exit(work: Callable[[], dict], report_write: int) -> None:
+    """In a forked child: run ``work``, write its report (or the exception) to ``report_write`` and
+    leave with ``os._exit`` (never the parent's exit handlers): 0 on success, 1 on an error."""
+    import os
+
+    code = 1
+    try:
+        report = work()
+        code = 1 if "error" in report else 0
+    except BaseException as exc:  # noqa: BLE001 - reported to the parent, which raises it
+        report = {"error": f"{type(exc).__name__}: {exc}"}
+    try:
+        _write_report(report_write, report)
+    finally:
+        os._exit(code)
+
+
 def _draw_jobs(jobs_read: int, folder: Path) -> dict:
     """Take job records from the pipe until it is closed and draw each; {"drawn": {stage: paths}}, with
     "error" naming the stage and the cause of the first failure (the later jobs are then only discarded)."""
@@ -265,18 +282,12 @@ class _Plotter:
         self._report, report_write = os.pipe()
         pid = _fork_quietly()
         if pid == 0:  # plotter: draw, report, leave without running the parent's exit handlers
-            code = 1
-            try:
+            def plotter() -> dict:
                 os.close(self._jobs)
                 os.close(self._report)
-                report = self._serve(jobs_read)
-                code = 1 if "error" in report else 0
-            except BaseException as exc:  # noqa: BLE001 - reported to the parent, which raises it
-                report = {"error": f"{type(exc).__name__}: {exc}"}
-            try:
-                _write_report(report_write, report)
-            finally:
-                os._exit(code)
+                return self._serve(jobs_read)
+
+            _report_and_exit(plotter, report_write)
         os.close(jobs_read)
         os.close(report_write)
         self.pid = pid
@@ -294,17 +305,11 @@ class _Plotter:
         read, write = os.pipe()
         helper = _fork_quietly()
         if helper == 0:
-            code = 1
-            try:
+            def drawer() -> dict:
                 os.close(read)
-                report = _draw_jobs(jobs_read, self.folder)
-                code = 1 if "error" in report else 0
-            except BaseException as exc:  # noqa: BLE001
-                report = {"error": f"{type(exc).__name__}: {exc}"}
-            try:
-                _write_report(write, report)
-            finally:
-                os._exit(code)
+                return _draw_jobs(jobs_read, self.folder)
+
+            _report_and_exit(drawer, write)
         os.close(write)
         mine = _draw_jobs(jobs_read, self.folder)
         theirs = _read_report(read)
