@@ -49,29 +49,6 @@ def _misfit_power(frequency: np.ndarray, values: np.ndarray, axis: int = -1) -> 
 _ROWS_AT_ONCE = 128
 
 
-#: rows of :func:`neighbour_noise_std` computed together (their misfit, 2 MB at 2000 lines, stays in the cache)
-_ROWS_AT_ONCE = 128
-
-
-def _misfit_power_at(frequency: np.ndarray, values: np.ndarray, centre: np.ndarray, step: int) -> np.ndarray:
-    """:func:`_misfit_power` of the lines ``centre`` against their neighbours ``step`` lines away
-    (the same arithmetic as on the axis subsampled by ``step``); shape (n_rows, centre.size)."""
-    f_centre = frequency[centre]
-    before = f_centre - frequency[centre - step]
-    after = frequency[centre + step] - f_centre
-    w_left = after / (before + after)
-    w_right = 1.0 - w_left
-    norm = 1.0 / (1.0 + w_left**2 + w_right**2)
-    left, right = np.repeat(w_left, 2), np.repeat(w_right, 2)
-    misfit = np.multiply(values.take(centre - step, axis=1).view(float), left)
-    misfit += values.take(centre + step, axis=1).view(float) * right
-    np.subtract(values.take(centre, axis=1).view(float), misfit, out=misfit)
-    misfit *= misfit
-    power = np.add(misfit[:, 0::2], misfit[:, 1::2])
-    power *= norm
-    return power
-
-
 def neighbour_noise_std(frequency: np.ndarray, values: np.ndarray, axis: int = -1) -> np.ndarray:
     """Noise standard deviation per row (E|n|² = σ²), from each line's misfit to its neighbours.
 
@@ -130,12 +107,16 @@ def mode_indicator(frf: FRF) -> np.ndarray:
 
 
 def _indicator_and_peak(frf: FRF) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`mode_indicator` and each channel's max |H| (n_channels,), from one |H| (in place)."""
+    """:func:`mode_indicator` and each channel's max |H| (n_channels,), from one |H| (squared in place;
+    the channels' normalised squares summed by one matrix-vector product)."""
     mag = np.abs(frf.channels)
     peak = mag.max(axis=1)
-    mag /= np.where(peak > 0, peak, 1.0)[:, None]
+    scale = np.where(peak > 0, peak, 1.0)
+    if not 1e-150 < scale.min() <= scale.max() < 1e150:  # |H|² would leave the float range: normalise first
+        mag /= scale[:, None]
+        scale = np.ones_like(scale)
     mag *= mag
-    return np.sqrt(np.mean(mag, axis=0)), peak
+    return np.sqrt(((1.0 / scale**2) @ mag) / mag.shape[0]), peak
 
 
 @dataclass(frozen=True)
@@ -270,7 +251,8 @@ def local_noise_std(frequency: np.ndarray, values: np.ndarray, lines, exclude,
 
 def find_modes(frf: FRF, min_prominence_db: float = 6.0, noise_factor: float = 10.0,
                bandwidths: float = 3.0, max_modes: int | None = None,
-               noise_std: np.ndarray | None = None, line_noise_std: np.ndarray | None = None) -> list[ModeBand]:
+               noise_std: np.ndarray | None = None, line_noise_std: np.ndarray | None = None,
+               indicator: tuple[np.ndarray, np.ndarray] | None = None) -> list[ModeBand]:
     """Find resonance peaks and give each a fitting band.
 
     A peak of the mode indicator counts when it stands ``min_prominence_db``
@@ -280,10 +262,11 @@ def find_modes(frf: FRF, min_prominence_db: float = 6.0, noise_factor: float = 1
     when the FRF carries its own noise per line, e.g. an estimate from time
     data). Its band is ±``bandwidths`` half-power widths (at least ±5 lines),
     clipped halfway to the neighbouring peaks and to the data, with its edges
-    moved halfway between lines (see :func:`_edges_between_lines`).
+    moved halfway between lines (see :func:`_edges_between_lines`). ``indicator``: the mode
+    indicator and each channel's max |H| (:func:`_indicator_and_peak`), when the caller has them.
     """
     freq = frf.frequency_hz
-    ind, peak_mag = _indicator_and_peak(frf)
+    ind, peak_mag = _indicator_and_peak(frf) if indicator is None else indicator
     noise = estimate_noise_std(frf) if noise_std is None else noise_std
     with np.errstate(invalid="ignore", divide="ignore"):
         noise_rel = float(np.sqrt(np.nanmean((noise / peak_mag) ** 2)))
