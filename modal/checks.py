@@ -166,9 +166,11 @@ def _exp_mean_median(n_channels: int) -> float:
     return float(special.gammaincinv(n_channels, 0.5)) / n_channels
 
 
-def _seen_through(res, omega, response, noise_std):
-    floor = ARITHMETIC_FLOOR * np.max(np.abs(response), axis=1)
-    return np.maximum(np.minimum(noise_std, neighbour_noise_std(omega, res)), floor)
+def _seen_through(noise_std, seen, peak):
+    """The noise per channel as a residual shows it: the smaller of the raw-data estimate and the
+    residual's own neighbour-misfit estimate ``seen``, at least ``ARITHMETIC_FLOOR`` times the
+    channel's max |H| (``peak``); see :func:`residual_noise_std`."""
+    return np.maximum(np.minimum(np.asarray(noise_std, float), seen), ARITHMETIC_FLOOR * peak)
 
 
 def residual_noise_std(omega: np.ndarray, response: np.ndarray, power: int, region: np.ndarray,
@@ -198,7 +200,7 @@ def residual_noise_std(omega: np.ndarray, response: np.ndarray, power: int, regi
     ndarray, shape (n_channels,)
     """
     res = residual if residual is not None else fit_residual(omega, response, power, region, omega_n, damping_ratio)
-    return _seen_through(res, omega, response, np.asarray(noise_std, float))
+    return _seen_through(noise_std, neighbour_noise_std(omega, res), np.max(np.abs(response), axis=1))
 
 
 def fit_residual_noise_std(omega: np.ndarray, fit, noise_std) -> np.ndarray:
@@ -218,9 +220,9 @@ def fit_residual_noise_std(omega: np.ndarray, fit, noise_std) -> np.ndarray:
     -------
     ndarray, shape (n_channels,)
     """
-    peak = np.asarray(fit.channel_scale, float)
-    seen = neighbour_noise_std(omega, fit.residual, axis=0) * np.where(peak > 0, peak, 1.0)
-    return np.maximum(np.minimum(np.asarray(noise_std, float), seen), ARITHMETIC_FLOOR * peak)
+    peak = np.asarray(fit.channel_scale, float)  # the residual is held per channel over its peak, lines first
+    return _seen_through(noise_std, neighbour_noise_std(omega, fit.residual, axis=0) * np.where(peak > 0, peak, 1.0),
+                         peak)
 
 
 def residual_structure(omega: np.ndarray, response: np.ndarray, power: int, region: np.ndarray,
@@ -353,7 +355,7 @@ def find_missing_mode(omega: np.ndarray, response: np.ndarray, power: int, regio
     if residual_noise is not None:
         sigma2 = np.asarray(residual_noise, float)[strongest] ** 2
     else:
-        sigma2 = _seen_through(res, omega, Y, noise_std[strongest]) ** 2
+        sigma2 = _seen_through(noise_std[strongest], neighbour_noise_std(omega, res), np.max(np.abs(Y), axis=1)) ** 2
     if not np.all(sigma2 > 0):
         return None
     energy = np.mean(np.abs(res) ** 2 / sigma2[:, None], axis=0)

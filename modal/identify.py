@@ -974,7 +974,7 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
         fit = _nls_fit(frf, bands, power, noise, data)
         # the checks all measure the residual of the same modes on the same lines: the fit's own when it is
         # unweighted (no second solve), else computed once
-        own = fit.residual is not None and _line_weight(frf, bands) is None
+        own = fit.residual is not None and not fit.line_weighted
         if own:
             residual = _ScaledResidual(fit.residual, np.where(fit.channel_scale > 0, fit.channel_scale, 1.0))
         else:

@@ -42,6 +42,8 @@ class NLSFit:
     channel_scale : ndarray, shape (n_channels,), optional
         max |H| of each channel over the lines, FRF unit (``residual`` is divided by it, or by 1
         where it is 0).
+    line_weighted : bool
+        The fit weighted its lines (``line_weight`` given): ``residual`` is the weighted one.
     """
 
     omega_n: np.ndarray
@@ -54,6 +56,7 @@ class NLSFit:
     n_iter: int
     residual: np.ndarray | None = None
     channel_scale: np.ndarray | None = None
+    line_weighted: bool = False
 
 
 #: largest damping ratio the fit may reach (far past critical: the mode is then a slope)
@@ -364,6 +367,7 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
         n_iter=n_iter,
         residual=res,
         channel_scale=peak,
+        line_weighted=weight is not None,
     )
 
 
