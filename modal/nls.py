@@ -178,8 +178,11 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
     n_ch = Y_raw.shape[0]
     peak = np.abs(Y_raw).max(axis=1)
     ch_scale = np.where(peak > 0, peak, 1.0)
-    # (n_freq, n_ch), each channel scaled to max 1 (divided and transposed in one pass)
-    Y = np.divide(Y_raw.T, ch_scale[None, :], out=np.empty((Y_raw.shape[1], n_ch), dtype=complex))
+    # (n_freq, n_ch), each channel scaled to max 1: a transposed copy divided in place on its real view
+    # (numpy divides complex by real as complex by complex, three times as long and not correctly rounded)
+    Y = np.array(Y_raw.T, dtype=complex, order="C")
+    parts = Y.view(float)
+    np.divide(parts, np.repeat(ch_scale, 2), out=parts)
     w_ref = np.atleast_1d(np.asarray(omega_n0, float))
     w_ref = float(w_ref[0] if w_ref.size == 1 else np.median(w_ref))
     x = omega / w_ref
