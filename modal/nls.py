@@ -302,7 +302,7 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
     if Y is not Y_full:  # back to the channels: one projection of the full data
         Y = Y_full
         QhY = Q.conj().T @ Y
-        res = np.subtract(Y, Q @ QhY)
+        res = np.subtract(Y, Q @ QhY, out=Y)  # in place: the scaled copy is ours and not needed after
     n_freq = x.size
     n_b = Phi.shape[1]
     C = np.linalg.solve(R, QhY)

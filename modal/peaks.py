@@ -27,7 +27,9 @@ def _misfit_power(frequency: np.ndarray, values: np.ndarray, axis: int = -1) -> 
     w_left = step[1:] / (step[:-1] + step[1:])
     w_right = 1.0 - w_left
     norm = 1.0 / (1.0 + w_left**2 + w_right**2)
-    values = np.ascontiguousarray(values, dtype=complex)
+    values = np.asarray(values, dtype=complex)
+    if values.strides[-1] != values.itemsize:  # the real view needs Re, Im side by side along the last axis
+        values = np.ascontiguousarray(values)
     # on the real view (real and imaginary parts side by side), in place: 1000 channels ×
     # 2000 lines are 32 MB per temporary, and complex-by-real products cost twice as much
     parts = values.view(float)
@@ -93,14 +95,12 @@ def neighbour_noise_std(frequency: np.ndarray, values: np.ndarray, axis: int = -
     if axis == 0:
         if values.shape[0] < 5:
             return np.full(values.shape[1], np.nan)
-        median = np.empty(values.shape[1])
-        for start in range(0, values.shape[1], _ROWS_AT_ONCE):  # a block of columns stays in the cache
-            block = values[:, start:start + _ROWS_AT_ONCE]
-            power = np.ascontiguousarray(_misfit_power(frequency, block, axis=0).T)
-            mid = power.shape[1] // 2
-            power.partition(mid, axis=1)  # in place: the misfit is ours
-            median[start:start + _ROWS_AT_ONCE] = power[:, mid]
-        return np.sqrt(median / np.log(2))
+        # all rows at once (contiguous shifts of whole lines; in blocks of columns the misfit took 30 % longer),
+        # then the lines of each row side by side for the median
+        power = np.ascontiguousarray(_misfit_power(frequency, values, axis=0).T)
+        mid = power.shape[1] // 2
+        power.partition(mid, axis=1)  # in place: the misfit is ours
+        return np.sqrt(power[:, mid] / np.log(2))
     if values.shape[1] < 5:
         return np.abs(values).max(axis=1) * np.nan
     median = np.empty(values.shape[0])
