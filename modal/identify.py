@@ -885,7 +885,7 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
     # an FRF estimated from time data carries its own calibrated noise per line (modal.estimate_frf)
     line_noise = getattr(frf, "noise_std", None)
     if bands_hz is not None:
-        bands = bands_from_hz(frf, bands_hz)
+        bands = bands_from_hz(frf, bands_hz, indicator=indicator[0])
     elif found is not None and max_modes is None:  # the automatic choice's search, with the same arguments
         bands = found
     else:

@@ -366,8 +366,9 @@ def _edges_between_lines(freq: np.ndarray, low: float, high: float) -> tuple[flo
     return float(low), float(high)
 
 
-def bands_from_hz(frf: FRF, bands_hz) -> list[ModeBand]:
-    """Turn user bands ``[(f_low, f_high), ...]`` (Hz) into :class:`ModeBand` objects."""
+def bands_from_hz(frf: FRF, bands_hz, indicator: np.ndarray | None = None) -> list[ModeBand]:
+    """Turn user bands ``[(f_low, f_high), ...]`` (Hz) into :class:`ModeBand` objects (``indicator``: the
+    :func:`mode_indicator`, when the caller has it)."""
     out = []
     try:
         pairs = [(float(a), float(b)) for a, b in bands_hz]
@@ -375,7 +376,7 @@ def bands_from_hz(frf: FRF, bands_hz) -> list[ModeBand]:
         raise IdentificationError(
             f"bands_hz must be a list of (f_low, f_high) pairs in Hz, got {bands_hz!r}"
         ) from None
-    ind = mode_indicator(frf)
+    ind = mode_indicator(frf) if indicator is None else indicator
     freq = frf.frequency_hz
     for low, high in pairs:
         if not (np.isfinite(low) and np.isfinite(high) and low < high):
