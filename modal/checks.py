@@ -125,7 +125,7 @@ def _check_channels(peak: np.ndarray, noise_std: np.ndarray) -> np.ndarray:
 
     Ranked by the estimated peak/σ alone, the chosen channels of many with the same true
     ratio are those whose σ estimate came out low by chance (1000 channels, σ² estimated on
-    741 lines: 8 chosen ones 10–15 % low), and the residual then looks like more than noise.
+    741 lines: the 8 chosen ones 15–17 % low in σ²), and the residual then looks like more than noise.
     Within a factor :data:`SNR_TIE` the estimates' errors cannot decide membership, and the
     peak does not depend on them.
     """
