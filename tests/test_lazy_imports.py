@@ -39,6 +39,23 @@ def test_the_scene_runner_imports_the_solvers_only_when_a_stage_needs_them():
     # scipy.integrate, scipy.linalg) wait until a stage calls them
     loaded = _modules_after("import balancer.cli, balancer.scene.runner, balancer.scene.plots")
     assert not any(loaded[m] for m in ("scipy.optimize", "scipy.integrate", "scipy.linalg"))
+    # a non-stiff simulation runs DOP853 in balancer.adb.dop853: no scipy.integrate (whose package
+    # import loads scipy.optimize too); the stiff methods still use solve_ivp
+    loaded = _modules_after("from balancer.adb import ADBParameters, simulate\n"
+                            "simulate(ADBParameters(M=1.0, m=0.02, n=2, R=0.05, e=5e-4, k=1e4, c=20.0, D=1e-3), 150.0,"
+                            " 0.05)")
+    assert not loaded["scipy.integrate"] and not loaded["scipy.optimize"]
     assert _modules_after("from balancer.adb import ADBParameters, simulate\n"
                           "simulate(ADBParameters(M=1.0, m=0.02, n=2, R=0.05, e=5e-4, k=1e4, c=20.0, D=1e-3), 150.0,"
-                          " 0.05)")["scipy.integrate"] is True
+                          " 0.05, method='LSODA')")["scipy.integrate"] is True
+
+
+def test_the_demo_scene_stages_need_neither_scipy_optimize_nor_scipy_integrate():
+    # the demo's three roots and one bounded minimum run in balancer.solve1d, its run-up in
+    # balancer.adb.dop853: together ~0.1-0.2 s of imports the demo no longer pays
+    loaded = _modules_after(f"from balancer.scene import run_scene\n"
+                            f"import tempfile, pathlib\n"
+                            f"scene = pathlib.Path({str(ROOT)!r}) / 'data' / 'synthetic' / 'demo_scene.toml'\n"
+                            f"with tempfile.TemporaryDirectory() as d:\n"
+                            f"    run_scene(scene, out=pathlib.Path(d) / 'demo.h5', plot_jobs=2)")
+    assert not loaded["scipy.optimize"] and not loaded["scipy.integrate"]

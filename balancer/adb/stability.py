@@ -14,6 +14,7 @@ import numpy as np
 
 from modal.errors import ParameterError
 
+from ..solve1d import find_root
 from .equilibria import balanced_state
 from .linear import CLASS_NAMES, STABLE, EigenAnalysis, eigen_analysis_nondimensional
 from .parameters import STD_ORDER, ADBParameters, ParameterStd
@@ -223,8 +224,9 @@ def stable_speed_intervals(
     """Speed intervals (rad/s) in which the balanced state is linearly stable.
 
     The speed range is scanned on a uniform grid (batched eigenvalues); every change of
-    sign of the largest real part is then refined by Brent's method.  Intervals narrower
-    than the grid spacing can be missed: raise ``grid_points`` if in doubt.
+    sign of the largest real part is then refined by Brent's method
+    (:func:`balancer.solve1d.find_root`).  Intervals narrower than the grid spacing can be
+    missed: raise ``grid_points`` if in doubt.
 
     Parameters
     ----------
@@ -268,9 +270,7 @@ def stable_speed_intervals(
         low, high = speeds[index], speeds[index + 1]
         if growth(low) * growth(high) > 0.0:
             return high if stable[index + 1] else low
-        from scipy.optimize import brentq  # scipy.optimize only when refining (import ~0.1 s)
-
-        return brentq(growth, low, high, xtol=xtol_ratio * wn, rtol=4 * np.finfo(float).eps)
+        return find_root(growth, low, high, xtol=xtol_ratio * wn, rtol=4 * np.finfo(float).eps)
 
     intervals = []
     start = speeds[0] if stable[0] else None
