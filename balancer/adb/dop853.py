@@ -12,6 +12,7 @@ as in SciPy.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Callable
 
@@ -67,7 +68,7 @@ def _first_step(fun, t0: float, y0: np.ndarray, f0: np.ndarray, span: float, rto
     d1 = _rms(f0 / scale)
     h0 = 1e-6 if d0 < 1e-5 or d1 < 1e-5 else 0.01 * d0 / d1
     h0 = min(h0, span)
-    f1 = fun(t0 + h0, y0 + h0 * f0)
+    f1 = np.asarray(fun(t0 + h0, y0 + h0 * f0), dtype=float)
     d2 = _rms((f1 - f0) / scale) / h0
     if d1 <= 1e-15 and d2 <= 1e-15:
         h1 = max(1e-6, h0 * 1e-3)
@@ -105,24 +106,20 @@ def dop853(fun: Callable[[float, np.ndarray], np.ndarray], t_span: tuple[float, 
     n = y.size
     times = np.asarray(t_eval, dtype=float)
     atol = np.asarray(atol, dtype=float)
-    nfev = 0
-
-    def f_eval(time: float, state: np.ndarray) -> np.ndarray:
-        nonlocal nfev
-        nfev += 1
-        return np.asarray(fun(time, state), dtype=float)
-
-    f = f_eval(t, y)
-    h_abs = _first_step(f_eval, t, y, f, t_bound - t, rtol, atol)
+    sqrt = math.sqrt
+    # plain-float stage times (the same IEEE arithmetic as numpy scalars, cheaper in the right-hand side)
+    a_rows = [(a[:s], float(c)) for s, (a, c) in enumerate(zip(_A[1:], _C[1:]), start=1)]
+    a_extra = [(a[:s], float(c)) for s, (a, c) in enumerate(zip(_A_EXTRA, _C_EXTRA), start=_N + 1)]
+    f = np.asarray(fun(t, y), dtype=float)
+    h_abs = _first_step(fun, t, y, f, t_bound - t, rtol, atol)
+    nfev = 2  # f and the first-step probe
     K = np.empty((_co.N_STAGES_EXTENDED, n))
     K_step = K[:_N + 1]
-    a_rows = [(a[:s], c) for s, (a, c) in enumerate(zip(_A[1:], _C[1:]), start=1)]
-    a_extra = [(a[:s], c) for s, (a, c) in enumerate(zip(_A_EXTRA, _C_EXTRA), start=_N + 1)]
     samples_t, samples_y = [], []
     index = 0  # first sample not yet produced
     status, message = 0, "The solver successfully reached the end of the integration interval."
     while t < t_bound:
-        min_step = 10 * abs(np.nextafter(t, np.inf) - t)
+        min_step = 10 * abs(math.nextafter(t, math.inf) - t)
         h_abs = max(h_abs, min_step)
         rejected = False
         while True:
@@ -137,19 +134,20 @@ def dop853(fun: Callable[[float, np.ndarray], np.ndarray], t_span: tuple[float, 
             # one step: the stages (as scipy.integrate._ivp.rk.rk_step)
             K[0] = f
             for s, (a, c) in enumerate(a_rows, start=1):
-                K[s] = f_eval(t + c * h, y + np.dot(K[:s].T, a) * h)
+                K[s] = fun(t + c * h, y + np.dot(K[:s].T, a) * h)
             y_new = y + h * np.dot(K[:_N].T, _B)
-            f_new = f_eval(t + h, y_new)
+            f_new = np.asarray(fun(t + h, y_new), dtype=float)
+            nfev += _N
             K[_N] = f_new
             scale = atol + np.maximum(np.abs(y), np.abs(y_new)) * rtol
             err5 = np.dot(K_step.T, _E5) / scale
             err3 = np.dot(K_step.T, _E3) / scale
-            err5_2 = np.linalg.norm(err5) ** 2
-            err3_2 = np.linalg.norm(err3) ** 2
+            err5_2 = sqrt(err5.dot(err5)) ** 2  # np.linalg.norm(x) ** 2, as SciPy, without its overhead
+            err3_2 = sqrt(err3.dot(err3)) ** 2
             if err5_2 == 0 and err3_2 == 0:
                 error = 0.0
             else:
-                error = np.abs(h) * err5_2 / np.sqrt((err5_2 + 0.01 * err3_2) * n)
+                error = h_abs * err5_2 / sqrt((err5_2 + 0.01 * err3_2) * n)
             if error < 1:
                 factor = _MAX_FACTOR if error == 0 else min(_MAX_FACTOR, _SAFETY * error ** _ERROR_EXPONENT)
                 if rejected:
@@ -161,10 +159,11 @@ def dop853(fun: Callable[[float, np.ndarray], np.ndarray], t_span: tuple[float, 
         if status != 0:
             break
         t_old, y_old, t, y, f = t, y, t_new, y_new, f_new
-        stop = int(np.searchsorted(times, t, side="right"))
+        stop = int(times.searchsorted(t, side="right"))
         if stop > index:  # dense output on this step (as Dop853DenseOutput)
             for s, (a, c) in enumerate(a_extra, start=_N + 1):
-                K[s] = f_eval(t_old + c * h, y_old + np.dot(K[:s].T, a) * h)
+                K[s] = fun(t_old + c * h, y_old + np.dot(K[:s].T, a) * h)
+            nfev += len(a_extra)
             F = np.empty((_co.INTERPOLATOR_POWER, n))
             delta_y = y - y_old
             F[0] = delta_y

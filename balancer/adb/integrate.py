@@ -31,7 +31,7 @@ from .equations import (
     scalar_rhs,
 )
 from .parameters import ADBParameters, ParameterBatch
-from .speed import ConstantSpeed, as_speed_profile, check_profile
+from .speed import ConstantSpeed, LinearRunUp, as_speed_profile, check_profile
 
 __all__ = ["STIFFNESS_RATIO", "IntegrationResult", "choose_method", "integrate"]
 
@@ -181,11 +181,21 @@ def integrate(
         single = scalar_rhs(*(float(getattr(batch, name)[0]) for name in ("M", "m")), batch.n,
                             *(float(getattr(batch, name)[0]) for name in ("R", "e", "k", "c", "D")), frame=frame)
 
-        def fun(t, y):
-            omega, alpha = speed_at(t)
-            if not (math.isfinite(omega) and math.isfinite(alpha)):
-                raise ParameterError(f"speed profile is not finite at t = {t!r} s: expected finite values")
-            return single(y, omega, alpha)
+        if isinstance(profile, LinearRunUp):
+            # LinearRunUp.speed_rad_s / acceleration_rad_s2 of one float, inlined (the same arithmetic;
+            # finite by construction): the run-up's right-hand side is called ~16 000 times
+            t0, t1, duration = profile.start_time_s, profile.start_time_s + profile.duration_s, profile.duration_s
+            w0, dw, rate = profile.start_speed, profile.end_speed - profile.start_speed, profile.rate_rad_s2
+
+            def fun(t, y):
+                omega = w0 + dw * min(max((t - t0) / duration, 0.0), 1.0)
+                return single(y, omega, rate if t0 <= t < t1 else 0.0)
+        else:
+            def fun(t, y):
+                omega, alpha = speed_at(t)
+                if not (math.isfinite(omega) and math.isfinite(alpha)):
+                    raise ParameterError(f"speed profile is not finite at t = {t!r} s: expected finite values")
+                return single(y, omega, alpha)
     else:
         def fun(t, y):
             omega, alpha = speed_at(t)
