@@ -31,7 +31,7 @@ def _stability(results):
         ax.axvspan(lo, hi, color="tab:green", alpha=0.15, lw=0)
     ax.set_xlabel("speed Ω/ωn")
     ax.set_ylabel("max Re λ of the balanced state [1/s]")
-    ax.set_title("balanced state: stable where shaded")
+    ax.set_title("balanced state: stable where shaded", y=1.0)  # fixed: nothing above the axes to avoid
     return [("stability", fig)]
 
 
