@@ -12,7 +12,7 @@ ROOT = Path(__file__).resolve().parent.parent
 def _modules_after(code: str) -> dict:
     script = (f"import sys, json\nsys.path.insert(0, {str(ROOT)!r})\n{code}\n"
               "print(json.dumps({m: m in sys.modules for m in ('balancer.influence', 'matplotlib.figure', 'scipy.optimize',"
-              "'scipy.integrate', 'scipy.linalg')}))")
+              "'scipy.integrate', 'scipy.linalg', 'h5py')}))")
     proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, proc.stderr[-2000:]
     return json.loads(proc.stdout.strip().splitlines()[-1])
@@ -39,6 +39,7 @@ def test_the_scene_runner_imports_the_solvers_only_when_a_stage_needs_them():
     # scipy.integrate, scipy.linalg) wait until a stage calls them
     loaded = _modules_after("import balancer.cli, balancer.scene.runner, balancer.scene.plots")
     assert not any(loaded[m] for m in ("scipy.optimize", "scipy.integrate", "scipy.linalg"))
+    assert not loaded["h5py"]  # only the parent writes the archive, after the fork
     # a non-stiff simulation runs DOP853 in balancer.adb.dop853: no scipy.integrate (whose package
     # import loads scipy.optimize too); the stiff methods still use solve_ivp
     loaded = _modules_after("from balancer.adb import ADBParameters, simulate\n"

@@ -7,18 +7,21 @@ import json
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable
-
-import h5py
+from typing import TYPE_CHECKING, Any, Callable
 
 import modal
-from modal.archive import read_node, write_archive
 from modal.errors import ArchiveError, SceneError
 
 from .schema import STAGES, Reference, Scene, dependencies, load_scene, parse_scene
 from .stages import STAGE_FUNCTIONS
 
+if TYPE_CHECKING:
+    import h5py
+
 __all__ = ["SceneRun", "run_scene", "plan", "stage_hashes"]
+
+# h5py (and modal.archive) are imported where an archive is read or written: `python -m balancer run`
+# forks its plotting process before, and what is imported by then is paid before both processes work
 
 #: configuration sections that make up each stage's inputs (besides its dependencies' hashes)
 _STAGE_CONFIG = {
@@ -142,6 +145,8 @@ def _open_earlier(path) -> h5py.File | None:
     path = Path(path)
     if not path.is_file():
         return None  # nothing to reuse yet: run everything
+    import h5py
+
     try:
         f = h5py.File(path, "r")
     except OSError as exc:
@@ -410,6 +415,8 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, p
         timings: dict[str, float] = {}
         for stage in STAGES:
             if status[stage] == "reused":
+                from modal.archive import read_node
+
                 results[stage] = read_node(earlier[stage])
     finally:
         if earlier is not None:
@@ -455,6 +462,8 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, p
         if archive_path is not None:
             keep = [s for s in STAGES if s in results and (stored is True or stored is False or s in stored)]
             archive_path.parent.mkdir(parents=True, exist_ok=True)
+            from modal.archive import write_archive
+
             write_archive(archive_path, {s: results[s] for s in keep}, scene_text=scene.text or None,
                           inputs_hash={s: hashes[s] for s in keep})
         if plotted:
