@@ -161,6 +161,12 @@ def _open_earlier(path) -> h5py.File | None:
     return f
 
 
+#: the results each stage's figures read (balancer.scene.plots; tests/test_scene_plot_jobs.py checks it): a
+#: plotting process is handed only these, so it unpickles (and imports the classes of) nothing more
+_PLOT_INPUTS = {"identify": ("frf", "identify"), "adb_stability": ("adb_stability",),
+                "adb_response": ("adb_response", "rotor"), "compressor": ("compressor",), "mounts": ("mounts",),
+                "drive": ("drive",), "balance": ("balance",)}
+
 #: size of one job record on the plotters' pipe: written at once (atomic below PIPE_BUF) and read whole by
 #: whichever drawing process is free
 _RECORD = 1024
@@ -440,7 +446,7 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, p
         for stage in list(pending):
             if stage not in results or not all(status[t] != "ran" or t in results for t in dependencies(scene, stage)):
                 continue
-            given = {s: results[s] for s in _closure(scene, [stage]) if s in results}
+            given = {s: results[s] for s in _PLOT_INPUTS.get(stage, _closure(scene, [stage])) if s in results}
             if plotter.submit(stage, given):
                 pending.remove(stage)
 
