@@ -1,7 +1,15 @@
 """``python -m balancer``: see :mod:`balancer.cli`."""
 import sys
 
-from .cli import main
+if sys.argv[1:2] == ["run"]:
+    # A scene run is short and ends with os._exit (below): its imports (some 10^5 objects, none of
+    # them garbage) and stages need no cyclic garbage collection, which would take ~15 ms of the
+    # imports made before the plotting process is forked.  The drawing processes run without it too.
+    import gc
+
+    gc.disable()
+
+from .cli import main  # noqa: E402
 
 code = main()
 if sys.argv[1:2] == ["run"]:
