@@ -5,14 +5,19 @@ A layout engine (``layout="constrained"``) measures every tick label of every ax
 before the figure is drawn, and mathtext runs a parser for each ``10^{-3}`` label: both
 cost more than drawing the figure itself.  The figures of this package have known
 contents (tick labels of a few characters, one-line axis labels and titles), so margins
-set once in inches leave room for them at any figure size.
+set once in inches leave room for them at any figure size.  :func:`png_bytes` encodes the
+drawn figure itself (Pillow's adaptive PNG filtering costs more than it saves on plots).
 """
 from __future__ import annotations
 
+import struct
+import zlib
+
+import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.ticker import LogFormatterSciNotation
 
-__all__ = ["fixed_figure", "margins", "PlainLogFormatter", "plain_log_ticks"]
+__all__ = ["fixed_figure", "margins", "PlainLogFormatter", "plain_log_ticks", "png_bytes"]
 
 _SUPERSCRIPT = str.maketrans("-0123456789", "⁻⁰¹²³⁴⁵⁶⁷⁸⁹")
 _MATH_OPEN, _MATH_CLOSE = r"$\mathdefault{", "}$"
@@ -81,3 +86,54 @@ def fixed_figure(width_in: float, height_in: float, **kwargs) -> Figure:
     fig = Figure(figsize=(width_in, height_in))
     fig.subplots_adjust(**margins(width_in, height_in, **kwargs))
     return fig
+
+
+def _png_chunk(kind: bytes, data: bytes) -> bytes:
+    return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+
+
+def png_bytes(figure: Figure, dpi: float = 100.0, compress_level: int = 3) -> bytes:
+    """The figure drawn by Agg at ``dpi`` and encoded as a PNG file (8-bit RGBA).
+
+    The pixels of ``figure.savefig(format="png", dpi=dpi)`` (tested), written without a PNG
+    filter and deflated at ``compress_level``: on the flat colours of plots that is smaller
+    than Pillow's adaptive filtering (which ``savefig`` uses) and takes about 40 % of its time.
+    Like ``savefig`` it records the software (tEXt) and the resolution (pHYs).
+
+    Parameters
+    ----------
+    figure : Figure
+    dpi : float
+        Resolution, dots per inch.
+    compress_level : int
+        zlib level, 0-9.
+
+    Returns
+    -------
+    bytes
+        The PNG file's content.
+    """
+    import matplotlib
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    before = figure.dpi
+    figure.set_dpi(dpi)
+    try:
+        canvas = FigureCanvasAgg(figure)
+        canvas.draw()
+        rgba = np.asarray(canvas.buffer_rgba())
+    finally:
+        figure.set_dpi(before)
+    height, width = rgba.shape[:2]
+    rows = np.zeros((height, 1 + 4 * width), dtype=np.uint8)  # each scanline: filter type 0, then RGBA
+    rows[:, 1:] = rgba.reshape(height, -1)
+    per_metre = int(dpi / 0.0254 + 0.5)
+    software = f"Matplotlib version{matplotlib.__version__}, https://matplotlib.org/"
+    return b"".join([
+        b"\x89PNG\r\n\x1a\n",
+        _png_chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 6, 0, 0, 0)),
+        _png_chunk(b"tEXt", b"Software\x00" + software.encode("latin-1")),
+        _png_chunk(b"pHYs", struct.pack(">IIB", per_metre, per_metre, 1)),
+        _png_chunk(b"IDAT", zlib.compress(rows, compress_level)),
+        _png_chunk(b"IEND", b""),
+    ])

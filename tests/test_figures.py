@@ -76,3 +76,25 @@ def test_scene_figures_fit_without_a_layout_engine(demo_results, stage):
             for b in boxes[i + 1:]:
                 overlap = (min(a.x1, b.x1) - max(a.x0, b.x0), min(a.y1, b.y1) - max(a.y0, b.y0))
                 assert min(overlap) <= 1.0, (stage, name, a, b)
+
+
+@pytest.mark.parametrize("stage", ["identify", "adb_response", "mounts"])
+def test_png_bytes_holds_the_pixels_savefig_writes(demo_results, stage):
+    # the scene's own PNG writer (no filter, zlib) against matplotlib's savefig (Pillow): decoded,
+    # the same RGBA pixels, resolution and software note
+    import io
+
+    import numpy as np
+    from PIL import Image
+
+    from balancer.scene.plots import stage_figures
+    from modal.figures import png_bytes
+
+    for name, fig in stage_figures(stage, demo_results):
+        ours = Image.open(io.BytesIO(png_bytes(fig, dpi=100)))
+        theirs_file = io.BytesIO()
+        fig.savefig(theirs_file, format="png", dpi=100)
+        theirs = Image.open(io.BytesIO(theirs_file.getvalue()))
+        assert ours.mode == theirs.mode == "RGBA", name
+        assert np.array_equal(np.asarray(ours), np.asarray(theirs)), name
+        assert ours.info["dpi"] == theirs.info["dpi"] and ours.info["Software"] == theirs.info["Software"]
