@@ -209,9 +209,13 @@ def _fork_quietly() -> int:
     return pid
 
 
-def _report_and_exit(work: Callable[[], dict], report_write: int) -> None:
+def _report_and_exit(work: Callable[[], dict], report_write: int, after: Callable[[], None] | None = None) -> None:
     """In a forked child: run ``work``, write its report (or the exception) to ``report_write`` and
-    leave with ``os._exit`` (never the parent's exit handlers): 0 on success, 1 on an error."""
+    leave with ``os._exit`` (never the parent's exit handlers): 0 on success, 1 on an error.
+
+    The report's pipe is closed before leaving, so the reader has it at once rather than after
+    this process's memory is torn down (a few ms); ``after`` runs then (the plotter reaps its helper).
+    """
     import os
 
     code = 1
@@ -222,6 +226,9 @@ def _report_and_exit(work: Callable[[], dict], report_write: int) -> None:
         report = {"error": f"{type(exc).__name__}: {exc}"}
     try:
         _write_report(report_write, report)
+        os.close(report_write)
+        if after is not None:
+            after()
     finally:
         os._exit(code)
 
@@ -298,10 +305,16 @@ class _Plotter:
                 os.close(self._report)
                 return self._serve(jobs_read)
 
-            _report_and_exit(plotter, report_write)
+            _report_and_exit(plotter, report_write, after=self._reap_helper)
         os.close(jobs_read)
         os.close(report_write)
         self.pid = pid
+
+    def _reap_helper(self) -> None:
+        import os
+
+        if getattr(self, "_helper", None):
+            os.waitpid(self._helper, 0)
 
     def _serve(self, jobs_read: int) -> dict:
         """The plotter: import, fork the helper, draw; the two reports merged."""
@@ -322,9 +335,9 @@ class _Plotter:
 
             _report_and_exit(drawer, write)
         os.close(write)
+        self._helper = helper  # reaped after this process has reported (_reap_helper)
         mine = _draw_jobs(jobs_read, self.folder)
         theirs = _read_report(read)
-        os.waitpid(helper, 0)
         errors = [r["error"] for r in (mine, theirs) if "error" in r]
         return {"drawn": {**mine.get("drawn", {}), **theirs.get("drawn", {})},
                 **({"error": "; ".join(errors)} if errors else {})}
