@@ -18,7 +18,7 @@ from .model import mode_basis, solve_linear
 from .nls import fit_modes, truncation_shift
 from .rational import rational_pole
 from .propagate import combine_poles, constant_covariance, magnitude_to_complex
-from .peaks import ModeBand, bands_from_hz, estimate_noise_std, find_modes
+from .peaks import ModeBand, _indicator_and_peak, bands_from_hz, estimate_noise_std, find_modes
 from .results import FLAG_TEXT, IdentificationResult, ModeResult, ModeStd, correlation_of, physical_covariance, physical_parameters
 from .units import TWO_PI
 
@@ -276,7 +276,12 @@ def _band_data(frf, bands, channels=None):
     """Lines of the bands (rad/s), the FRF there (all or some channels) and each line's region."""
     keep, region = _regions(bands, frf.frequency_hz)
     rows = slice(None) if channels is None else channels
-    return frf.omega_rad_s[keep], frf.channels[rows][:, keep], region
+    lines = np.flatnonzero(keep)
+    starts = np.concatenate([[0], np.flatnonzero(np.diff(lines) > 1) + 1, [lines.size]])
+    response = frf.channels[rows]
+    # each band's run of lines copied as a block (half the time of a masked copy of every channel)
+    runs = [response[:, lines[a]:lines[b - 1] + 1] for a, b in zip(starts[:-1], starts[1:]) if b > a]
+    return frf.omega_rad_s[keep], (np.concatenate(runs, axis=1) if runs else response[:, keep]), region
 
 
 def _start_pole(frf, band, power, noise):
@@ -541,6 +546,18 @@ def _band_noise(frf, bands, line_noise):
     return np.sqrt(np.mean(line_noise[:, lines] ** 2, axis=1))
 
 
+class _ScaledResidual:
+    """A fit's own residual (:attr:`modal.nls.NLSFit.residual`, (n_freq, n_channels), each channel over its
+    scale) read as rows (n_channels, n_freq) in the FRF's unit: ``residual[rows]``. The checks read a few
+    of many channels (the strongest eight of 1000), so only those are scaled back and transposed."""
+
+    def __init__(self, residual: np.ndarray, scale: np.ndarray):
+        self._residual, self._scale = residual, scale
+
+    def __getitem__(self, rows) -> np.ndarray:
+        return (self._residual[:, rows] * self._scale[rows]).T
+
+
 def _local_misfit(frf, bands, power, omega_n, damping_ratio, data=None) -> np.ndarray:
     """Per mode, the misfit near it relative to the data there (RMS over the strongest channels, at most
     ``POLE_CHANNELS``).
@@ -555,6 +572,8 @@ def _local_misfit(frf, bands, power, omega_n, damping_ratio, data=None) -> np.nd
         omega_all, response = frf.omega_rad_s, frf.channels
     else:
         omega_all, response, _ = data
+    many = response.shape[0] > POLE_CHANNELS
+    magnitude = np.abs(response) if many else None  # |H| of every channel once, for every band's ranking
     for b, (band, wn, zeta) in enumerate(zip(bands, omega_n, damping_ratio)):
         # band edges lie halfway between lines (peaks._edges_between_lines): no rounding of 2π f can
         # move a line across one
@@ -563,8 +582,8 @@ def _local_misfit(frf, bands, power, omega_n, damping_ratio, data=None) -> np.nd
             continue
         run = slice(lines[0], lines[-1] + 1)  # a view: no copy of every channel
         omega, h = omega_all[run], response[:, run]
-        if h.shape[0] > POLE_CHANNELS:  # the strong channels carry the misfit that matters; O(1) in channels
-            h = h[np.argsort(np.abs(h).max(axis=1))[::-1][:POLE_CHANNELS]]
+        if many:  # the strong channels carry the misfit that matters; O(1) in channels
+            h = h[np.argsort(magnitude[:, run].max(axis=1))[::-1][:POLE_CHANNELS]]
         basis = mode_basis(omega, omega_n, damping_ratio, power).T
         design = np.hstack([basis, ((1j * omega) ** power)[:, None]])
         coef = solve_linear(design, h.T)
@@ -761,22 +780,25 @@ def choose_method(frf: FRF, bands_hz=None, min_prominence_db: float = 6.0) -> st
     return _auto_choice(frf, bands_hz, min_prominence_db)[0]
 
 
-def _auto_choice(frf: FRF, bands_hz, min_prominence_db: float) -> tuple[str, list | None]:
-    """:func:`choose_method`'s choice and the peaks' bands it found (None when it did not search), so that
-    identify does not search the peaks twice."""
+def _auto_choice(frf: FRF, bands_hz, min_prominence_db: float,
+                 indicator=None) -> tuple[str, list | None, np.ndarray | None]:
+    """:func:`choose_method`'s choice, the peaks' bands it found and the raw noise it estimated (None
+    when it did not search), so that identify does neither twice (``indicator``:
+    :func:`modal.peaks._indicator_and_peak`, if known)."""
     if bands_hz is not None:
-        return "nls", None
+        return "nls", None, None
     from .global_ import channel_grid
 
     index, _, transposed = channel_grid(frf)
     if index.shape[1] > 1:
-        return "global", None
+        return "global", None, None
+    noise = estimate_noise_std(frf)
     try:  # the peaks identify itself would fit: the same noise-aware test (an estimate's noise per line)
-        bands = find_modes(frf, min_prominence_db=min_prominence_db, noise_std=estimate_noise_std(frf),
-                           line_noise_std=getattr(frf, "noise_std", None))
+        bands = find_modes(frf, min_prominence_db=min_prominence_db, noise_std=noise,
+                           line_noise_std=getattr(frf, "noise_std", None), indicator=indicator)
     except IdentificationError:
-        return "nls", None
-    return ("global" if len(bands) >= AUTO_GLOBAL_PEAKS else "nls"), bands
+        return "nls", None, noise
+    return ("global" if len(bands) >= AUTO_GLOBAL_PEAKS else "nls"), bands, noise
 
 
 def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, driving_point=None,
@@ -839,7 +861,8 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
         raise IdentificationError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
     from .scaling import scale_exponent, scaled_frf, unscale_result
 
-    exponent = scale_exponent(frf)
+    indicator = _indicator_and_peak(frf)  # |H| once: the mode indicator and each channel's max |H|
+    exponent = scale_exponent(frf, peak=indicator[1])
     if exponent:  # values near over- or underflow: fit 2**e H (exact) and scale the results back
         gain = 2.0**exponent
         result = identify(scaled_frf(frf, exponent), method, bands_hz,
@@ -847,9 +870,10 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
                           driving_point=driving_point, min_prominence_db=min_prominence_db, max_modes=max_modes,
                           **global_options)
         return unscale_result(result, gain)
-    found = None  # peak bands the automatic choice already searched
+    found = raw_noise = None  # peak bands the automatic choice already searched, and its noise estimate
     if method == "auto":  # chosen on the (possibly rescaled) data, so the choice never overflows
-        method, found = ("global", None) if global_options else _auto_choice(frf, bands_hz, min_prominence_db)
+        method, found, raw_noise = (("global", None, None) if global_options
+                                    else _auto_choice(frf, bands_hz, min_prominence_db, indicator))
     if method == "global":
         from .global_ import identify_global
 
@@ -857,7 +881,7 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
         return identify_global(frf, band_hz=band, noise_std=noise_std, driving_point=driving_point, **global_options)
     power = KIND_POWER[frf.kind]
     n_ch = frf.n_channels
-    estimated_noise = estimate_noise_std(frf)
+    estimated_noise = estimate_noise_std(frf) if raw_noise is None else raw_noise
     # an FRF estimated from time data carries its own calibrated noise per line (modal.estimate_frf)
     line_noise = getattr(frf, "noise_std", None)
     if bands_hz is not None:
@@ -866,7 +890,7 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
         bands = found
     else:
         bands = find_modes(frf, min_prominence_db=min_prominence_db, max_modes=max_modes, noise_std=estimated_noise,
-                           line_noise_std=line_noise)
+                           line_noise_std=line_noise, indicator=indicator)
     known_noise = noise_std is None and line_noise is not None
     if known_noise:
         estimated_noise = _band_noise(frf, bands, line_noise)
@@ -957,9 +981,9 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
         fit = _nls_fit(frf, bands, power, noise, data)
         # the checks all measure the residual of the same modes on the same lines: the fit's own when it is
         # unweighted (no second solve), else computed once
-        own = fit.residual is not None and _line_weight(frf, bands) is None
+        own = fit.residual is not None and not fit.line_weighted
         if own:
-            residual = (fit.residual * np.where(fit.channel_scale > 0, fit.channel_scale, 1.0)).T
+            residual = _ScaledResidual(fit.residual, np.where(fit.channel_scale > 0, fit.channel_scale, 1.0))
         else:
             with np.errstate(all="ignore"):
                 residual = fit_residual(data[0], data[1], power, data[2], fit.omega_n, fit.damping_ratio)

@@ -42,6 +42,8 @@ class NLSFit:
     channel_scale : ndarray, shape (n_channels,), optional
         max |H| of each channel over the lines, FRF unit (``residual`` is divided by it, or by 1
         where it is 0).
+    line_weighted : bool
+        The fit weighted its lines (``line_weight`` given): ``residual`` is the weighted one.
     """
 
     omega_n: np.ndarray
@@ -54,6 +56,7 @@ class NLSFit:
     n_iter: int
     residual: np.ndarray | None = None
     channel_scale: np.ndarray | None = None
+    line_weighted: bool = False
 
 
 #: largest damping ratio the fit may reach (far past critical: the mode is then a slope)
@@ -175,8 +178,11 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
     n_ch = Y_raw.shape[0]
     peak = np.abs(Y_raw).max(axis=1)
     ch_scale = np.where(peak > 0, peak, 1.0)
-    # (n_freq, n_ch), each channel scaled to max 1 (divided and transposed in one pass)
-    Y = np.divide(Y_raw.T, ch_scale[None, :], out=np.empty((Y_raw.shape[1], n_ch), dtype=complex))
+    # (n_freq, n_ch), each channel scaled to max 1: a transposed copy divided in place on its real view
+    # (numpy divides complex by real as complex by complex, three times as long and not correctly rounded)
+    Y = np.array(Y_raw.T, dtype=complex, order="C")
+    parts = Y.view(float)
+    np.divide(parts, np.repeat(ch_scale, 2), out=parts)
     w_ref = np.atleast_1d(np.asarray(omega_n0, float))
     w_ref = float(w_ref[0] if w_ref.size == 1 else np.median(w_ref))
     x = omega / w_ref
@@ -296,7 +302,7 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
     if Y is not Y_full:  # back to the channels: one projection of the full data
         Y = Y_full
         QhY = Q.conj().T @ Y
-        res = np.subtract(Y, Q @ QhY)
+        res = np.subtract(Y, Q @ QhY, out=Y)  # in place: the scaled copy is ours and not needed after
     n_freq = x.size
     n_b = Phi.shape[1]
     C = np.linalg.solve(R, QhY)
@@ -364,6 +370,7 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
         n_iter=n_iter,
         residual=res,
         channel_scale=peak,
+        line_weighted=weight is not None,
     )
 
 

@@ -285,6 +285,13 @@ class IdentificationResult:
         return out
 
 
+def _kcm(omega_n, damping_ratio, A: np.ndarray):
+    """k = m ωn², c = 2 ζ m ωn, m = 1/|A| (infinite where A = 0)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        m = 1.0 / np.abs(A)
+        return m * omega_n**2, 2.0 * damping_ratio * m * omega_n, m
+
+
 def physical_parameters(omega_n, damping_ratio, modal_constant, cov=None):
     """k, c, m and their standard errors from (ωn, ζ, A) of a driving point.
 
@@ -305,11 +312,7 @@ def physical_parameters(omega_n, damping_ratio, modal_constant, cov=None):
     (k, c, m), (std_k, std_c, std_m) : tuples of ndarray
     """
     A = np.asarray(modal_constant, dtype=complex)
-    a = np.abs(A)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        m = 1.0 / a
-    k = m * omega_n**2
-    c = 2.0 * damping_ratio * m * omega_n
+    k, c, m = _kcm(omega_n, damping_ratio, A)
     if cov is None:
         nan = np.full(A.shape, np.nan)
         return (k, c, m), (nan, nan.copy(), nan.copy())
@@ -347,12 +350,10 @@ def physical_covariance(omega_n, damping_ratio, modal_constant, cov):
         Rows and columns k (N/m), c (N s/m), m (kg).
     """
     A = np.asarray(modal_constant, dtype=complex)
-    a = np.abs(A)
+    k, c, m = _kcm(omega_n, damping_ratio, A)
     with np.errstate(divide="ignore", invalid="ignore"):
-        m = 1.0 / a
-        k = m * omega_n**2
-        c = 2.0 * damping_ratio * m * omega_n
-        da_dre, da_dim = A.real / a, A.imag / a
+        a = np.abs(A)
+        da_dre, da_dim = A.real / a, A.imag / a  # ∂|A|/∂Re A, ∂|A|/∂Im A
         # gradients of (k, c, m) with respect to (ωn, ζ, Re A, Im A): (..., 3, 4)
         grad = np.zeros(A.shape + (3, 4))
         grad[..., 0, 0] = 2 * m * omega_n

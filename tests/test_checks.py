@@ -91,3 +91,41 @@ def test_residual_of_a_right_model_under_noise_is_white():
         ratios.append(residual_structure(frf.omega_rad_s, frf.channels, 0, region, fit.omega_n,
                                          fit.damping_ratio))
     assert np.all(np.abs(np.array(ratios) - 1) < 0.15), ratios
+
+
+def test_missing_mode_check_channels_are_not_chosen_by_their_noise_estimates_luck():
+    # 1000 channels of white noise with the same true peak/σ (noise 1 % of each channel's peak, peaks
+    # spread over a decade): ranked by the estimated peak/σ, the 8 chosen are those whose σ² came out
+    # low by chance (about 2.5 of the estimate's per-channel scatter s below its mean), and the
+    # missing-mode screen then reads noise as residual. The check's channels must be an unbiased draw:
+    # their mean σ²-estimate within 4 standard errors (4 s/sqrt(8)) of all channels' mean. The old
+    # ranking misses that by far, which shows the test can fail.
+    from modal.checks import CHECK_CHANNELS, _check_channels, _strongest
+    from modal.peaks import neighbour_noise_std
+
+    rng = np.random.default_rng(7)
+    n_ch, n_lines = 1000, 741
+    sigma = 0.01 * np.geomspace(1.0, 10.0, n_ch)
+    noise = sigma[:, None] * (rng.standard_normal((n_ch, n_lines)) + 1j * rng.standard_normal((n_ch, n_lines)))
+    noise /= np.sqrt(2)
+    estimate = neighbour_noise_std(np.arange(n_lines, dtype=float), noise)
+    peak = 100 * sigma * (1 + 1e-3 * rng.standard_normal(n_ch))
+    ratio = (estimate / sigma) ** 2
+    limit = 4 * np.std(ratio) / np.sqrt(CHECK_CHANNELS)
+    chosen = _check_channels(peak, estimate)
+    assert chosen.size == CHECK_CHANNELS and np.unique(chosen).size == CHECK_CHANNELS
+    assert abs(np.mean(ratio[chosen]) - np.mean(ratio)) < limit
+    assert np.mean(ratio[_strongest(peak / estimate)]) < np.mean(ratio) - limit
+
+
+def test_missing_mode_check_channels_leave_out_a_loud_but_much_noisier_channel():
+    # the highest peak, but its σ 10x the others' (peak/σ a fifth of the best): not among the chosen,
+    # which are the next-highest peaks; with eight channels or fewer all are used
+    from modal.checks import CHECK_CHANNELS, _check_channels
+
+    peak = np.array([5.0] + [1.0 + 0.1 * k for k in range(20)])
+    noise = np.array([0.1] + [0.01] * 20)
+    chosen = _check_channels(peak, noise)
+    assert 0 not in chosen
+    assert set(chosen) == set(range(21 - CHECK_CHANNELS, 21))
+    assert sorted(_check_channels(peak[:6], noise[:6])) == list(range(6))

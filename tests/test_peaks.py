@@ -35,3 +35,25 @@ def test_noise_estimate_ignores_a_trend_on_a_jittered_axis():
     sigma = 0.1
     noise = sigma / np.sqrt(2) * (rng.standard_normal(f.size) + 1j * rng.standard_normal(f.size))
     assert abs(estimate_noise_std(FRF(f, trend + noise))[0] / sigma - 1) < 4 * 1.2 / np.sqrt(f.size)
+
+
+def test_evenly_spaced_lines_take_the_same_misfit_as_any_axis():
+    # an evenly spaced axis (np.linspace, whose spacings differ by rounding) is computed with weights ½ by
+    # scalars: the misfit power equals the general weighted formula to rounding (the weights differ
+    # from ½ by ~1e-13, the misfit by that times the neighbours' difference: 1e-11 of the mean power
+    # bounds it with room), along either axis, and a straight trend still cancels to rounding
+    from modal.peaks import UNIFORM_WEIGHT_TOL, _misfit_power
+
+    rng = np.random.default_rng(5)
+    f = np.linspace(3.0, 403.0, 2001)
+    step = np.diff(f)
+    w_left = step[1:] / (step[:-1] + step[1:])
+    assert 0 < np.max(np.abs(w_left - 0.5)) <= UNIFORM_WEIGHT_TOL
+    values = rng.standard_normal((4, f.size)) + 1j * rng.standard_normal((4, f.size))
+    misfit = values[:, 1:-1] - (w_left * values[:, :-2] + (1 - w_left) * values[:, 2:])
+    general = np.abs(misfit) ** 2 / (1 + w_left**2 + (1 - w_left) ** 2)
+    atol = 1e-11 * general.mean()
+    np.testing.assert_allclose(_misfit_power(f, values), general, rtol=0, atol=atol)
+    np.testing.assert_allclose(_misfit_power(f, values.T.copy(), axis=0), general.T, rtol=0, atol=atol)
+    trend = (2 + 3j) * f
+    assert _misfit_power(f, trend[None, :]).max() < (1e-12 * np.abs(trend).max()) ** 2
