@@ -4,9 +4,18 @@ wired together by scenes.
 
 ``balancer`` imports ``modal``; never the reverse.
 """
-from modal.archive import read_archive
-
 __all__ = ["run_scene", "read_archive"]
+
+
+def read_archive(path):
+    """Read an archive written by a scene run; see :func:`modal.archive.read_archive`.
+
+    (Imported when called: ``python -m balancer run`` starts its plotting process early, and
+    h5py is not needed before that.)
+    """
+    from modal.archive import read_archive as _read
+
+    return _read(path)
 
 
 def run_scene(*args, **kwargs):

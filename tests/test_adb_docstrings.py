@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from numpydoc_sections import documented
 
-MODULES = ["parameters", "equations", "linear", "equilibria", "stability", "speed", "integrate", "analysis", "simulate", "drag", "studies", "plots", "verdict", "montecarlo"]
+MODULES = ["parameters", "equations", "linear", "equilibria", "stability", "speed", "integrate", "analysis", "simulate", "drag", "studies", "plots", "verdict", "montecarlo", "dop853"]
 
 
 def _public(module_name):

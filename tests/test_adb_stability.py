@@ -286,3 +286,23 @@ def test_a_huge_condition_number_at_one_grid_speed_does_not_split_a_stable_inter
     at = balanced_stability(params, [4.3 * wn])
     assert at.stability_class[0] == STABLE
     assert at.rounding_bound_per_s[0] < 1e-6 * abs(at.max_real_part_per_s[0])
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_interval_scan_verdicts_are_the_eigenvalue_verdicts(seed):
+    # stable_speed_intervals scans with Routh verdicts (stability_map margin=False); away from the
+    # eigenvalue path's rounding band they must be its verdicts, point for point
+    from balancer.adb.stability import _analyse_balanced, _stable_on_grid, balanced_state
+
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(2, 5))
+    M, m, R = rng.uniform(0.5, 5.0), rng.uniform(0.005, 0.05), rng.uniform(0.02, 0.1)
+    p = ADBParameters(M=M, m=m, n=n, R=R, e=rng.uniform(0.0, 0.9) * n * m * R / M, k=rng.uniform(1e3, 1e5),
+                      c=rng.uniform(0.1, 50.0), D=10 ** rng.uniform(-5.0, -1.0))
+    speeds = np.linspace(0.002, 8.0, 2000) * p.natural_frequency_rad_s
+    angles = balanced_state(p)[2:2 + n]
+    eig = _analyse_balanced([p], speeds, [angles])
+    clear = np.abs(eig.max_real_part_per_s) > 1e3 * eig.rounding_bound_per_s
+    routh = _stable_on_grid(p, speeds, angles)
+    assert np.array_equal(routh[clear], (eig.stability_class == STABLE)[clear])
+    assert np.count_nonzero(clear) > 1990  # the band is a few points at most

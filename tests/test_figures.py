@@ -76,3 +76,60 @@ def test_scene_figures_fit_without_a_layout_engine(demo_results, stage):
             for b in boxes[i + 1:]:
                 overlap = (min(a.x1, b.x1) - max(a.x0, b.x0), min(a.y1, b.y1) - max(a.y0, b.y0))
                 assert min(overlap) <= 1.0, (stage, name, a, b)
+
+
+@pytest.mark.parametrize("stage", ["identify", "adb_response", "mounts"])
+def test_png_bytes_holds_the_pixels_savefig_writes(demo_results, stage):
+    # the scene's own PNG writer (no filter, zlib) against matplotlib's savefig (Pillow): decoded,
+    # the same RGBA pixels, resolution and software note
+    import io
+
+    import numpy as np
+    from PIL import Image
+
+    from balancer.scene.plots import stage_figures
+    from modal.figures import png_bytes
+
+    for name, fig in stage_figures(stage, demo_results):
+        ours = Image.open(io.BytesIO(png_bytes(fig, dpi=100)))
+        theirs_file = io.BytesIO()
+        fig.savefig(theirs_file, format="png", dpi=100)
+        theirs = Image.open(io.BytesIO(theirs_file.getvalue()))
+        assert ours.mode == theirs.mode == "RGBA", name
+        assert np.array_equal(np.asarray(ours), np.asarray(theirs)), name
+        assert ours.info["dpi"] == theirs.info["dpi"] and ours.info["Software"] == theirs.info["Software"]
+
+
+def _log_figure(axis: str, low: float, high: float, marks: bool):
+    import numpy as np
+    from matplotlib.figure import Figure
+
+    from modal.figures import minor_tick_marks, plain_log_ticks
+
+    fig = Figure(figsize=(4, 3))
+    ax = fig.add_subplot()
+    x = np.linspace(1.0, 100.0, 500)
+    y = np.geomspace(low, high, 500)
+    (ax.semilogy if axis == "y" else ax.semilogx)(*((x, y) if axis == "y" else (y, x)), ".", ms=2)
+    target = ax.yaxis if axis == "y" else ax.xaxis
+    plain_log_ticks(target)
+    if marks:
+        minor_tick_marks(target)
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    return np.asarray(canvas.buffer_rgba()).copy(), target
+
+
+@pytest.mark.parametrize("axis, low, high", [("y", 2e-4, 30.0), ("x", 1e-3, 10.0), ("y", 1.5, 8.0), ("y", 0.3, 3.0)])
+def test_minor_tick_marks_draw_what_the_minor_ticks_drew(axis, low, high):
+    # the same pixels as the axis' own minor ticks: over several decades (unlabelled: one artist, no
+    # Tick per location) and within about one decade (labelled: the axis' own ticks come back)
+    import numpy as np
+
+    plain, _ = _log_figure(axis, low, high, marks=False)
+    light, target = _log_figure(axis, low, high, marks=True)
+    assert np.array_equal(plain, light)
+    if high / low > 100:
+        assert len(target.minorTicks) <= 1  # the template tick only
+    else:  # labelled: the axis drew its own minor ticks, labels included
+        assert any(label.get_text() for label in target.get_minorticklabels())

@@ -12,7 +12,7 @@ ROOT = Path(__file__).resolve().parent.parent
 def _modules_after(code: str) -> dict:
     script = (f"import sys, json\nsys.path.insert(0, {str(ROOT)!r})\n{code}\n"
               "print(json.dumps({m: m in sys.modules for m in ('balancer.influence', 'matplotlib.figure', 'scipy.optimize',"
-              "'scipy.integrate', 'scipy.linalg')}))")
+              "'scipy.integrate', 'scipy.linalg', 'h5py')}))")
     proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, proc.stderr[-2000:]
     return json.loads(proc.stdout.strip().splitlines()[-1])
@@ -39,6 +39,25 @@ def test_the_scene_runner_imports_the_solvers_only_when_a_stage_needs_them():
     # scipy.integrate, scipy.linalg) wait until a stage calls them
     loaded = _modules_after("import balancer.cli, balancer.scene.runner, balancer.scene.plots")
     assert not any(loaded[m] for m in ("scipy.optimize", "scipy.integrate", "scipy.linalg"))
+    assert not loaded["h5py"]  # only the parent writes the archive, after the fork
+    # a non-stiff simulation runs DOP853 in balancer.adb.dop853: no scipy.integrate (whose package
+    # import loads scipy.optimize too); the stiff methods still use solve_ivp
+    loaded = _modules_after("from balancer.adb import ADBParameters, simulate\n"
+                            "simulate(ADBParameters(M=1.0, m=0.02, n=2, R=0.05, e=5e-4, k=1e4, c=20.0, D=1e-3), 150.0,"
+                            " 0.05)")
+    assert not loaded["scipy.integrate"] and not loaded["scipy.optimize"]
     assert _modules_after("from balancer.adb import ADBParameters, simulate\n"
                           "simulate(ADBParameters(M=1.0, m=0.02, n=2, R=0.05, e=5e-4, k=1e4, c=20.0, D=1e-3), 150.0,"
-                          " 0.05)")["scipy.integrate"] is True
+                          " 0.05, method='LSODA')")["scipy.integrate"] is True
+
+
+def test_the_demo_scene_stages_need_no_scipy_solver_module():
+    # the demo's three roots and one bounded minimum run in balancer.solve1d, its run-up in
+    # balancer.adb.dop853, the mounts' 6 x 6 generalised eigenproblem in numpy: together ~0.15-0.25 s
+    # of imports the demo no longer pays
+    loaded = _modules_after(f"from balancer.scene import run_scene\n"
+                            f"import tempfile, pathlib\n"
+                            f"scene = pathlib.Path({str(ROOT)!r}) / 'data' / 'synthetic' / 'demo_scene.toml'\n"
+                            f"with tempfile.TemporaryDirectory() as d:\n"
+                            f"    run_scene(scene, out=pathlib.Path(d) / 'demo.h5', plot_jobs=2)")
+    assert not any(loaded[m] for m in ("scipy.optimize", "scipy.integrate", "scipy.linalg"))

@@ -129,6 +129,7 @@ def test_cli_json_and_exit_codes(tmp_path):
     cmd = [sys.executable, "-m", "balancer", "run", str(path), "--json", "--out", str(tmp_path / "o.h5")]
     out = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
     assert out.returncode == 0, out.stderr
+    # stdout is a pipe (block-buffered) and `run` leaves by os._exit after flushing: the whole document arrives
     doc = json.loads(out.stdout)
     assert doc["stages"] == {s: ("ran" if s == "compressor" else "skipped") for s in STAGES}
     # seed 004: 285.5 N at the optimum (crank_drive.md)

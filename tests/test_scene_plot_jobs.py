@@ -104,3 +104,12 @@ def test_a_failing_plot_is_reported_with_its_stage(tmp_path, monkeypatch, jobs):
     with pytest.raises(RuntimeError, match="plots of identify.*ValueError: no figure today"):
         run_scene(DEMO, out=tmp_path / "c.h5", plots_dir=tmp_path / "c", plot_jobs=jobs)
 
+
+
+def test_every_stage_figure_declares_the_results_it_reads():
+    # a plotting process is handed only runner._PLOT_INPUTS[stage] (the byte-for-byte test above shows the
+    # demo's figures come out the same from that subset); a new figure must say what it reads
+    from balancer.scene import plots, runner
+
+    assert set(runner._PLOT_INPUTS) == set(plots._FIGURES)
+    assert all(stage in inputs for stage, inputs in runner._PLOT_INPUTS.items())

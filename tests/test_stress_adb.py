@@ -194,7 +194,7 @@ def check_boundary(params: ADBParameters) -> None:
     lin = balanced_stability(params, ends)
     for growth, rounding, cls, speed in zip(lin.max_real_part_per_s, lin.rounding_bound_per_s, lin.stability_class,
                                             ends):
-        # brentq stops within 1e-10 ωn of the root: the growth rate there is that times its slope
+        # the root finder stops within 1e-10 ωn of the root: the growth rate there is that times its slope
         near = abs(growth) <= max(1e3 * rounding, 1e-6 * wn)
         assert cls == 0 or near, (speed / wn, growth, rounding, cls)
     event("boundary: checked")

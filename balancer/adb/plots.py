@@ -104,7 +104,9 @@ def plot_amplitude(result: SimulationResult, *, ax: Axes | None = None, log: boo
         plain_log_ticks(ax.yaxis)
     ax.set_xlabel("time (s)")
     ax.set_ylabel("amplitude (m)")
-    ax.set_title(f"final state: {result.final_state}")
+    # y given: nothing sits above this axes, so matplotlib's search for a free place (which lays out
+    # the y tick labels once more) would leave the title where it is
+    ax.set_title(f"final state: {result.final_state}", y=1.0)
     ax.legend(loc="best")
     return figure
 

@@ -275,6 +275,19 @@ def _check_restrained(mounts: Sequence[Mount]) -> None:
             "every direction")
 
 
+def _generalised_eigh(stiffness: np.ndarray, mass: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Eigenvalues (ascending) and mass-normalised eigenvectors of ``K v = lambda M v``.
+
+    ``M`` symmetric positive definite: with ``M = L L^T`` (Cholesky), the symmetric
+    ``L^-1 K L^-T w = lambda w`` and ``v = L^-T w`` (what LAPACK's ``sygv`` does, here in numpy:
+    6 x 6, so ``scipy.linalg``'s import, ~30 ms, would cost more than the solve).
+    """
+    lower_inv = np.linalg.inv(np.linalg.cholesky(mass))
+    reduced = lower_inv @ stiffness @ lower_inv.T
+    eig, vectors = np.linalg.eigh(0.5 * (reduced + reduced.T))
+    return eig, lower_inv.T @ vectors
+
+
 def damping_matrix(system: MountedBody) -> np.ndarray:
     """6 x 6 damping matrix: mount dampers plus modal damping ``zeta`` [N s/m, ...].
 
@@ -288,10 +301,8 @@ def damping_matrix(system: MountedBody) -> np.ndarray:
     """
     damping = _mount_damping_matrix(system.mounts)
     if system.damping_ratio > 0.0:
-        from scipy import linalg  # scipy.linalg only when solving (generalised eigenproblem)
-
         mass = mass_matrix(system.body)
-        eig, shapes = linalg.eigh(stiffness_matrix(system.mounts), mass)
+        eig, shapes = _generalised_eigh(stiffness_matrix(system.mounts), mass)
         omega = np.sqrt(eig)
         damping = damping + mass @ shapes @ np.diag(2 * system.damping_ratio * omega) @ shapes.T @ mass
     return damping
@@ -389,10 +400,8 @@ def natural_modes(system: MountedBody) -> MountModes:
     -------
     MountModes
     """
-    from scipy import linalg
-
     mass = mass_matrix(system.body)
-    eig, shapes = linalg.eigh(stiffness_matrix(system.mounts), mass)
+    eig, shapes = _generalised_eigh(stiffness_matrix(system.mounts), mass)
     share = shapes * (mass @ shapes)
     return MountModes(np.sqrt(np.clip(eig, 0.0, None)) / (2 * np.pi), shapes, share)
 

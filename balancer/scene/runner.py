@@ -7,18 +7,21 @@ import json
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable
-
-import h5py
+from typing import TYPE_CHECKING, Any, Callable
 
 import modal
-from modal.archive import read_node, write_archive
 from modal.errors import ArchiveError, SceneError
 
 from .schema import STAGES, Reference, Scene, dependencies, load_scene, parse_scene
 from .stages import STAGE_FUNCTIONS
 
+if TYPE_CHECKING:
+    import h5py
+
 __all__ = ["SceneRun", "run_scene", "plan", "stage_hashes"]
+
+# h5py (and modal.archive) are imported where an archive is read or written: `python -m balancer run`
+# forks its plotting process before, and what is imported by then is paid before both processes work
 
 #: configuration sections that make up each stage's inputs (besides its dependencies' hashes)
 _STAGE_CONFIG = {
@@ -142,6 +145,8 @@ def _open_earlier(path) -> h5py.File | None:
     path = Path(path)
     if not path.is_file():
         return None  # nothing to reuse yet: run everything
+    import h5py
+
     try:
         f = h5py.File(path, "r")
     except OSError as exc:
@@ -155,6 +160,12 @@ def _open_earlier(path) -> h5py.File | None:
         raise
     return f
 
+
+#: the results each stage's figures read (balancer.scene.plots; tests/test_scene_plot_jobs.py checks it): a
+#: plotting process is handed only these, so it unpickles (and imports the classes of) nothing more
+_PLOT_INPUTS = {"identify": ("frf", "identify"), "adb_stability": ("adb_stability",),
+                "adb_response": ("adb_response", "rotor"), "compressor": ("compressor",), "mounts": ("mounts",),
+                "drive": ("drive",), "balance": ("balance",)}
 
 #: size of one job record on the plotters' pipe: written at once (atomic below PIPE_BUF) and read whole by
 #: whichever drawing process is free
@@ -198,9 +209,13 @@ def _fork_quietly() -> int:
     return pid
 
 
-def _report_and_exit(work: Callable[[], dict], report_write: int) -> None:
+def _report_and_exit(work: Callable[[], dict], report_write: int, after: Callable[[], None] | None = None) -> None:
     """In a forked child: run ``work``, write its report (or the exception) to ``report_write`` and
-    leave with ``os._exit`` (never the parent's exit handlers): 0 on success, 1 on an error."""
+    leave with ``os._exit`` (never the parent's exit handlers): 0 on success, 1 on an error.
+
+    The report's pipe is closed before leaving, so the reader has it at once rather than after
+    this process's memory is torn down (a few ms); ``after`` runs then (the plotter reaps its helper).
+    """
     import os
 
     code = 1
@@ -211,6 +226,9 @@ def _report_and_exit(work: Callable[[], dict], report_write: int) -> None:
         report = {"error": f"{type(exc).__name__}: {exc}"}
     try:
         _write_report(report_write, report)
+        os.close(report_write)
+        if after is not None:
+            after()
     finally:
         os._exit(code)
 
@@ -287,10 +305,16 @@ class _Plotter:
                 os.close(self._report)
                 return self._serve(jobs_read)
 
-            _report_and_exit(plotter, report_write)
+            _report_and_exit(plotter, report_write, after=self._reap_helper)
         os.close(jobs_read)
         os.close(report_write)
         self.pid = pid
+
+    def _reap_helper(self) -> None:
+        import os
+
+        if getattr(self, "_helper", None):
+            os.waitpid(self._helper, 0)
 
     def _serve(self, jobs_read: int) -> dict:
         """The plotter: import, fork the helper, draw; the two reports merged."""
@@ -311,9 +335,9 @@ class _Plotter:
 
             _report_and_exit(drawer, write)
         os.close(write)
+        self._helper = helper  # reaped after this process has reported (_reap_helper)
         mine = _draw_jobs(jobs_read, self.folder)
         theirs = _read_report(read)
-        os.waitpid(helper, 0)
         errors = [r["error"] for r in (mine, theirs) if "error" in r]
         return {"drawn": {**mine.get("drawn", {}), **theirs.get("drawn", {})},
                 **({"error": "; ".join(errors)} if errors else {})}
@@ -410,6 +434,8 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, p
         timings: dict[str, float] = {}
         for stage in STAGES:
             if status[stage] == "reused":
+                from modal.archive import read_node
+
                 results[stage] = read_node(earlier[stage])
     finally:
         if earlier is not None:
@@ -433,7 +459,7 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, p
         for stage in list(pending):
             if stage not in results or not all(status[t] != "ran" or t in results for t in dependencies(scene, stage)):
                 continue
-            given = {s: results[s] for s in _closure(scene, [stage]) if s in results}
+            given = {s: results[s] for s in _PLOT_INPUTS.get(stage, _closure(scene, [stage])) if s in results}
             if plotter.submit(stage, given):
                 pending.remove(stage)
 
@@ -455,6 +481,8 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, p
         if archive_path is not None:
             keep = [s for s in STAGES if s in results and (stored is True or stored is False or s in stored)]
             archive_path.parent.mkdir(parents=True, exist_ok=True)
+            from modal.archive import write_archive
+
             write_archive(archive_path, {s: results[s] for s in keep}, scene_text=scene.text or None,
                           inputs_hash={s: hashes[s] for s in keep})
         if plotted:

@@ -11,6 +11,7 @@ from modal.errors import ParameterError
 
 from .forces import _check_objective, _objective_value, _refined_max
 from ..._checks import bounded
+from ...solve1d import find_root, minimize_bounded
 from .model import (
     PAPER_RULES,
     Objective,
@@ -245,7 +246,7 @@ def optimal_counterweight(mech: SliderCrank, speed_rpm: float, objective: Object
     ``-m_rot/m_rec <= alpha <= 1``.  The convex objective is minimised by
     bounded Brent (inner maxima refined to 1e-10 rad); for ``"max"`` the
     result is then polished by solving the equal-peak condition with
-    ``brentq`` when two peaks are active.
+    Brent's root finder when two peaks are active (:mod:`balancer.solve1d`).
 
     Parameters
     ----------
@@ -273,11 +274,7 @@ def optimal_counterweight(mech: SliderCrank, speed_rpm: float, objective: Object
         return _objective_value(mech, omega, (m_rot + alpha * m_rec) * r, objective)
 
     # For "max" a coarse bracket suffices: the equal-peak root polishes it.
-    from scipy import optimize  # scipy.optimize only when optimising (import ~0.1 s)
-
-    res = optimize.minimize_scalar(phi, bounds=(lower, upper), method="bounded",
-                                   options={"xatol": 1e-7 if objective == "max" else 1e-10})
-    alpha, method = float(res.x), "bounded Brent"
+    alpha, method = minimize_bounded(phi, lower, upper, xatol=1e-7 if objective == "max" else 1e-10), "bounded Brent"
     # Compare with the bounds: the bounded method never evaluates them.
     for bound in (lower, upper):
         if phi(bound) < phi(alpha):
@@ -320,14 +317,12 @@ def _polish_equal_peak(mech: SliderCrank, omega: float, alpha: float, lower: flo
         return _local_peak(mech, omega, u, angle_a, half_width)[1] - _local_peak(
             mech, omega, u, angle_b, half_width)[1]
 
-    from scipy import optimize
-
     step = 1e-6
     for _ in range(20):
         lo, hi = max(lower, alpha - step), min(upper, alpha + step)
         g_lo, g_hi = gap(lo), gap(hi)
         if g_lo * g_hi < 0:
-            return float(optimize.brentq(gap, lo, hi, xtol=1e-15, rtol=4 * np.finfo(float).eps)), \
+            return find_root(gap, lo, hi, xtol=1e-15, rtol=4 * np.finfo(float).eps), \
                 "equal-peak root"
         step *= 4.0
     return alpha, method
