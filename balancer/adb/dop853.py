@@ -18,8 +18,28 @@ from typing import Callable
 
 import numpy as np
 
-from . import _dop853_coefficients as _co
 
+def _coefficients():
+    """Hairer's DOP853 coefficients as SciPy tabulates them (``scipy/integrate/_ivp/dop853_coefficients.py``),
+    read from SciPy's installed file without importing the ``scipy.integrate`` package (whose import
+    costs ~0.1-0.2 s); a SciPy that keeps the table elsewhere gets the regular import."""
+    import importlib.util
+    from pathlib import Path
+
+    import scipy
+
+    path = Path(scipy.__file__).parent / "integrate" / "_ivp" / "dop853_coefficients.py"
+    if path.is_file():
+        spec = importlib.util.spec_from_file_location(f"{__name__}._scipy_coefficients", path)
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+        return module
+    from scipy.integrate._ivp import dop853_coefficients  # pragma: no cover - another SciPy layout
+
+    return dop853_coefficients
+
+
+_co = _coefficients()
 __all__ = ["DOP853Result", "dop853"]
 
 _N = _co.N_STAGES
