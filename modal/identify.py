@@ -1004,6 +1004,8 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
                 flags.add("did_not_converge")
             if not np.all(np.isfinite(fit.noise_var)):
                 flags.add("too_few_points")  # no lines left over for a residual: no errors
+            elif not np.all(np.isfinite(fit.mode_cov[r])):
+                flags.add("high_uncertainty")  # errors undetermined: the data do not determine a pole (nls.FISHER_RCOND)
             # inadequate where a user should act: beyond the noise and beyond what a linear model explains
             # of clean measured data (modal.flags.RELATIVE_MISFIT)
             if np.isfinite(chi2) and chi2 > CHI2_LIMIT and not relative[b] <= RELATIVE_MISFIT:

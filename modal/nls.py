@@ -106,6 +106,37 @@ def _design(x, numerator, x_squared, params, out, dphi):
     return out, dphi
 
 
+#: eigenvalues of the poles' Fisher information (scaled to a unit diagonal) below this fraction of the largest
+#: count as zero: directions of the poles the data do not determine (two poles fitted onto one peak, a mode the
+#: lines cannot resolve). Its inverse there held rounding noise: variances of either sign, 1e7 times the data's
+#: spread, or spuriously small (stress: 8 modes at ζ ≈ 0.3, eigenvalue ratio −5e-17).
+FISHER_RCOND = 1e-12
+#: a parameter whose weight in such a direction exceeds this (of a unit eigenvector) is not determined: the
+#: weights of the determined ones there are rounding, ~eps over the gap to the next eigenvalue
+NULL_WEIGHT = 1e-6
+
+
+def _pole_covariance(F: np.ndarray) -> np.ndarray:
+    """Covariance of the poles from their Fisher information ``F`` (symmetric, finite): its inverse, with NaN
+    rows and columns for the parameters the data do not determine (see :data:`FISHER_RCOND`)."""
+    s = np.sqrt(np.abs(np.diag(F)))
+    s[s == 0] = 1.0
+    scale = np.outer(s, s)
+    scaled = F / scale
+    try:
+        eigenvalues, vectors = np.linalg.eigh(scaled)
+    except np.linalg.LinAlgError:
+        return np.full(F.shape, np.nan)
+    resolved = eigenvalues > FISHER_RCOND * eigenvalues[-1]
+    if resolved.all():
+        return np.linalg.inv(scaled) / scale
+    cov = (vectors[:, resolved] / eigenvalues[resolved]) @ vectors[:, resolved].T
+    loose = np.any(np.abs(vectors[:, ~resolved]) > NULL_WEIGHT, axis=1)
+    cov[loose, :] = np.nan
+    cov[:, loose] = np.nan
+    return cov / scale
+
+
 def _compress(Y: np.ndarray, probes: np.ndarray) -> np.ndarray:
     """Many channels: replace Y (n_freq, n_ch) by Y V with V (n_ch, k) orthonormal.
 
@@ -321,12 +352,7 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
         F = 2 * np.real((E.conj().T @ E) * ((Cm.conj() * weights) @ Cm.T))
     cov_theta = np.full((n_theta, n_theta), np.nan)
     if np.all(np.isfinite(F)):
-        s = np.sqrt(np.abs(np.diag(F)))
-        s[s == 0] = 1.0
-        try:
-            cov_theta = np.linalg.inv(F / np.outer(s, s)) / np.outer(s, s)
-        except np.linalg.LinAlgError:
-            pass
+        cov_theta = _pole_covariance(F)
     elif np.all(noise_var == 0):
         cov_theta = np.zeros((n_theta, n_theta))
     # sensitivity of the linear coefficients to the poles: G_j = −Φ⁺ ∂Φ/∂θ_j C

@@ -23,7 +23,8 @@ FLAG_TEXT = {
     "too_few_points": "too few lines near resonance for this method",
     "damping_pair_spread": "circle fit: the damping estimates from point pairs disagree by more than 10 %",
     "model_inadequate": "residual is much larger than the noise (chi-square > 3) and more than 3 % of the data near the mode: the model does not explain the data (close modes, missing mode, nonlinearity)",
-    "high_uncertainty": "standard error of the damping ratio exceeds 10 % of its value",
+    "high_uncertainty": ("standard error of the damping ratio exceeds 10 % of its value, or the errors are "
+                         "undetermined (the data do not determine this mode's pole apart from another's)"),
     "did_not_converge": "least-squares refinement did not converge; the start values are reported",
     "driving_point_assumed": "single-channel FRF without point ids: taken as a driving point",
     "not_driving_point": "transfer FRF (response point differs from reference): k, c, m are not defined for it",
@@ -325,7 +326,8 @@ def physical_parameters(omega_n, damping_ratio, modal_constant, cov=None):
 def correlation_of(cov: np.ndarray) -> np.ndarray:
     """Correlation matrix (..., n, n) of covariance matrices; NaN where a variance is not positive."""
     cov = np.asarray(cov, float)
-    sd = np.sqrt(np.diagonal(cov, axis1=-2, axis2=-1))
+    variance = np.diagonal(cov, axis1=-2, axis2=-1)
+    sd = np.sqrt(np.where(variance > 0, variance, np.nan))  # not positive: NaN, as documented, without a warning
     with np.errstate(divide="ignore", invalid="ignore"):
         out = cov / (sd[..., :, None] * sd[..., None, :])
     return np.where(np.isfinite(out), np.clip(out, -1.0, 1.0), np.nan)
