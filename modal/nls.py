@@ -118,18 +118,29 @@ NULL_WEIGHT = 1e-6
 
 def _pole_covariance(F: np.ndarray) -> np.ndarray:
     """Covariance of the poles from their Fisher information ``F`` (symmetric, finite): its inverse, with NaN
-    rows and columns for the parameters the data do not determine (see :data:`FISHER_RCOND`)."""
+    rows and columns for the parameters the data do not determine (see :data:`FISHER_RCOND`).
+
+    The plain inverse of ``F`` scaled to a unit diagonal (n parameters) serves when its variances are
+    positive and below 1/(n² ``FISHER_RCOND``): then no eigenvalue is below ``FISHER_RCOND`` of the largest
+    (the smallest is at least 1/(n · the largest variance), the largest at most n); otherwise the
+    eigen-decomposition decides.
+    """
     s = np.sqrt(np.abs(np.diag(F)))
     s[s == 0] = 1.0
     scale = np.outer(s, s)
     scaled = F / scale
     try:
+        inverse = np.linalg.inv(scaled)
+        variance = np.diag(inverse)
+        if np.all(variance > 0) and variance.max() * F.shape[0] ** 2 * FISHER_RCOND < 1:
+            return inverse / scale
+    except np.linalg.LinAlgError:
+        pass
+    try:
         eigenvalues, vectors = np.linalg.eigh(scaled)
     except np.linalg.LinAlgError:
         return np.full(F.shape, np.nan)
     resolved = eigenvalues > FISHER_RCOND * eigenvalues[-1]
-    if resolved.all():
-        return np.linalg.inv(scaled) / scale
     cov = (vectors[:, resolved] / eigenvalues[resolved]) @ vectors[:, resolved].T
     loose = np.any(np.abs(vectors[:, ~resolved]) > NULL_WEIGHT, axis=1)
     cov[loose, :] = np.nan
