@@ -558,6 +558,26 @@ class _ScaledResidual:
         return (self._residual[:, rows] * self._scale[rows]).T
 
 
+def _constant_distance(difference: np.ndarray, cov: np.ndarray, floor: np.ndarray) -> np.ndarray:
+    """Per channel, the distance of a complex difference of modal constants in standard errors: the
+    Mahalanobis distance of (Re, Im) under their 2×2 covariance ``cov`` (n_ch, 2, 2), each part's error
+    at least ``floor`` (the refinement's own precision: on exact data the errors are rounding, and so
+    is the difference).
+
+    k, c, m depend on |A|, and a half-power or circle constant's covariance is often long across
+    A and short along it: the difference divided by the total error sqrt(var Re + var Im) let a
+    bias 10 of its errors along |A| pass as 1.9 (docs/stress.md, finding 33). Where the covariance
+    is singular, that total error is used.
+    """
+    a, b, c = cov[:, 0, 0] + floor**2, cov[:, 0, 1], cov[:, 1, 1] + floor**2
+    x, y = difference.real, difference.imag
+    with np.errstate(divide="ignore", invalid="ignore"):
+        det = a * c - b * b
+        squared = (c * x * x - 2 * b * x * y + a * y * y) / det
+        total = np.abs(difference) / np.sqrt(a + c)
+    return np.where((det > 0) & (squared >= 0), np.sqrt(np.maximum(squared, 0)), total)
+
+
 def _local_misfit(frf, bands, power, omega_n, damping_ratio, data=None) -> np.ndarray:
     """Per mode, the misfit near it relative to the data there (RMS over the strongest channels, at most
     ``POLE_CHANNELS``).
@@ -963,7 +983,7 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
             # modal constants against each channel's own error (the circle's come from its
             # geometry, which a neighbour bends even when the pole passes)
             with np.errstate(divide="ignore", invalid="ignore"):
-                z_const = np.abs(d_const) / np.sqrt(cov[:, 2, 2] + cov[:, 3, 3])
+                z_const = _constant_distance(d_const, cov[:, 2:, 2:], REFINEMENT_PRECISION * np.abs(const - d_const))
             const_biased = pole_biased | (z_const > BIAS_LIMIT)
             # biased: the difference is added to the covariance along it
             diff = np.column_stack([d_const.real, d_const.imag])
