@@ -21,7 +21,8 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.ticker import LogFormatterSciNotation, NullLocator
 
-__all__ = ["fixed_figure", "margins", "PlainLogFormatter", "plain_log_ticks", "png_bytes", "minor_tick_marks"]
+__all__ = ["fixed_figure", "margins", "gap_fraction", "PlainLogFormatter", "plain_log_ticks", "png_bytes",
+           "minor_tick_marks"]
 
 _SUPERSCRIPT = str.maketrans("-0123456789", "⁻⁰¹²³⁴⁵⁶⁷⁸⁹")
 _MATH_OPEN, _MATH_CLOSE = r"$\mathdefault{", "}$"
@@ -76,12 +77,17 @@ def margins(width_in: float, height_in: float, *, left: float, right: float, bot
     """
     inner_w = width_in - left - right
     inner_h = height_in - bottom - top
-    axes_w = (inner_w - (ncols - 1) * wgap) / ncols
-    axes_h = (inner_h - (nrows - 1) * hgap) / nrows
-    if axes_w <= 0 or axes_h <= 0:
+    if inner_w - (ncols - 1) * wgap <= 0 or inner_h - (nrows - 1) * hgap <= 0:
         raise ValueError(f"margins leave no room for the axes in a {width_in} x {height_in} in figure")
     return {"left": left / width_in, "right": 1.0 - right / width_in, "bottom": bottom / height_in,
-            "top": 1.0 - top / height_in, "wspace": wgap / axes_w, "hspace": hgap / axes_h}
+            "top": 1.0 - top / height_in, "wspace": gap_fraction(wgap, inner_w, ncols),
+            "hspace": gap_fraction(hgap, inner_h, nrows)}
+
+
+def gap_fraction(gap_in: float, extent_in: float, n: int) -> float:
+    """matplotlib's ``wspace``/``hspace`` (a fraction of the mean axes size) for a gap of ``gap_in`` inches
+    between ``n`` axes sharing ``extent_in`` inches (0 for one axes: there is no gap)."""
+    return gap_in / ((extent_in - (n - 1) * gap_in) / n) if n > 1 else 0.0
 
 
 def fixed_figure(width_in: float, height_in: float, **kwargs) -> Figure:

@@ -835,8 +835,8 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
         which ran.
         ``"nls"``: complex nonlinear least squares of all modes
         together, each band started from its one-mode rational fit
-            (:func:`modal.rational.rational_pole`; from the better of half-power and
-            circle fit where that gives no pole or a doubtful fit).
+        (:func:`modal.rational.rational_pole`; from the better of half-power and
+        circle fit where that gives no pole or a doubtful fit).
         ``"global"``: poly-reference LSCF (PolyMAX) poles with a stabilisation
         diagram, then a joint refinement of all poles, modal constants and
         residual terms over the whole band (:func:`modal.global_.identify_global`;

@@ -254,22 +254,20 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
         weight = np.asarray(line_weight, float)[:, None]
         Y_full = Y = Y_full * weight
         background = background * weight
-    if n_ch > 2 * (2 * n_b + 8):  # many channels: fit on fewer combinations
-        Phi0 = np.empty((x.size, n_b), dtype=complex)
-        Phi0[:, n_modes:] = background
-        Phi0, dphi0 = _design(x, numerator, x_squared, params, Phi0, np.empty((x.size, n_theta), complex))
-        if weight is not None:
-            Phi0[:, :n_modes] *= weight
-            dphi0 *= weight
-        Y = _compress(Y_full, np.hstack([Phi0, dphi0]))
-
-    def evaluate(p):
+    def design(p):
         Phi = np.empty((x.size, n_b), dtype=complex)
         Phi[:, n_modes:] = background
         Phi, dphi = _design(x, numerator, x_squared, p, Phi, np.empty((x.size, n_theta), complex))
         if weight is not None:  # the modes' columns (the background's are weighted once, above)
             Phi[:, :n_modes] *= weight
             dphi *= weight
+        return Phi, dphi
+
+    if n_ch > 2 * (2 * n_b + 8):  # many channels: fit on fewer combinations
+        Y = _compress(Y_full, np.hstack(design(params)))
+
+    def evaluate(p):
+        Phi, dphi = design(p)
         Q, R, QhY, res = _project(Phi, Y)
         return Phi, dphi, Q, R, QhY, res, float(np.vdot(res, res).real)
 

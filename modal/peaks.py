@@ -33,35 +33,26 @@ def _misfit_power(frequency: np.ndarray, values: np.ndarray, axis: int = -1) -> 
     # on the real view (real and imaginary parts side by side), in place: 1000 channels ×
     # 2000 lines are 32 MB per temporary, and complex-by-real products cost twice as much
     parts = values.view(float)
+    if axis == 0:  # whole rows of lines shifted
+        before, centre, after = parts[:-2], parts[1:-1], parts[2:]
+    else:  # along the real view's last axis a line is two numbers wide
+        before, centre, after = parts[:, :-4], parts[:, 2:-2], parts[:, 4:]
     if w_left.size and np.all(np.abs(w_left - 0.5) <= UNIFORM_WEIGHT_TOL):
         # evenly spaced lines (to rounding): weights ½, factor 2/3, by scalars in place
+        misfit = np.add(before, after)
+        misfit *= -0.5
+        misfit += centre
+        norm = 2.0 / 3.0
+    else:
         if axis == 0:
-            misfit = np.add(parts[:-2], parts[2:])
-            misfit *= -0.5
-            misfit += parts[1:-1]
+            left, right, norm = w_left[:, None], w_right[:, None], norm[:, None]
         else:
-            misfit = np.add(parts[:, :-4], parts[:, 4:])
-            misfit *= -0.5
-            misfit += parts[:, 2:-2]
-        misfit *= misfit
-        power = np.add(misfit[..., 0::2], misfit[..., 1::2])
-        power *= 2.0 / 3.0
-        return power
-    if axis == 0:
-        left, right = w_left[:, None], w_right[:, None]
-        misfit = np.multiply(parts[:-2], left)
-        misfit += parts[2:] * right
-        np.subtract(parts[1:-1], misfit, out=misfit)
-        misfit *= misfit
-        power = np.add(misfit[:, 0::2], misfit[:, 1::2])
-        power *= norm[:, None]
-        return power
-    left, right = np.repeat(w_left, 2), np.repeat(w_right, 2)
-    misfit = np.multiply(parts[:, :-4], left)
-    misfit += parts[:, 4:] * right
-    np.subtract(parts[:, 2:-2], misfit, out=misfit)
+            left, right = np.repeat(w_left, 2), np.repeat(w_right, 2)
+        misfit = np.multiply(before, left)
+        misfit += after * right
+        np.subtract(centre, misfit, out=misfit)
     misfit *= misfit
-    power = np.add(misfit[:, 0::2], misfit[:, 1::2])
+    power = np.add(misfit[..., 0::2], misfit[..., 1::2])
     power *= norm
     return power
 

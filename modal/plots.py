@@ -9,7 +9,7 @@ from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 
 from .errors import ModalError
-from .figures import margins, minor_tick_marks, plain_log_ticks
+from .figures import gap_fraction, margins, minor_tick_marks, plain_log_ticks
 from .frf import FRF, KIND_POWER
 from .model import mode_basis
 from .results import IdentificationResult
@@ -95,11 +95,6 @@ def _model_name(result: IdentificationResult) -> str:
     return result.method + (f"; {flagged} of {len(result.modes)} modes flagged" if flagged else "")
 
 
-def _spacing(gap_in: float, extent_in: float, n: int) -> float:
-    """matplotlib's wspace/hspace (a fraction of the mean axes size) for a gap in inches between n axes."""
-    return gap_in / ((extent_in - (n - 1) * gap_in) / n) if n > 1 else 0.0
-
-
 def plot_fit(frf: FRF, result: IdentificationResult | Sequence[IdentificationResult], channel: int | None = None,
              figure: Figure | None = None) -> Figure:
     """Magnitude and phase with the fitted model(s) over the data, and each mode's Nyquist plot.
@@ -140,12 +135,12 @@ def plot_fit(frf: FRF, result: IdentificationResult | Sequence[IdentificationRes
         frame = margins(width, height, left=0.8, right=0.3, bottom=0.5, top=0.15)
         inner_w, inner_h = width - 1.1, height - 0.65
         # between the phase and the Nyquist rows: the phase's x label, a Nyquist title and its offset text
-        outer = fig.add_gridspec(2, 1, height_ratios=[2.4, 1.1 * nrows_nyq], hspace=_spacing(0.95, inner_h, 2),
+        outer = fig.add_gridspec(2, 1, height_ratios=[2.4, 1.1 * nrows_nyq], hspace=gap_fraction(0.95, inner_h, 2),
                                  left=frame["left"], right=frame["right"], bottom=frame["bottom"], top=frame["top"])
         top_h = (inner_h - 0.95) * 2.4 / (2.4 + 1.1 * nrows_nyq)
-        top = outer[0].subgridspec(2, 1, height_ratios=[1.4, 1.0], hspace=_spacing(0.3, top_h, 2))
-        nyq = outer[1].subgridspec(nrows_nyq, ncols, wspace=_spacing(0.5, inner_w, ncols),
-                                   hspace=_spacing(0.75, inner_h - 0.95 - top_h, nrows_nyq))
+        top = outer[0].subgridspec(2, 1, height_ratios=[1.4, 1.0], hspace=gap_fraction(0.3, top_h, 2))
+        nyq = outer[1].subgridspec(nrows_nyq, ncols, wspace=gap_fraction(0.5, inner_w, ncols),
+                                   hspace=gap_fraction(0.75, inner_h - 0.95 - top_h, nrows_nyq))
     else:
         fig = figure
         grid = fig.add_gridspec(2 + nrows_nyq, ncols, height_ratios=[1.4, 1.0] + [1.1] * nrows_nyq)

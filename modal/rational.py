@@ -5,9 +5,9 @@ for a start, ``H(ω) ≈ N(s) / D(s)`` with ``s = iω``, ``D(s) = s² + a1 s + a
 (the pole: ``a0 = ωn²``, ``a1 = 2ζωn``) and ``N`` a complex quadratic: the mode's
 ``A s^p`` plus an offset times ``D``. Multiplying out, ``H D − N = 0`` is linear
 in (a0, a1, N): Levy's fit. Its equations weigh each line by ``|D|``, which
-favours the lines away from the peak; two Sanathanan–Koerner passes divide
-that weight out again (each pass weighs the lines by ``1/|D|`` of the previous
-pole), so the pole approaches the least-squares one. Every channel has its own
+favours the lines away from the peak; Sanathanan–Koerner passes (``SK_PASSES``)
+divide that weight out again (each pass weighs the lines by ``1/|D|`` of the
+previous pole), so the pole approaches the least-squares one. Every channel has its own
 numerator and all share the denominator; the numerators are projected out, so
 the pole comes from one 2×2 real system whatever the channel count.
 

@@ -212,6 +212,11 @@ class SpeedIntervals:
         return float(self.intervals_rad_s[0, 0]) if len(self) else math.inf
 
 
+#: default condition-number cap of :func:`stability_map` (see its ``condition_cap``), also the scan's of
+#: :func:`stable_speed_intervals`
+CONDITION_CAP = 1e8
+
+
 def _stable_on_grid(params: ADBParameters, speeds: np.ndarray, angles: np.ndarray) -> np.ndarray:
     """Whether the balanced state is stable at each speed of a scan.
 
@@ -227,7 +232,7 @@ def _stable_on_grid(params: ADBParameters, speeds: np.ndarray, angles: np.ndarra
     growth, bound, nondim = np.empty(shape), np.empty(shape), np.empty(shape)
     codes = np.empty(shape, dtype=int)
     ratio = speeds[None, :] / params.natural_frequency_rad_s
-    _routh_rows([params], [0], [angles], speeds, ratio, 1e8, growth, bound, nondim, codes)
+    _routh_rows([params], [0], [angles], speeds, ratio, CONDITION_CAP, growth, bound, nondim, codes)
     return codes[0] == STABLE
 
 
@@ -354,7 +359,7 @@ _MAP_FIELDS = ("M", "m", "n", "R", "e", "k", "c", "D")
 
 
 def stability_map(params: ADBParameters, speeds_rad_s, parameter: str, values, *, ball_angles_rad=None,
-                  condition_cap: float | None = 1e8, margin: bool = True) -> StabilityMap:
+                  condition_cap: float | None = CONDITION_CAP, margin: bool = True) -> StabilityMap:
     """Balanced-state stability over ``speeds x values``.
 
     With ``margin=True`` (default) every point is a batched eigenvalue problem and the
