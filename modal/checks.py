@@ -203,7 +203,7 @@ def residual_noise_std(omega: np.ndarray, response: np.ndarray, power: int, regi
     return _seen_through(noise_std, neighbour_noise_std(omega, res), np.max(np.abs(response), axis=1))
 
 
-def fit_residual_noise_std(omega: np.ndarray, fit, noise_std) -> np.ndarray:
+def fit_residual_noise_std(omega: np.ndarray, fit, noise_std, channels=slice(None)) -> np.ndarray:
     """:func:`residual_noise_std` from the residual a fit already holds (no second solve).
 
     Parameters
@@ -214,15 +214,16 @@ def fit_residual_noise_std(omega: np.ndarray, fit, noise_std) -> np.ndarray:
         An unweighted fit with the offset per region (``background_powers=(0,)``, the model
         of :func:`residual_noise_std`), holding ``residual`` and ``channel_scale``.
     noise_std : ndarray, shape (n_channels,)
-        Raw-data estimate per channel.
+        Raw-data estimate per channel (of the ``channels`` only, when given).
+    channels : slice or ndarray of int, optional
+        The fit's channels to measure (default all).
 
     Returns
     -------
     ndarray, shape (n_channels,)
     """
-    peak = np.asarray(fit.channel_scale, float)  # the residual is held per channel over its peak, lines first
-    return _seen_through(noise_std, neighbour_noise_std(omega, fit.residual, axis=0) * np.where(peak > 0, peak, 1.0),
-                         peak)
+    return _seen_through(noise_std, neighbour_noise_std(omega, fit.residual[channels]),
+                         np.asarray(fit.channel_scale, float)[channels])
 
 
 def residual_structure(omega: np.ndarray, response: np.ndarray, power: int, region: np.ndarray,

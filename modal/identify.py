@@ -18,7 +18,7 @@ from .model import mode_basis, solve_linear
 from .nls import fit_modes, truncation_shift
 from .rational import rational_pole
 from .propagate import combine_poles, constant_covariance, magnitude_to_complex
-from .peaks import ModeBand, _indicator_and_peak, bands_from_hz, estimate_noise_std, find_modes
+from .peaks import ModeBand, _indicator_and_peak, bands_from_hz, channel_sample, estimate_noise_std, find_modes
 from .results import FLAG_TEXT, IdentificationResult, ModeResult, ModeStd, correlation_of, physical_covariance, physical_parameters
 from .units import TWO_PI
 
@@ -284,6 +284,20 @@ def _band_data(frf, bands, channels=None):
     return frf.omega_rad_s[keep], (np.concatenate(runs, axis=1) if runs else response[:, keep]), region
 
 
+def _band_peaks(bands, data) -> np.ndarray:
+    """max |H| of each channel on each band's lines, (n_bands, n_channels), from the bands' :func:`_band_data`
+    (|H| of every channel once: the fit scales each channel by its largest, the misfit check ranks by them)."""
+    omega, response, _ = data
+    magnitude = np.abs(response)
+    out = np.zeros((len(bands), response.shape[0]))
+    for b, band in enumerate(bands):
+        # a band's lines are a run of the bands' lines (every line between its edges is in it)
+        lines = np.flatnonzero((omega >= TWO_PI * band.low_hz) & (omega <= TWO_PI * band.high_hz))
+        if lines.size:
+            out[b] = magnitude[:, lines[0]:lines[-1] + 1].max(axis=1)
+    return out
+
+
 def _start_pole(frf, band, power, noise):
     """Best start of (ωn, ζ) among half-power and circle, by residual with A solved linearly."""
     omega, h = _mode_arrays(frf, band)
@@ -365,25 +379,28 @@ def _doubtful(fit, bands) -> bool:
                 and np.all(s_zeta <= REL_STD_LIMIT * zeta))
 
 
-def _nls_fit(frf, bands, power, noise, data=None):
+def _nls_fit(frf, bands, power, noise, data=None, band_peak=None):
     """The band-wise NLS fit of every band's mode, from the cheapest start that serves.
 
     Each band starts from its one-mode rational fit (a few linear solves); a band where
     that gives no pole, or a fit that looks doubtful (:func:`_doubtful`), takes the
     half-power and circle starts of :func:`_start_pole` as well (of :func:`_principal_start`,
     one curve per band, for many channels), and the fit with the lower residual is kept.
-    ``data``: the :func:`_band_data` of the bands, when the caller has it.
+    ``data``: the :func:`_band_data` of the bands, when the caller has it; ``band_peak``: its
+    :func:`_band_peaks`.
     """
     quick = [_quick_start(frf, band, power, noise) for band in bands]
     if all(q is not None for q in quick):
-        fit = _fit_bands(frf, bands, power, [q[0] for q in quick], [q[1] for q in quick], data=data)
+        fit = _fit_bands(frf, bands, power, [q[0] for q in quick], [q[1] for q in quick], data=data,
+                         band_peak=band_peak)
         if not _doubtful(fit, bands):
             return fit
     else:
         fit = None
     start = _principal_start if frf.n_channels > 1 else _start_pole
     starts = [start(frf, band, power, noise) for band in bands]
-    careful = _fit_bands(frf, bands, power, [s[0] for s in starts], [s[1] for s in starts], data=data)
+    careful = _fit_bands(frf, bands, power, [s[0] for s in starts], [s[1] for s in starts], data=data,
+                         band_peak=band_peak)
     if fit is None or _fit_cost(careful) <= _fit_cost(fit):
         return careful
     return fit
@@ -546,18 +563,6 @@ def _band_noise(frf, bands, line_noise):
     return np.sqrt(np.mean(line_noise[:, lines] ** 2, axis=1))
 
 
-class _ScaledResidual:
-    """A fit's own residual (:attr:`modal.nls.NLSFit.residual`, (n_freq, n_channels), each channel over its
-    scale) read as rows (n_channels, n_freq) in the FRF's unit: ``residual[rows]``. The checks read a few
-    of many channels (the strongest eight of 1000), so only those are scaled back and transposed."""
-
-    def __init__(self, residual: np.ndarray, scale: np.ndarray):
-        self._residual, self._scale = residual, scale
-
-    def __getitem__(self, rows) -> np.ndarray:
-        return (self._residual[:, rows] * self._scale[rows]).T
-
-
 def _constant_distance(difference: np.ndarray, cov: np.ndarray, floor: np.ndarray) -> np.ndarray:
     """Per channel, the distance of a complex difference of modal constants in standard errors: the
     Mahalanobis distance of (Re, Im) under their 2×2 covariance ``cov`` (n_ch, 2, 2), each part's error
@@ -578,14 +583,14 @@ def _constant_distance(difference: np.ndarray, cov: np.ndarray, floor: np.ndarra
     return np.where((det > 0) & (squared >= 0), np.sqrt(np.maximum(squared, 0)), total)
 
 
-def _local_misfit(frf, bands, power, omega_n, damping_ratio, data=None) -> np.ndarray:
+def _local_misfit(frf, bands, power, omega_n, damping_ratio, data=None, band_peak=None) -> np.ndarray:
     """Per mode, the misfit near it relative to the data there (RMS over the strongest channels, at most
     ``POLE_CHANNELS``).
 
     In each band every fitted mode and a complex offset are solved linearly at the
     fitted poles; the residual is taken on the lines within ±3 half-power widths
     (at least ±3 lines) of the band's mode. ``data``: the :func:`_band_data` of the bands
-    (each band is a run of its lines).
+    (each band is a run of its lines); ``band_peak``: its :func:`_band_peaks`.
     """
     out = np.full(len(bands), np.nan)
     if data is None:
@@ -593,7 +598,6 @@ def _local_misfit(frf, bands, power, omega_n, damping_ratio, data=None) -> np.nd
     else:
         omega_all, response, _ = data
     many = response.shape[0] > POLE_CHANNELS
-    magnitude = np.abs(response) if many else None  # |H| of every channel once, for every band's ranking
     for b, (band, wn, zeta) in enumerate(zip(bands, omega_n, damping_ratio)):
         # band edges lie halfway between lines (peaks._edges_between_lines): no rounding of 2π f can
         # move a line across one
@@ -603,7 +607,8 @@ def _local_misfit(frf, bands, power, omega_n, damping_ratio, data=None) -> np.nd
         run = slice(lines[0], lines[-1] + 1)  # a view: no copy of every channel
         omega, h = omega_all[run], response[:, run]
         if many:  # the strong channels carry the misfit that matters; O(1) in channels
-            h = h[np.argsort(magnitude[:, run].max(axis=1))[::-1][:POLE_CHANNELS]]
+            peak = np.abs(h).max(axis=1) if band_peak is None else band_peak[b]
+            h = h[np.argsort(peak)[::-1][:POLE_CHANNELS]]
         basis = mode_basis(omega, omega_n, damping_ratio, power).T
         design = np.hstack([basis, ((1j * omega) ** power)[:, None]])
         coef = solve_linear(design, h.T)
@@ -659,7 +664,7 @@ def _line_weight(frf, bands):
     return ref / np.maximum(sigma, 1e-3 * ref)
 
 
-def _fit_bands(frf, bands, power, omega_n0, damping_ratio0, channels=None, data=None):
+def _fit_bands(frf, bands, power, omega_n0, damping_ratio0, channels=None, data=None, band_peak=None):
     """:func:`modal.nls.fit_modes` of every band's mode together, with collapsed modes reseated.
 
     A weak mode whose start lies on a noise spike can collapse there inside the
@@ -671,12 +676,15 @@ def _fit_bands(frf, bands, power, omega_n0, damping_ratio0, channels=None, data=
     modes peaks in its band (:func:`modal.checks.restart_pole`), and the joint
     fit runs again. The restart is kept only when its residual is lower: the
     reported fit is the better least-squares optimum of the same model. ``data``: the
-    :func:`_band_data` of these bands and channels, when the caller has it.
+    :func:`_band_data` of these bands and channels, when the caller has it; ``band_peak``: its
+    :func:`_band_peaks`.
     """
     omega, response, region = _band_data(frf, bands, channels) if data is None else data
     weight = _line_weight(frf, bands)
+    scale = None if band_peak is None else band_peak.max(axis=0)  # max |H| of each channel on the lines
     with np.errstate(all="ignore"):
-        fit = fit_modes(omega, response, power, omega_n0, damping_ratio0, region=region, line_weight=weight)
+        fit = fit_modes(omega, response, power, omega_n0, damping_ratio0, region=region, line_weight=weight,
+                        channel_scale=scale)
     if len(bands) < 2:
         return fit
     for r in range(len(bands)):
@@ -694,7 +702,8 @@ def _fit_bands(frf, bands, power, omega_n0, damping_ratio0, channels=None, data=
         start_wn, start_zeta = fit.omega_n.copy(), fit.damping_ratio.copy()
         start_wn[r], start_zeta[r] = start
         with np.errstate(all="ignore"):
-            restart = fit_modes(omega, response, power, start_wn, start_zeta, region=region, line_weight=weight)
+            restart = fit_modes(omega, response, power, start_wn, start_zeta, region=region, line_weight=weight,
+                                channel_scale=scale)
         if _fit_cost(restart) < _fit_cost(fit):
             fit = restart
     return fit
@@ -998,26 +1007,36 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
             per_mode.append((wn, zeta, const, cov, s_wn, s_z, flags, q, chi2, reference))
     else:
         data = _band_data(frf, bands)  # the lines of the bands, taken out once
-        fit = _nls_fit(frf, bands, power, noise, data)
+        band_peak = _band_peaks(bands, data)
+        fit = _nls_fit(frf, bands, power, noise, data, band_peak)
         # the checks all measure the residual of the same modes on the same lines: the fit's own when it is
         # unweighted (no second solve), else computed once
         own = fit.residual is not None and not fit.line_weighted
         if own:
-            residual = _ScaledResidual(fit.residual, np.where(fit.channel_scale > 0, fit.channel_scale, 1.0))
+            residual = fit.residual
         else:
             with np.errstate(all="ignore"):
                 residual = fit_residual(data[0], data[1], power, data[2], fit.omega_n, fit.damping_ratio)
-        fit_noise = _fit_noise(frf, bands, power, fit.omega_n, fit.damping_ratio, estimated_noise, known=known_noise,
-                               residual=residual, fit=fit if own else None, data=data)
-        chi2 = _chi2(fit.noise_var, fit_noise)
-        # the check's noise is the residual's own: with a known noise (time data) it computes it itself
+        # χ² is a median over the channels: many channels are sampled (peaks.channel_sample)
+        rows = channel_sample(n_ch)
+        if known_noise:
+            fit_noise = estimated_noise[rows]
+        elif own:
+            with np.errstate(all="ignore"):
+                fit_noise = fit_residual_noise_std(data[0], fit, estimated_noise[rows], rows)
+        else:
+            fit_noise = _fit_noise(frf, bands, power, fit.omega_n, fit.damping_ratio, estimated_noise,
+                                   residual=residual, data=data)[rows]
+        chi2 = _chi2(fit.noise_var[rows], fit_noise)
+        # the check's noise is the residual's own (of every channel, when at hand; else it measures its own)
         missing_mode = _missing_mode(frf, bands, power, fit.omega_n, fit.damping_ratio, estimated_noise, residual,
-                                     None if known_noise else fit_noise, data, fit.channel_scale)
+                                     None if known_noise or isinstance(rows, np.ndarray) else fit_noise, data,
+                                     fit.channel_scale)
         # near-exact data: the offset's truncation (modes outside the bands) biases the poles
         # beyond their white-noise errors; its measured shift is added to them (finding 26)
         shift = _truncation(frf, bands, power, fit, residual=residual, data=data)
         order = np.argsort(fit.omega_n)  # two close poles may cross during the fit
-        relative = _local_misfit(frf, bands, power, fit.omega_n[order], fit.damping_ratio[order], data)
+        relative = _local_misfit(frf, bands, power, fit.omega_n[order], fit.damping_ratio[order], data, band_peak)
         for b, (band, r) in enumerate(zip(bands, order)):
             flags: set[str] = set()
             if not fit.converged:

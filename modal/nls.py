@@ -36,12 +36,11 @@ class NLSFit:
         Residual estimate of E|n|² per channel.
     converged : bool
     n_iter : int
-    residual : ndarray, shape (n_freq, n_channels), optional
-        Residual of the fit, each channel divided by its ``channel_scale`` (and each line
-        times its weight, for a weighted fit).
+    residual : ndarray, shape (n_channels, n_freq), optional
+        Residual of the fit in the FRF's unit (each line times its weight, for a weighted fit).
     channel_scale : ndarray, shape (n_channels,), optional
-        max |H| of each channel over the lines, FRF unit (``residual`` is divided by it, or by 1
-        where it is 0).
+        max |H| of each channel over the lines, FRF unit (the fit works on each channel over it,
+        or over 1 where it is 0).
     line_weighted : bool
         The fit weighted its lines (``line_weight`` given): ``residual`` is the weighted one.
     """
@@ -148,8 +147,9 @@ def _pole_covariance(F: np.ndarray) -> np.ndarray:
     return cov / scale
 
 
-def _compress(Y: np.ndarray, probes: np.ndarray) -> np.ndarray:
-    """Many channels: replace Y (n_freq, n_ch) by Y V with V (n_ch, k) orthonormal.
+def _compress(rows: np.ndarray, scale: np.ndarray, probes: np.ndarray) -> np.ndarray:
+    """Many channels: replace Y (n_freq, n_ch) by Y V with V (n_ch, k) orthonormal, where Y is
+    ``rows`` (n_ch, n_freq) transposed with each channel times its ``scale``.
 
     The cost ||P⊥ Y V||² and its gradient depend on the channels only through
     the row space kept by V. The fitted coefficients Φ⁺Y and, to first order, their
@@ -161,11 +161,12 @@ def _compress(Y: np.ndarray, probes: np.ndarray) -> np.ndarray:
     stay within 1e-4 of their standard errors of the fit to every channel; a
     randomised range finder of 20 columns with a power iteration, five products
     with Y, stayed within 3e-3). Modal constants and noise levels are computed
-    afterwards on the full data.
+    afterwards on the full data. Both products read ``rows`` as they are (BLAS takes
+    the transpose): no scaled copy of every channel.
     """
     basis, _ = np.linalg.qr(probes)
-    V, _ = np.linalg.qr((basis.conj().T @ Y).conj().T)  # (n_ch, k) orthonormal
-    return Y @ V
+    V, _ = np.linalg.qr((rows @ basis.conj()).conj() * scale[:, None])  # (n_ch, k) orthonormal: of (Q₀ᴴY)ᴴ
+    return rows.T @ (V * scale[:, None])
 
 
 def _project(Phi, Y):
@@ -179,7 +180,7 @@ def _project(Phi, Y):
 def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, damping_ratio0,
               region: np.ndarray | None = None, max_iter: int = 200, step_tol: float = 1e-13,
               background_powers: tuple[int, ...] = (0,), residual_terms: bool = False,
-              line_weight: np.ndarray | None = None) -> NLSFit:
+              line_weight: np.ndarray | None = None, channel_scale: np.ndarray | None = None) -> NLSFit:
     """Fit poles and modal constants of several modes to many channels at once.
 
     Parameters
@@ -214,17 +215,16 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
         noise σ_line that varies over the lines (an estimate from time data: its noise
         spikes at the zeros of the force spectrum). ``noise_var`` and the covariances are
         then those of the weighted problem: ``noise_var`` estimates σ_ref².
+    channel_scale : ndarray, shape (n_channels,), optional
+        max |H| of each channel over the lines, when the caller has it (each channel is fitted
+        over it).
     """
     omega = np.asarray(omega, float)
-    Y_raw = np.atleast_2d(np.asarray(response, complex))
-    n_ch = Y_raw.shape[0]
-    peak = np.abs(Y_raw).max(axis=1)
+    rows = np.atleast_2d(np.asarray(response, complex))  # (n_ch, n_freq), the FRF's unit: never written to
+    n_ch = rows.shape[0]
+    peak = np.abs(rows).max(axis=1) if channel_scale is None else np.asarray(channel_scale, float)
     ch_scale = np.where(peak > 0, peak, 1.0)
-    # (n_freq, n_ch), each channel scaled to max 1: a transposed copy divided in place on its real view
-    # (numpy divides complex by real as complex by complex, three times as long and not correctly rounded)
-    Y = np.array(Y_raw.T, dtype=complex, order="C")
-    parts = Y.view(float)
-    np.divide(parts, np.repeat(ch_scale, 2), out=parts)
+    inverse_scale = 1.0 / ch_scale  # the fit works on each channel scaled to max 1
     w_ref = np.atleast_1d(np.asarray(omega_n0, float))
     w_ref = float(w_ref[0] if w_ref.size == 1 else np.median(w_ref))
     x = omega / w_ref
@@ -241,7 +241,6 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
     zeta_lo = 1e-6 * float((x[1:] - x[:-1]).min()) / (2 * x.max()) if x.size > 1 else 1e-12
     params[0::2] = np.minimum(np.maximum(params[0::2], x_lo), x_hi)
     params[1::2] = np.minimum(np.maximum(params[1::2], zeta_lo), ZETA_MAX)
-    Y_full = Y
     background = _background(x, region, n_regions, background_powers)
     if residual_terms:
         kind = (1j * x) ** power
@@ -252,7 +251,7 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
     weight = None
     if line_weight is not None:
         weight = np.asarray(line_weight, float)[:, None]
-        Y_full = Y = Y_full * weight
+        rows = rows * weight[:, 0]
         background = background * weight
     def design(p):
         Phi = np.empty((x.size, n_b), dtype=complex)
@@ -264,7 +263,10 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
         return Phi, dphi
 
     if n_ch > 2 * (2 * n_b + 8):  # many channels: fit on fewer combinations
-        Y = _compress(Y_full, np.hstack(design(params)))
+        Y = _compress(rows, inverse_scale, np.hstack(design(params)))
+    else:  # (n_freq, n_ch), each channel scaled: a transposed copy, multiplied on its real view
+        Y = np.array(rows.T, order="C")  # (numpy multiplies complex by real as complex by complex)
+        Y.view(float).__imul__(np.repeat(inverse_scale, 2))
 
     def evaluate(p):
         Phi, dphi = design(p)
@@ -339,16 +341,17 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
             break
 
     Phi, dphi, Q, R, QhY, res, cost = state
-    if Y is not Y_full:  # back to the channels: one projection of the full data
-        Y = Y_full
-        QhY = Q.conj().T @ Y
-        res = np.subtract(Y, Q @ QhY, out=Y)  # in place: the scaled copy is ours and not needed after
+    # back to every channel: one projection of the full data, channels first in the FRF's unit (no copy of
+    # the data: BLAS reads ``rows`` transposed), the residual written over the model
+    data_coef = (rows @ Q.conj()).T  # Qᴴ Yᵀ, (n_b, n_ch)
+    res = data_coef.T @ Q.T  # the model
+    np.subtract(rows, res, out=res)
+    QhY = data_coef * inverse_scale
     n_freq = x.size
     n_b = Phi.shape[1]
     C = np.linalg.solve(R, QhY)
-    parts = np.ascontiguousarray(res).view(float)  # Re, Im side by side: |r|² summed without a temporary per line
-    rss = np.einsum("ij,ij->j", parts, parts)
-    rss = rss[0::2] + rss[1::2]
+    parts = res.view(float)  # Re, Im side by side: |r|² summed without a temporary per line
+    rss = np.einsum("ij,ij->i", parts, parts) * inverse_scale**2
     dof = n_freq - n_b - n_theta / (2 * n_ch)
     noise_var = rss / dof if dof > 0 else np.full(n_ch, np.nan)
     # Fisher information of the poles (Schur complement via the projected Jacobian)

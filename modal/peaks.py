@@ -1,6 +1,7 @@
 """Noise level, mode indicator, automatic peak detection and fitting bands."""
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -8,7 +9,8 @@ import numpy as np
 from .errors import IdentificationError
 from .frf import FRF
 
-__all__ = ["estimate_noise_std", "neighbour_noise_std", "local_noise_std", "mode_indicator", "find_modes", "ModeBand", "bands_from_hz"]
+__all__ = ["estimate_noise_std", "neighbour_noise_std", "local_noise_std", "mode_indicator", "find_modes", "ModeBand",
+           "bands_from_hz", "channel_sample"]
 
 
 #: neighbour weights within this of ½ count as an evenly spaced axis (``np.linspace`` lines differ from even by
@@ -16,13 +18,10 @@ __all__ = ["estimate_noise_std", "neighbour_noise_std", "local_noise_std", "mode
 UNIFORM_WEIGHT_TOL = 1e-9
 
 
-def _misfit_power(frequency: np.ndarray, values: np.ndarray, axis: int = -1) -> np.ndarray:
+def _misfit_power(frequency: np.ndarray, values: np.ndarray) -> np.ndarray:
     """Each inner line's squared misfit to the straight line through its neighbours, over
-    (1 + w_l² + w_r²), so that white noise of variance σ² gives E = σ²; shape (n_rows, n_freq − 2).
-
-    ``axis``: the lines along the last axis (``values`` (n_rows, n_freq), the default) or
-    along the first (``values`` (n_freq, n_rows); the result is then (n_freq − 2, n_rows)).
-    """
+    (1 + w_l² + w_r²), so that white noise of variance σ² gives E = σ²; ``values`` (n_rows, n_freq),
+    the result (n_rows, n_freq − 2)."""
     step = np.diff(np.asarray(frequency, float))
     w_left = step[1:] / (step[:-1] + step[1:])
     w_right = 1.0 - w_left
@@ -30,13 +29,10 @@ def _misfit_power(frequency: np.ndarray, values: np.ndarray, axis: int = -1) -> 
     values = np.asarray(values, dtype=complex)
     if values.strides[-1] != values.itemsize:  # the real view needs Re, Im side by side along the last axis
         values = np.ascontiguousarray(values)
-    # on the real view (real and imaginary parts side by side), in place: 1000 channels ×
-    # 2000 lines are 32 MB per temporary, and complex-by-real products cost twice as much
+    # on the real view (real and imaginary parts side by side, a line two numbers wide), in place:
+    # 1000 channels × 2000 lines are 32 MB per temporary, and complex-by-real products cost twice as much
     parts = values.view(float)
-    if axis == 0:  # whole rows of lines shifted
-        before, centre, after = parts[:-2], parts[1:-1], parts[2:]
-    else:  # along the real view's last axis a line is two numbers wide
-        before, centre, after = parts[:, :-4], parts[:, 2:-2], parts[:, 4:]
+    before, centre, after = parts[:, :-4], parts[:, 2:-2], parts[:, 4:]
     if w_left.size and np.all(np.abs(w_left - 0.5) <= UNIFORM_WEIGHT_TOL):
         # evenly spaced lines (to rounding): weights ½, factor 2/3, by scalars in place
         misfit = np.add(before, after)
@@ -44,15 +40,11 @@ def _misfit_power(frequency: np.ndarray, values: np.ndarray, axis: int = -1) -> 
         misfit += centre
         norm = 2.0 / 3.0
     else:
-        if axis == 0:
-            left, right, norm = w_left[:, None], w_right[:, None], norm[:, None]
-        else:
-            left, right = np.repeat(w_left, 2), np.repeat(w_right, 2)
-        misfit = np.multiply(before, left)
-        misfit += after * right
+        misfit = np.multiply(before, np.repeat(w_left, 2))
+        misfit += after * np.repeat(w_right, 2)
         np.subtract(centre, misfit, out=misfit)
     misfit *= misfit
-    power = np.add(misfit[..., 0::2], misfit[..., 1::2])
+    power = np.add(misfit[:, 0::2], misfit[:, 1::2])
     power *= norm
     return power
 
@@ -61,7 +53,7 @@ def _misfit_power(frequency: np.ndarray, values: np.ndarray, axis: int = -1) -> 
 _ROWS_AT_ONCE = 128
 
 
-def neighbour_noise_std(frequency: np.ndarray, values: np.ndarray, axis: int = -1) -> np.ndarray:
+def neighbour_noise_std(frequency: np.ndarray, values: np.ndarray) -> np.ndarray:
     """Noise standard deviation per row (E|n|² = σ²), from each line's misfit to its neighbours.
 
     Each inner line is compared with the straight line through its two
@@ -79,19 +71,8 @@ def neighbour_noise_std(frequency: np.ndarray, values: np.ndarray, axis: int = -
         Increasing axis (any unit).
     values : ndarray, shape (n_rows, n_freq)
         Complex data per row; at least 5 lines, else NaN.
-    axis : {-1, 0}
-        The axis of the lines: -1 as above, 0 for ``values`` of shape (n_freq, n_rows).
     """
     values = np.atleast_2d(np.asarray(values, dtype=complex))
-    if axis == 0:
-        if values.shape[0] < 5:
-            return np.full(values.shape[1], np.nan)
-        # all rows at once (contiguous shifts of whole lines; in blocks of columns the misfit took 30 % longer),
-        # then the lines of each row side by side for the median
-        power = np.ascontiguousarray(_misfit_power(frequency, values, axis=0).T)
-        mid = power.shape[1] // 2
-        power.partition(mid, axis=1)  # in place: the misfit is ours
-        return np.sqrt(power[:, mid] / np.log(2))
     if values.shape[1] < 5:
         return np.abs(values).max(axis=1) * np.nan
     median = np.empty(values.shape[0])
@@ -210,6 +191,35 @@ def _peaks_with_prominence(y: np.ndarray, min_prominence: float) -> np.ndarray:
     return inner[level - np.maximum(left_base, right_base) >= min_prominence]
 
 
+#: statistics per channel that only enter a mean or a median over the channels (a peak's signal-to-noise
+#: ratio, the fit's chi-square) are measured on at most this many channels, a fixed random sample
+SAMPLE_CHANNELS = 128
+
+
+def channel_sample(n_channels: int, size: int | None = None) -> slice | np.ndarray:
+    """The channels a mean or median over all channels is estimated from: all of them (``slice(None)``)
+    up to ``size`` (default :data:`SAMPLE_CHANNELS`), else ``size`` of them drawn at random without replacement (a fixed seed, so a result
+    does not change from run to run), in increasing order.
+
+    A mean or median over a random sample estimates the one over all channels without bias (each channel
+    is as likely to be drawn), with a sampling error 1/sqrt(``size``) of the spread over the channels (times
+    sqrt(1 − size/n)). An evenly strided sample would not serve: channels are often ordered by point and
+    direction, and a stride that is a multiple of the number of directions sees one direction only.
+    """
+    size = SAMPLE_CHANNELS if size is None else size
+    if n_channels <= size:
+        return slice(None)
+    return _random_sample(n_channels, size)
+
+
+@functools.lru_cache(maxsize=16)
+def _random_sample(n_channels: int, size: int) -> np.ndarray:
+    """:func:`channel_sample`'s draw (read-only: one array serves every call with these sizes)."""
+    rows = np.sort(np.random.default_rng(0x5EED).choice(n_channels, size, replace=False))
+    rows.flags.writeable = False
+    return rows
+
+
 #: half-width (lines) of the window in which the local noise level around a peak is measured
 LOCAL_NOISE_LINES = 64
 #: with a noise per line (an estimate from time data), a peak must stand this many of its own σ above zero
@@ -272,7 +282,8 @@ def find_modes(frf: FRF, min_prominence_db: float = 6.0, noise_factor: float = 1
     both the whole axis' and the local one around the peak (RMS over the
     channels of |H|/σ_local, :func:`local_noise_std`, or ``line_noise_std``
     when the FRF carries its own noise per line, e.g. an estimate from time
-    data). Its band is ±``bandwidths`` half-power widths (at least ±5 lines),
+    data); the RMS over more than :data:`SAMPLE_CHANNELS` channels is taken on a sample of them
+    (:func:`channel_sample`). Its band is ±``bandwidths`` half-power widths (at least ±5 lines),
     clipped halfway to the neighbouring peaks and to the data, with its edges
     moved halfway between lines (see :func:`_edges_between_lines`). ``indicator``: the mode
     indicator and each channel's max |H| (:func:`_indicator_and_peak`), when the caller has them.
@@ -288,15 +299,19 @@ def find_modes(frf: FRF, min_prominence_db: float = 6.0, noise_factor: float = 1
     keep = ind[idx] > floor
     idx = idx[keep]
     if idx.size:
-        mag = np.abs(frf.channels[:, idx])
+        # the tests below take a mean over the channels: many channels are sampled (channel_sample)
+        rows = channel_sample(frf.n_channels)
+        values = frf.channels[rows]
+        mag = np.abs(values[:, idx])
         if line_noise_std is None:
             spacing = np.min(np.diff(freq))
             region = [max(5, int(np.ceil(bandwidths * _half_power_width(freq, ind, i) / spacing))) for i in idx]
-            local = local_noise_std(freq, frf.channels, idx, region)
+            local = local_noise_std(freq, values, idx, region)
         else:
             # a per-line noise estimated from few averages scatters: its median over the same
             # window is the level (the noise of an estimate varies smoothly with frequency) ...
             line_noise = np.atleast_2d(np.asarray(line_noise_std, float))
+            line_noise = line_noise[rows] if line_noise.shape[0] == frf.n_channels else line_noise
             local = np.empty(mag.shape)
             near = np.empty(mag.shape)
             for k, line in enumerate(idx):

@@ -41,7 +41,7 @@ def test_evenly_spaced_lines_take_the_same_misfit_as_any_axis():
     # an evenly spaced axis (np.linspace, whose spacings differ by rounding) is computed with weights ½ by
     # scalars: the misfit power equals the general weighted formula to rounding (the weights differ
     # from ½ by ~1e-13, the misfit by that times the neighbours' difference: 1e-11 of the mean power
-    # bounds it with room), along either axis, and a straight trend still cancels to rounding
+    # bounds it with room), and a straight trend still cancels to rounding
     from modal.peaks import UNIFORM_WEIGHT_TOL, _misfit_power
 
     rng = np.random.default_rng(5)
@@ -54,6 +54,52 @@ def test_evenly_spaced_lines_take_the_same_misfit_as_any_axis():
     general = np.abs(misfit) ** 2 / (1 + w_left**2 + (1 - w_left) ** 2)
     atol = 1e-11 * general.mean()
     np.testing.assert_allclose(_misfit_power(f, values), general, rtol=0, atol=atol)
-    np.testing.assert_allclose(_misfit_power(f, values.T.copy(), axis=0), general.T, rtol=0, atol=atol)
     trend = (2 + 3j) * f
     assert _misfit_power(f, trend[None, :]).max() < (1e-12 * np.abs(trend).max()) ** 2
+
+
+def test_channel_sample_takes_every_channel_up_to_its_size_and_a_fixed_unaliased_draw_beyond():
+    from modal.peaks import SAMPLE_CHANNELS, channel_sample
+
+    assert channel_sample(SAMPLE_CHANNELS) == slice(None)
+    n = 3 * 400  # channels ordered point by point, three directions each (x, y, z, x, y, z, ...)
+    rows = channel_sample(n)
+    assert rows.size == SAMPLE_CHANNELS and np.all(np.diff(rows) > 0) and 0 <= rows[0] and rows[-1] < n
+    np.testing.assert_array_equal(rows, channel_sample(n))  # the same channels on every call
+    # every direction drawn about a third of the time: binomial(128, 1/3) is 42.7 ± 5.3; 4 SD either side
+    # (a stride that is a multiple of 3 would draw one direction only)
+    counts = np.bincount(rows % 3, minlength=3)
+    expected, sd = SAMPLE_CHANNELS / 3, np.sqrt(SAMPLE_CHANNELS * (1 / 3) * (2 / 3))
+    assert np.all(np.abs(counts - expected) <= 4 * sd), counts
+
+
+def _many_channel_frf(n_channels=1000):
+    rng = np.random.default_rng(1)
+    const = rng.standard_normal((n_channels, 3)) + 0.05j * rng.standard_normal((n_channels, 3))
+    f = np.linspace(0, 400, 2001)
+    return add_noise(modal_frf(f, [50.0, 120.0, 300.0], [0.01, 0.02, 0.03], const, kind="accelerance"), 0.01, seed=2)
+
+
+def test_sampled_tests_over_channels_agree_with_every_channel(monkeypatch):
+    # the peak test's mean and the chi-square's median over 1000 channels, from 128 of them: the same
+    # peaks, and chi-square within the sample median's error. Each channel's ratio of residual variance
+    # (~735 degrees of freedom: 3.7 %) to its noise estimate (a median of ~740 neighbour misfits: 1.44/sqrt(n)
+    # for independent ones, x1.3 for the neighbours' overlap, 7 %) spreads by at most 0.1; the median of 128
+    # draws then has error 1.25 · 0.1/sqrt(128) · sqrt(1 − 128/1000) ≈ 0.01, and 4 of them bound it
+    import warnings
+
+    import modal.peaks as peaks
+    from modal import identify
+    from modal.peaks import find_modes
+
+    frf = _many_channel_frf()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        sampled_bands, sampled = find_modes(frf), identify(frf, "nls")
+        monkeypatch.setattr(peaks, "SAMPLE_CHANNELS", frf.n_channels)
+        every_bands, every = find_modes(frf), identify(frf, "nls")
+    assert sampled_bands == every_bands and len(every_bands) == 3
+    for a, b in zip(sampled.modes, every.modes):
+        assert a.natural_frequency_hz == b.natural_frequency_hz and a.damping_ratio == b.damping_ratio
+        assert abs(a.chi2 - b.chi2) <= 4 * 1.25 * 0.1 / np.sqrt(128) * np.sqrt(1 - 128 / 1000)
+        assert a.flags == b.flags
