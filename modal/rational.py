@@ -61,22 +61,24 @@ def rational_pole(omega: np.ndarray, response: np.ndarray, noise_std=None,
     w_ref = float(omega[omega.size // 2]) or float(np.max(np.abs(omega))) or 1.0
     s = 1j * omega / w_ref
     basis = np.stack([np.ones_like(s), s, s * s], axis=1)  # (n_freq, 3)
-    hs = h * s  # (n_ch, n_freq)
-    rhs = -hs * s
+    # columns H·1, H·s and the right-hand side −H·s² of every channel side by side: (n_freq, 3 n_ch), so
+    # that projecting out the numerators is two matrix products
+    hs = h * s
+    columns = np.concatenate([h, hs, -hs * s]).T
+    n_ch = h.shape[0]
     weight = np.ones(omega.size)
     a0 = a1 = np.nan
     for _ in range(passes + 1):
         q, _r = np.linalg.qr(basis * weight[:, None])
-        qh = q.conj().T
-        # columns H·1, H·s and the right-hand side −H·s², weighted, numerators projected out
-        cols = np.stack([h, hs, rhs], axis=2) * weight[None, :, None]  # (n_ch, n_freq, 3)
-        before = np.real(np.einsum("cfi,cfi->i", cols[..., :2].conj(), cols[..., :2]))
-        cols = cols - q @ (qh @ cols)
-        flat = cols.reshape(-1, 3)
-        gram = np.real(flat.conj().T @ flat)
+        weighted = columns * weight[:, None]
+        projected = weighted - q @ (q.conj().T @ weighted)
+        # the 3x3 Gram matrix of the three kinds of column, summed over lines and channels
+        kinds = projected.reshape(omega.size, 3, n_ch).transpose(1, 0, 2).reshape(3, -1)
+        gram = np.real(kinds.conj() @ kinds.T)
+        before = np.real(np.einsum("ij,ij->j", weighted.conj(), weighted)).reshape(3, n_ch).sum(axis=1)
         # a response the numerators alone explain (no pole: a constant, a slope) leaves only
         # rounding in the denominator's columns: no pole to report
-        if not np.all(gram.diagonal()[:2] > RANK_TOL * before):
+        if not np.all(gram.diagonal()[:2] > RANK_TOL * before[:2]):
             return None
         # the 2x2 normal equations by Cramer's rule
         det = gram[0, 0] * gram[1, 1] - gram[0, 1] * gram[1, 0]
