@@ -103,7 +103,9 @@ class ModeResult:
         the data; NaN when not computed). The noise is estimated without the
         model: each line against the straight line through its neighbours, on
         the raw data and on the residual, the smaller of the two
-        (:func:`modal.checks.residual_noise_std`).
+        (:func:`modal.checks.residual_noise_std`). The median over the channels
+        (for ``"nls"`` with more than 128 channels, over a fixed random sample
+        of 128: :func:`modal.peaks.channel_sample`).
     driving_point : bool or ndarray of bool
         Per channel: whether k, c, m are defined.
     quality : float
