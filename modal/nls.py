@@ -295,7 +295,8 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
         Y = _compress(rows, inverse_scale, np.hstack(design(params)))
     else:  # (n_freq, n_ch), each channel scaled: a transposed copy, multiplied on its real view
         Y = np.array(rows.T, order="C")  # (numpy multiplies complex by real as complex by complex)
-        Y.view(float).__imul__(np.repeat(inverse_scale, 2))
+        parts = Y.view(float)
+        parts *= np.repeat(inverse_scale, 2)
 
     def evaluate(p):
         Phi, dphi = design(p)
