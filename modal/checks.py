@@ -356,7 +356,7 @@ def find_missing_mode(omega: np.ndarray, response: np.ndarray, power: int, regio
     if residual_noise is not None:
         sigma2 = np.asarray(residual_noise, float)[strongest] ** 2
     else:
-        sigma2 = _seen_through(noise_std[strongest], neighbour_noise_std(omega, res), np.max(np.abs(Y), axis=1)) ** 2
+        sigma2 = _seen_through(noise_std[strongest], neighbour_noise_std(omega, res), peak[strongest]) ** 2
     if not np.all(sigma2 > 0):
         return None
     energy = np.mean(np.abs(res) ** 2 / sigma2[:, None], axis=0)

@@ -109,8 +109,21 @@ def _constants_all_poles(frf, bands, power, omega_n, damping_ratio):
     return out
 
 
+def _band_mask(frf, band: ModeBand) -> np.ndarray:
+    """The lines of a band (bool over the FRF's lines)."""
+    return (frf.frequency_hz >= band.low_hz) & (frf.frequency_hz <= band.high_hz)
+
+
+def _band_run(omega: np.ndarray, band: ModeBand) -> slice:
+    """A band's lines on the lines ``omega`` (rad/s) of the bands' :func:`_band_data`, where they are a run
+    (every line between its edges is in it; the edges lie halfway between lines,
+    :func:`modal.peaks._edges_between_lines`, so no rounding of 2π f moves a line across one)."""
+    lines = np.flatnonzero((omega >= TWO_PI * band.low_hz) & (omega <= TWO_PI * band.high_hz))
+    return slice(lines[0], lines[-1] + 1) if lines.size else slice(0, 0)
+
+
 def _mode_arrays(frf, band: ModeBand):
-    keep = (frf.frequency_hz >= band.low_hz) & (frf.frequency_hz <= band.high_hz)
+    keep = _band_mask(frf, band)
     return frf.omega_rad_s[keep], frf.channels[:, keep]
 
 
@@ -259,6 +272,11 @@ def _channel_weights(frf, band, noise):
         return np.where(noise > 0, (peak / noise) ** 2, peak**2)
 
 
+def _strongest_channels(frf, band, noise, count: int) -> np.ndarray:
+    """The ``count`` channels of highest :func:`_channel_weights` in a band, strongest first."""
+    return np.argsort(_channel_weights(frf, band, noise))[::-1][:count]
+
+
 def _regions(bands: list[ModeBand], freq):
     """Lines in any band, and a region index per line (overlapping bands merge)."""
     keep = np.zeros(freq.size, bool)
@@ -291,18 +309,16 @@ def _band_peaks(bands, data) -> np.ndarray:
     magnitude = np.abs(response)
     out = np.zeros((len(bands), response.shape[0]))
     for b, band in enumerate(bands):
-        # a band's lines are a run of the bands' lines (every line between its edges is in it)
-        lines = np.flatnonzero((omega >= TWO_PI * band.low_hz) & (omega <= TWO_PI * band.high_hz))
-        if lines.size:
-            out[b] = magnitude[:, lines[0]:lines[-1] + 1].max(axis=1)
+        run = _band_run(omega, band)
+        if run.stop > run.start:
+            out[b] = magnitude[:, run].max(axis=1)
     return out
 
 
 def _start_pole(frf, band, power, noise):
     """Best start of (ωn, ζ) among half-power and circle, by residual with A solved linearly."""
     omega, h = _mode_arrays(frf, band)
-    weights = _channel_weights(frf, band, noise)
-    strongest = np.argsort(weights)[::-1][:START_CHANNELS]
+    strongest = _strongest_channels(frf, band, noise, START_CHANNELS)
     candidates = []
     for method in ("halfpower", "circle"):
         with np.errstate(all="ignore"):
@@ -328,8 +344,8 @@ def _principal_start(frf, band, power, noise):
     start is searched on that one curve (:func:`_start_pole` of a one-channel FRF): two
     single-channel estimates per band instead of two per channel.
     """
-    keep = (frf.frequency_hz >= band.low_hz) & (frf.frequency_hz <= band.high_hz)
-    strongest = np.argsort(_channel_weights(frf, band, noise))[::-1][:START_CHANNELS]
+    keep = _band_mask(frf, band)
+    strongest = _strongest_channels(frf, band, noise, START_CHANNELS)
     sigma = np.asarray(noise, float)[strongest]
     usable = np.isfinite(sigma) & (sigma > 0)
     if not usable.any():
@@ -352,10 +368,10 @@ def _principal_start(frf, band, power, noise):
 def _quick_start(frf, band, power, noise):
     """(ωn, ζ) of a band's one-mode rational fit (:func:`modal.rational.rational_pole`) on its
     strongest channels, or None when it gives no pole inside the band."""
-    keep = (frf.frequency_hz >= band.low_hz) & (frf.frequency_hz <= band.high_hz)
+    keep = _band_mask(frf, band)
     omega, h = frf.omega_rad_s[keep], frf.channels
     if h.shape[0] > START_CHANNELS:  # the strongest channels first: no copy of every channel's band
-        strongest = np.argsort(_channel_weights(frf, band, noise))[::-1][:START_CHANNELS]
+        strongest = _strongest_channels(frf, band, noise, START_CHANNELS)
         h, noise = h[strongest], np.asarray(noise)[strongest]
     h = h[:, keep]
     with np.errstate(all="ignore"):
@@ -428,7 +444,7 @@ def _bandwise_covariance(frf, bands, power, poles, noise, own_constants=None):
     n_modes, n_ch = len(bands), frf.n_channels
     pole_rows = np.zeros((n_modes, n_ch, 2, 2, omega.size))
     for r, band in enumerate(bands):
-        lines = np.flatnonzero((frf.frequency_hz >= band.low_hz) & (frf.frequency_hz <= band.high_hz))
+        lines = np.flatnonzero(_band_mask(frf, band))
         pole_rows[r][..., np.searchsorted(keep_idx, lines)] = poles[r][7]["rows"]
     pole_cov = np.array([p[7]["cov"] for p in poles])
     wn = np.array([p[0] for p in poles], float)
@@ -468,7 +484,7 @@ def _without_neighbours(frf, bands, power, noise, poles):
         frf_r = dataclasses.replace(frf, response=isolated[0] if frf.response.ndim == 1 else isolated)
         strongest = None
         if frf.n_channels > POLE_CHANNELS:
-            strongest = np.argsort(_channel_weights(frf, band, noise))[::-1][:POLE_CHANNELS]
+            strongest = _strongest_channels(frf, band, noise, POLE_CHANNELS)
         out.append(_sdof_estimates(frf_r, band, power, noise, "halfpower", strongest))
     return out
 
@@ -556,10 +572,7 @@ def _chi2(residual_var, noise_std) -> float:
 def _band_noise(frf, bands, line_noise):
     """Per channel, the RMS over the bands' lines of a known noise per line."""
     line_noise = np.atleast_2d(np.asarray(line_noise, float))
-    freq = frf.frequency_hz
-    lines = np.zeros(freq.size, bool)
-    for band in bands:
-        lines |= (freq >= band.low_hz) & (freq <= band.high_hz)
+    lines, _ = _regions(bands, frf.frequency_hz)
     return np.sqrt(np.mean(line_noise[:, lines] ** 2, axis=1))
 
 
@@ -599,12 +612,9 @@ def _local_misfit(frf, bands, power, omega_n, damping_ratio, data=None, band_pea
         omega_all, response, _ = data
     many = response.shape[0] > POLE_CHANNELS
     for b, (band, wn, zeta) in enumerate(zip(bands, omega_n, damping_ratio)):
-        # band edges lie halfway between lines (peaks._edges_between_lines): no rounding of 2π f can
-        # move a line across one
-        lines = np.flatnonzero((omega_all >= TWO_PI * band.low_hz) & (omega_all <= TWO_PI * band.high_hz))
-        if lines.size < 3:
+        run = _band_run(omega_all, band)  # a view: no copy of every channel
+        if run.stop - run.start < 3:
             continue
-        run = slice(lines[0], lines[-1] + 1)  # a view: no copy of every channel
         omega, h = omega_all[run], response[:, run]
         if many:  # the strong channels carry the misfit that matters; O(1) in channels
             peak = np.abs(h).max(axis=1) if band_peak is None else band_peak[b]
@@ -941,7 +951,7 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
         for band in bands:
             strongest = None
             if n_ch > POLE_CHANNELS:
-                strongest = np.argsort(_channel_weights(frf, band, noise))[::-1][:POLE_CHANNELS]
+                strongest = _strongest_channels(frf, band, noise, POLE_CHANNELS)
             poles.append(_sdof_estimates(frf, band, power, noise, method, strongest))
         if method == "halfpower" and len(bands) > 1:
             poles = _without_neighbours(frf, bands, power, noise, poles)
@@ -1071,7 +1081,7 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
             flags.add("high_uncertainty")
         if assumed:
             flags.add("driving_point_assumed")
-        omega_b = frf.omega_rad_s[(frf.frequency_hz >= band.low_hz) & (frf.frequency_hz <= band.high_hz)]
+        omega_b = frf.omega_rad_s[_band_mask(frf, band)]
         spacing = line_spacing(omega_b) if omega_b.size > 1 else np.nan
         lines_per_bw = 2 * zeta * wn / spacing if spacing > 0 else np.nan
         others = [b.peak_hz for b in bands if b is not band and band.low_hz < b.peak_hz < band.high_hz]

@@ -54,7 +54,7 @@ class NLSFit:
     noise_var: np.ndarray
     converged: bool
     n_iter: int
-    residual: np.ndarray | None = None
+    residual: RowResidual | None = None
     channel_scale: np.ndarray | None = None
     line_weighted: bool = False
 
@@ -63,21 +63,21 @@ class RowResidual:
     """The residual Y − Q QᴴY of a fit, formed for the channels asked: ``residual[rows]`` (n_rows, n_freq).
 
     With many channels the checks read a sample (128 of 1000) and a few strongest channels; the whole
-    residual would be a product with every channel. ``data`` (n_ch, n_freq), the fit's orthonormal basis
-    ``basis`` (n_freq, n_b) and ``coefficients`` QᴴYᵀ (n_b, n_ch).
+    residual would be a product with every channel. ``data`` Y (n_ch, n_freq), the fit's orthonormal basis
+    ``basis`` Q (n_freq, n_b) and ``projected`` (QᴴYᵀ)ᵀ = Y conj(Q) (n_ch, n_b).
     """
 
-    __slots__ = ("_data", "_basis", "_coefficients")
+    __slots__ = ("_data", "_basis", "_projected")
 
-    def __init__(self, data: np.ndarray, basis: np.ndarray, coefficients: np.ndarray):
-        self._data, self._basis, self._coefficients = data, basis, coefficients
+    def __init__(self, data: np.ndarray, basis: np.ndarray, projected: np.ndarray):
+        self._data, self._basis, self._projected = data, basis, projected
 
     @property
     def shape(self) -> tuple[int, int]:
         return self._data.shape
 
     def __getitem__(self, rows) -> np.ndarray:
-        out = self._coefficients[:, rows].T @ self._basis.T  # the fitted part
+        out = self._projected[rows] @ self._basis.T  # the fitted part
         return np.subtract(self._data[rows], out, out=out)
 
 
@@ -374,9 +374,8 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
     # back to every channel: one projection of the full data, channels first in the FRF's unit (no copy of
     # the data: BLAS reads ``rows`` transposed)
     projected = rows @ Q.conj()  # (Qᴴ Yᵀ)ᵀ, (n_ch, n_b)
-    data_coef = projected.T
-    residual = RowResidual(rows, Q, data_coef)
-    QhY = data_coef * inverse_scale
+    residual = RowResidual(rows, Q, projected)
+    QhY = projected.T * inverse_scale
     n_freq = x.size
     n_b = Phi.shape[1]
     C = np.linalg.solve(R, QhY)

@@ -198,8 +198,8 @@ SAMPLE_CHANNELS = 128
 
 def channel_sample(n_channels: int, size: int | None = None) -> slice | np.ndarray:
     """The channels a mean or median over all channels is estimated from: all of them (``slice(None)``)
-    up to ``size`` (default :data:`SAMPLE_CHANNELS`), else ``size`` of them drawn at random without replacement (a fixed seed, so a result
-    does not change from run to run), in increasing order.
+    up to ``size`` (default :data:`SAMPLE_CHANNELS`), else ``size`` of them drawn at random without
+    replacement (a fixed seed, so a result does not change from run to run), in increasing order.
 
     A mean or median over a random sample estimates the one over all channels without bias (each channel
     is as likely to be drawn), with a sampling error 1/sqrt(``size``) of the spread over the channels (times
