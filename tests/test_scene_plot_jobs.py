@@ -113,3 +113,47 @@ def test_every_stage_figure_declares_the_results_it_reads():
 
     assert set(runner._PLOT_INPUTS) == set(plots._FIGURES)
     assert all(stage in inputs for stage, inputs in runner._PLOT_INPUTS.items())
+
+
+def test_preloaded_modules_are_all_a_figure_imports(tmp_path):
+    # the plotting process imports plots.PLOT_MODULES of its stages once, before it forks its helper; what
+    # unpickling a stage's plot inputs and drawing them imports beyond that would be imported again by each
+    # drawing process. Each stage's inputs are pickled by one run, then drawn in a fresh interpreter that
+    # holds only what the parent has when it forks (the runner) and the preloaded modules.
+    import pickle
+
+    from balancer.scene import plots, run_scene, runner
+    from test_scene import DRIVE
+
+    scenes = [DEMO, ROOT / "data" / "synthetic" / "balance_scene.toml",
+              {"scene": {"name": "drive"}, "drive": DRIVE, "outputs": {"plots": ["drive"]}}]
+    pickled = {}
+    for scene in scenes:
+        run = run_scene(scene, out=tmp_path / "x.h5", plots_dir=tmp_path / "p")
+        for stage in plots._FIGURES:
+            if stage in run.results and stage not in pickled:
+                given = {s: run.results[s] for s in runner._PLOT_INPUTS[stage] if s in run.results}
+                pickled[stage] = str(tmp_path / f"{stage}.pickle")
+                Path(pickled[stage]).write_bytes(pickle.dumps(given))
+    assert set(pickled) == set(plots._FIGURES)  # every stage with figures is covered
+    # each stage in a child of its own (forked after the runner's import), as a scene that plots only it
+    out = _run(tmp_path, f"""
+import pickle, balancer.scene.runner
+from pathlib import Path
+out = {{}}
+for stage, path in {pickled!r}.items():
+    read, write = os.pipe()
+    if os.fork() == 0:
+        plots.preload([stage])
+        before = set(sys.modules)
+        Path(stage).mkdir()
+        plots.save_stage_plot(stage, pickle.loads(Path(path).read_bytes()), Path(stage))
+        new = sorted(m for m in set(sys.modules) - before if m.split(".")[0] in ("modal", "balancer"))
+        os.write(write, json.dumps(new).encode())
+        os._exit(0)
+    os.close(write)
+    with os.fdopen(read) as report:
+        out[stage] = json.loads(report.read() or '"no report"')
+    os.wait()
+""")
+    assert out == {stage: [] for stage in pickled}

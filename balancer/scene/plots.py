@@ -1,6 +1,7 @@
 """One figure per stage, saved as PNG (crash-safely) for the scene runner."""
 from __future__ import annotations
 
+import importlib
 from pathlib import Path
 
 import numpy as np
@@ -9,7 +10,7 @@ from matplotlib.figure import Figure
 from modal.figures import fixed_figure, png_bytes
 from modal.io._atomic import atomic_path
 
-__all__ = ["stage_figures", "save_stage_plot"]
+__all__ = ["stage_figures", "save_stage_plot", "PLOT_MODULES", "preload"]
 
 
 def _identify(results):
@@ -110,6 +111,28 @@ def _balance(results):
 
 _FIGURES = {"identify": _identify, "adb_stability": _stability, "adb_response": _response,
             "compressor": _compressor, "mounts": _mounts, "drive": _drive, "balance": _balance}
+
+
+#: the modules a stage's figures import when drawn from its plot inputs (runner._PLOT_INPUTS) in a process that
+#: has only the scene runner: the plotting functions and the classes of the results unpickled for them
+#: (tests/test_scene_plot_jobs.py checks it). The scene's plotting process imports them once, before it forks
+#: its helper, instead of each drawing process importing them for itself.
+PLOT_MODULES = {
+    "identify": ("modal.plots",),
+    "adb_stability": (),
+    "adb_response": ("balancer.adb.plots",),
+    "compressor": ("balancer.compressor.crank_plots",),
+    "mounts": ("balancer.compressor.mounts",),
+    "drive": ("balancer.drive", "balancer.drive.shaft"),
+    "balance": ("balancer.influence.plots", "balancer.influence.study"),
+}
+
+
+def preload(stages) -> None:
+    """Import what drawing the figures of ``stages`` needs (:data:`PLOT_MODULES`)."""
+    for stage in stages:
+        for name in PLOT_MODULES.get(stage, ()):
+            importlib.import_module(name)
 
 
 def stage_figures(stage: str, results) -> list[tuple[str, Figure]]:

@@ -277,11 +277,12 @@ class _Plotter:
     where ``os.fork`` is missing or more than one thread is alive (forking a threaded process is unsafe).
     """
 
-    def __init__(self, jobs: int, folder: Path):
+    def __init__(self, jobs: int, folder: Path, stages=()):
         import os
         import threading
 
         self.folder = folder
+        self.stages = tuple(stages)  # the plot stages it will be handed (their modules are imported at once)
         self.pid: int | None = None
         self._payloads: list[str] = []
         self._drawn: list[Path] = []
@@ -324,7 +325,9 @@ class _Plotter:
         # a short-lived process that ends with os._exit: cyclic garbage (a drawn figure) need not be
         # collected, and not collecting saves ~7 % of the drawing
         gc.disable()
-        from . import plots  # noqa: F401 - matplotlib, imported while the parent computes
+        from . import plots  # matplotlib, imported while the parent computes
+
+        plots.preload(self.stages)  # and what drawing them imports: once, not in each drawing process
 
         read, write = os.pipe()
         helper = _fork_quietly()
@@ -451,7 +454,7 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, p
     if plotted:
         folder = Path(plots_dir) if plots_dir is not None else (
             archive_path.with_name(archive_path.stem + "_plots") if archive_path else Path("out") / f"{_slug(name)}_plots")
-    plotter = _Plotter(plot_jobs, folder) if plotted else None
+    plotter = _Plotter(plot_jobs, folder, plotted) if plotted else None
     pending = list(plotted)  # plot stages not yet handed to the child, in output order
 
     def hand_over() -> None:
