@@ -426,11 +426,9 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
         blk[:, 2, 3] = blk[:, 3, 2] = np.einsum("jc,jk,kc->c", g_re, cov_theta, g_im)
     # back to physical units: x → ω = x w_ref; c → A = c · ch_scale · w_ref^(2−p)
     a_scale = ch_scale * w_ref ** (2 - power)  # (n_ch,)
-    unit = np.array([w_ref, 1.0])
-    mode_cov[:, :, :2, :2] *= np.outer(unit, unit)
-    mode_cov[:, :, :2, 2:] *= unit[None, None, :, None] * a_scale[None, :, None, None]
-    mode_cov[:, :, 2:, :2] *= unit[None, None, None, :] * a_scale[None, :, None, None]
-    mode_cov[:, :, 2:, 2:] *= (a_scale**2)[None, :, None, None]
+    unit = np.empty((n_ch, 4))  # each channel's (ωn, ζ, Re A, Im A) per fitted unit
+    unit[:, 0], unit[:, 1], unit[:, 2], unit[:, 3] = w_ref, 1.0, a_scale, a_scale
+    mode_cov *= unit[:, :, None] * unit[:, None, :]  # one product: cov_ij · s_i s_j
     modal_constant = C[:n_modes] * a_scale[None, :]
     offsets = C[n_modes:] * ch_scale[None, :]
     return NLSFit(

@@ -18,14 +18,28 @@ __all__ = ["estimate_noise_std", "neighbour_noise_std", "local_noise_std", "mode
 UNIFORM_WEIGHT_TOL = 1e-9
 
 
-def _misfit_power(frequency: np.ndarray, values: np.ndarray) -> np.ndarray:
-    """Each inner line's squared misfit to the straight line through its neighbours, over
-    (1 + w_l² + w_r²), so that white noise of variance σ² gives E = σ²; ``values`` (n_rows, n_freq),
-    the result (n_rows, n_freq − 2)."""
+def _stencil(frequency: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """Weights of each inner line's neighbours (left and right, each repeated for Re and Im) and the
+    misfit's normalisation 1/(1 + w_l² + w_r²); None on an evenly spaced axis (weights ½, see
+    :data:`UNIFORM_WEIGHT_TOL`)."""
     step = np.diff(np.asarray(frequency, float))
     w_left = step[1:] / (step[:-1] + step[1:])
     w_right = 1.0 - w_left
-    norm = 1.0 / (1.0 + w_left**2 + w_right**2)
+    if w_left.size and np.all(np.abs(w_left - 0.5) <= UNIFORM_WEIGHT_TOL):
+        return None
+    return np.repeat(w_left, 2), np.repeat(w_right, 2), 1.0 / (1.0 + w_left**2 + w_right**2)
+
+
+_NOT_GIVEN = object()
+
+
+def _misfit_power(frequency: np.ndarray, values: np.ndarray, stencil=_NOT_GIVEN) -> np.ndarray:
+    """Each inner line's squared misfit to the straight line through its neighbours, over
+    (1 + w_l² + w_r²), so that white noise of variance σ² gives E = σ²; ``values`` (n_rows, n_freq),
+    the result (n_rows, n_freq − 2). ``stencil``: :func:`_stencil` of ``frequency``, when the caller
+    has it (rows taken in blocks)."""
+    if stencil is _NOT_GIVEN:
+        stencil = _stencil(frequency)
     values = np.asarray(values, dtype=complex)
     if values.strides[-1] != values.itemsize:  # the real view needs Re, Im side by side along the last axis
         values = np.ascontiguousarray(values)
@@ -33,15 +47,16 @@ def _misfit_power(frequency: np.ndarray, values: np.ndarray) -> np.ndarray:
     # 1000 channels × 2000 lines are 32 MB per temporary, and complex-by-real products cost twice as much
     parts = values.view(float)
     before, centre, after = parts[:, :-4], parts[:, 2:-2], parts[:, 4:]
-    if w_left.size and np.all(np.abs(w_left - 0.5) <= UNIFORM_WEIGHT_TOL):
+    if stencil is None:
         # evenly spaced lines (to rounding): weights ½, factor 2/3, by scalars in place
         misfit = np.add(before, after)
         misfit *= -0.5
         misfit += centre
         norm = 2.0 / 3.0
     else:
-        misfit = np.multiply(before, np.repeat(w_left, 2))
-        misfit += after * np.repeat(w_right, 2)
+        w_left, w_right, norm = stencil
+        misfit = np.multiply(before, w_left)
+        misfit += after * w_right
         np.subtract(centre, misfit, out=misfit)
     misfit *= misfit
     power = np.add(misfit[:, 0::2], misfit[:, 1::2])
@@ -76,8 +91,9 @@ def neighbour_noise_std(frequency: np.ndarray, values: np.ndarray) -> np.ndarray
     if values.shape[1] < 5:
         return np.abs(values).max(axis=1) * np.nan
     median = np.empty(values.shape[0])
+    stencil = _stencil(frequency)
     for start in range(0, values.shape[0], _ROWS_AT_ONCE):  # a block of rows stays in the cache
-        power = _misfit_power(frequency, values[start:start + _ROWS_AT_ONCE])
+        power = _misfit_power(frequency, values[start:start + _ROWS_AT_ONCE], stencil)
         mid = power.shape[1] // 2
         power.partition(mid, axis=1)  # in place: the misfit is ours
         median[start:start + _ROWS_AT_ONCE] = power[:, mid]
@@ -241,7 +257,7 @@ def _row_median(values: np.ndarray) -> np.ndarray:
 
 
 def local_noise_std(frequency: np.ndarray, values: np.ndarray, lines, exclude,
-                    half_width: int = LOCAL_NOISE_LINES) -> np.ndarray:
+                    half_width: int = LOCAL_NOISE_LINES, rows=slice(None)) -> np.ndarray:
     """Noise standard deviation beside each of ``lines``, per row: shape (n_rows, n_lines).
 
     The neighbour misfit (:func:`neighbour_noise_std`) on ``half_width`` lines
@@ -252,17 +268,19 @@ def local_noise_std(frequency: np.ndarray, values: np.ndarray, lines, exclude,
     noise peaks modes. Noise correlated over a few lines (an exponential window
     smooths the spectrum over 1/(πτ) Hz) hides from neighbours one line apart,
     so stencils of lines 2 and 4 apart are used too and the largest level counts.
-    NaN where fewer than 5 lines lie beside the region.
+    NaN where fewer than 5 lines lie beside the region. ``rows``: the rows of ``values`` to measure
+    (an index array or a slice; only the windows are taken out of them, not every line).
     """
     values = np.atleast_2d(np.asarray(values, dtype=complex))
     n = values.shape[1]
-    out = np.full((values.shape[0], np.size(lines)), np.nan)
+    n_rows = len(range(values.shape[0])[rows]) if isinstance(rows, slice) else len(rows)
+    out = np.full((n_rows, np.size(lines)), np.nan)
     for k, (line, gap) in enumerate(zip(np.atleast_1d(lines), np.atleast_1d(exclude))):
         sides = [(max(0, int(line) - int(gap) - half_width), max(0, int(line) - int(gap))),
                  (min(n, int(line) + int(gap) + 1), min(n, int(line) + int(gap) + 1 + half_width))]
         levels = []
         for step in STENCIL_STEPS:
-            powers = [_misfit_power(frequency[lo:hi:step], values[:, lo:hi:step])
+            powers = [_misfit_power(frequency[lo:hi:step], values[rows, lo:hi:step])
                       for lo, hi in sides if (hi - lo) // step >= 5]
             if powers:
                 levels.append(_row_median(np.concatenate(powers, axis=1)) / np.log(2))
@@ -301,12 +319,11 @@ def find_modes(frf: FRF, min_prominence_db: float = 6.0, noise_factor: float = 1
     if idx.size:
         # the tests below take a mean over the channels: many channels are sampled (channel_sample)
         rows = channel_sample(frf.n_channels)
-        values = frf.channels[rows]
-        mag = np.abs(values[:, idx])
+        mag = np.abs(frf.channels[:, idx][rows])  # the peaks' lines of the sampled rows (no copy of every line)
         if line_noise_std is None:
             spacing = np.min(np.diff(freq))
             region = [max(5, int(np.ceil(bandwidths * _half_power_width(freq, ind, i) / spacing))) for i in idx]
-            local = local_noise_std(freq, values, idx, region)
+            local = local_noise_std(freq, frf.channels, idx, region, rows=rows)
         else:
             # a per-line noise estimated from few averages scatters: its median over the same
             # window is the level (the noise of an estimate varies smoothly with frequency) ...

@@ -103,3 +103,24 @@ def test_sampled_tests_over_channels_agree_with_every_channel(monkeypatch):
         assert a.natural_frequency_hz == b.natural_frequency_hz and a.damping_ratio == b.damping_ratio
         assert abs(a.chi2 - b.chi2) <= 4 * 1.25 * 0.1 / np.sqrt(128) * np.sqrt(1 - 128 / 1000)
         assert a.flags == b.flags
+
+
+def test_rows_taken_in_blocks_and_by_index_give_each_row_its_own_estimate():
+    # the whole axis' noise takes its rows in blocks that share one stencil (the neighbour weights of the
+    # axis), and find_modes measures the local noise on sampled rows by index: each row's estimate must be
+    # the one it gets alone, exactly (the same arithmetic on the same numbers), on a jittered axis (weighted
+    # stencil) and an even one (weights ½)
+    from modal.peaks import _ROWS_AT_ONCE, local_noise_std, neighbour_noise_std
+
+    rng = np.random.default_rng(11)
+    n_rows = 2 * _ROWS_AT_ONCE + 7
+    for f in (10 + np.cumsum(rng.uniform(0.5, 1.5, 600)), np.linspace(0.0, 300.0, 600)):
+        values = rng.standard_normal((n_rows, f.size)) + 1j * rng.standard_normal((n_rows, f.size))
+        values *= rng.uniform(0.1, 10.0, n_rows)[:, None]
+        alone = np.array([neighbour_noise_std(f, row[None, :])[0] for row in values])
+        np.testing.assert_array_equal(neighbour_noise_std(f, values), alone)
+        rows = np.sort(rng.choice(n_rows, 40, replace=False))
+        lines, exclude = [100, 300, 560], [10, 20, 5]
+        np.testing.assert_array_equal(local_noise_std(f, values, lines, exclude, rows=rows),
+                                      local_noise_std(f, values[rows], lines, exclude))
+        assert np.all(np.isfinite(local_noise_std(f, values, lines, exclude, rows=rows)))
