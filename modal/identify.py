@@ -1105,10 +1105,10 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
         std = ModeStd(s_wn / TWO_PI, s_z, sq(s_const), sq(sk), sq(sc), sq(sm))
         flags_t = tuple(sorted(flags))
         mode = ModeResult(
-            natural_frequency_hz=wn / TWO_PI, damping_ratio=zeta, modal_constant=sq(const),
+            natural_frequency_hz=float(wn / TWO_PI), damping_ratio=float(zeta), modal_constant=sq(const),
             stiffness_n_per_m=sq(k), damping_n_s_per_m=sq(c), mass_kg=sq(m), std=std, flags=flags_t,
             method=method, band_hz=(band.low_hz, band.high_hz), n_lines=int(omega_b.size),
-            lines_per_bandwidth=lines_per_bw, chi2=chi2, driving_point=sq(driving), quality=quality,
+            lines_per_bandwidth=float(lines_per_bw), chi2=chi2, driving_point=sq(driving), quality=quality,
             window_damping_ratio=window_zeta, kcm_correlation=correlation_of(cov_kcm[0] if single else cov_kcm),
         )
         modes.append(mode)

@@ -768,3 +768,20 @@ def test_residual_sum_of_squares_by_difference_matches_the_residual_it_stands_fo
         # the same rows formed alone: rounding of the fitted part, ~1e-16 of the data
         np.testing.assert_allclose(fit.residual[[3, 7]], residual[[3, 7]], rtol=0,
                                    atol=1e-13 * np.abs(frf.channels).max())
+
+
+@pytest.mark.parametrize("method", ["nls", "halfpower", "circle", "global"])
+def test_scalar_results_are_plain_floats_whatever_the_method(method):
+    # a mode's scalars are Python floats for every method (the half-power and circle poles came out as numpy
+    # scalars): the archive then records them as one type, and scripts that test isinstance(x, float) or
+    # serialise them see the same thing from each method
+    frf = add_noise(modal_frf(np.linspace(50.0, 150.0, 201), [100.0], [0.02], [1.0]), 0.005, seed=3)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        mode = identify(frf, method).modes[0]
+    scalars = {"natural_frequency_hz": mode.natural_frequency_hz, "damping_ratio": mode.damping_ratio,
+               "lines_per_bandwidth": mode.lines_per_bandwidth, "chi2": mode.chi2, "quality": mode.quality,
+               "window_damping_ratio": mode.window_damping_ratio, "band low": mode.band_hz[0],
+               "band high": mode.band_hz[1], "std fn": mode.std.natural_frequency_hz,
+               "std zeta": mode.std.damping_ratio, "stiffness": mode.stiffness_n_per_m}
+    assert {name: type(value).__name__ for name, value in scalars.items()} == {name: "float" for name in scalars}

@@ -233,6 +233,11 @@ def _report_and_exit(work: Callable[[], dict], report_write: int, after: Callabl
         os._exit(code)
 
 
+def _plot_error(stage: str, exc: BaseException) -> str:
+    """How a failed figure is reported, wherever it was drawn: the stage and the cause."""
+    return f"plots of {stage}: {type(exc).__name__}: {exc}"
+
+
 def _draw_jobs(jobs_read: int, folder: Path) -> dict:
     """Take job records from the pipe until it is closed and draw each; {"drawn": {stage: paths}}, with
     "error" naming the stage and the cause of the first failure (the later jobs are then only discarded)."""
@@ -259,7 +264,7 @@ def _draw_jobs(jobs_read: int, folder: Path) -> dict:
                     given = pickle.load(handle)
                 drawn[job["stage"]] = [str(p) for p in save_stage_plot(job["stage"], given, folder)]
         except Exception as exc:  # the same report as from the parent: the stage and the cause
-            error = f"plots of {job['stage']}: {type(exc).__name__}: {exc}"
+            error = _plot_error(job["stage"], exc)
         finally:
             Path(job["file"]).unlink(missing_ok=True)
 
@@ -498,7 +503,7 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, p
                 try:
                     mine[stage] = save_stage_plot(stage, results, folder)
                 except Exception as exc:  # the same report as from the child: the stage and the cause
-                    raise RuntimeError(f"plots of {stage}: {type(exc).__name__}: {exc}") from exc
+                    raise RuntimeError(_plot_error(stage, exc)) from exc
             theirs = plotter.collect()
             for stage in plotted:
                 plot_paths += mine.get(stage, theirs.get(stage, []))
