@@ -8,6 +8,11 @@ if sys.argv[1:2] == ["run"]:
     import gc
 
     gc.disable()
+    # the plotting process is forked before anything else is imported: it imports matplotlib (and only the
+    # parts of modal that drawing needs) while this process imports the identification toolkit (balancer._plotter)
+    from ._plotter import start_early
+
+    start_early()
 
 from .cli import main  # noqa: E402
 

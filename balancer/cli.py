@@ -37,6 +37,15 @@ def build_parser(influence: bool = True) -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit code."""
+    from ._plotter import dismiss_early
+
+    try:
+        return _main(argv)
+    finally:
+        dismiss_early()  # a plotting process started for `run` (python -m balancer) that no run took over
+
+
+def _main(argv: list[str] | None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     # a scene run does not need the influence command's modules
     args = build_parser(influence=not (argv and argv[0] == "run")).parse_args(argv)

@@ -115,11 +115,13 @@ def test_every_stage_figure_declares_the_results_it_reads():
     assert all(stage in inputs for stage, inputs in runner._PLOT_INPUTS.items())
 
 
-def test_preloaded_modules_are_all_a_figure_imports(tmp_path):
-    # the plotting process imports plots.PLOT_MODULES of its stages once, before it forks its helper; what
-    # unpickling a stage's plot inputs and drawing them imports beyond that would be imported again by each
-    # drawing process. Each stage's inputs are pickled by one run, then drawn in a fresh interpreter that
-    # holds only what the parent has when it forks (the runner) and the preloaded modules.
+def test_every_figure_draws_the_same_in_a_plotting_process_with_only_the_drawing_modules(tmp_path):
+    # `python -m balancer run` forks its plotting process before modal is imported, and the process loads
+    # only modal's submodules that drawing needs (balancer._plotter._drawing_modal), then plots.PLOT_MODULES
+    # of its stages once, before it forks its helper. Each stage's plot inputs are pickled by a run here,
+    # then drawn in such a process, a child of its own per stage (as a scene that plots only it): the files
+    # are byte for byte the ones drawn here, drawing imports no modal/balancer module beyond the preloaded
+    # ones (each drawing process would import it again), and the identification toolkit never loads.
     import pickle
 
     from balancer.scene import plots, run_scene, runner
@@ -135,11 +137,17 @@ def test_preloaded_modules_are_all_a_figure_imports(tmp_path):
                 given = {s: run.results[s] for s in runner._PLOT_INPUTS[stage] if s in run.results}
                 pickled[stage] = str(tmp_path / f"{stage}.pickle")
                 Path(pickled[stage]).write_bytes(pickle.dumps(given))
+                (tmp_path / "serial").mkdir(exist_ok=True)
+                plots.save_stage_plot(stage, given, tmp_path / "serial")
     assert set(pickled) == set(plots._FIGURES)  # every stage with figures is covered
-    # each stage in a child of its own (forked after the runner's import), as a scene that plots only it
-    out = _run(tmp_path, f"""
-import pickle, balancer.scene.runner
+    script = f"""
+import json, os, pickle, sys
 from pathlib import Path
+sys.path.insert(0, {str(ROOT)!r})
+from balancer import _plotter
+_plotter._drawing_modal()
+import matplotlib.figure
+from balancer.scene import plots
 out = {{}}
 for stage, path in {pickled!r}.items():
     read, write = os.pipe()
@@ -155,5 +163,88 @@ for stage, path in {pickled!r}.items():
     with os.fdopen(read) as report:
         out[stage] = json.loads(report.read() or '"no report"')
     os.wait()
-""")
-    assert out == {stage: [] for stage in pickled}
+out["toolkit"] = sorted(m for m in ("modal.identify", "modal.checks", "modal.nls", "scipy.special", "h5py")
+                        if m in sys.modules)
+print(json.dumps(out))
+"""
+    proc = subprocess.run([sys.executable, "-c", script], cwd=tmp_path, capture_output=True, text=True, timeout=300,
+                          env={**os.environ, "MPLBACKEND": "Agg"})
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    out = json.loads(proc.stdout.strip().splitlines()[-1])
+    assert out == {**{stage: [] for stage in pickled}, "toolkit": []}
+    serial = sorted(p.name for p in (tmp_path / "serial").glob("*.png"))
+    assert len(serial) >= len(pickled)
+    for name in serial:
+        stage = next(s for s in pickled if name.startswith(s + "_"))
+        assert (tmp_path / stage / name).read_bytes() == (tmp_path / "serial" / name).read_bytes(), name
+
+
+def test_the_command_line_draws_the_same_files_from_its_early_plotting_process(tmp_path):
+    # `python -m balancer run` starts its plotting process before it imports modal; the run takes it over:
+    # the same files, byte for byte, as drawn in one process
+    from balancer.scene import run_scene
+
+    serial = run_scene(DEMO, out=tmp_path / "a.h5", plots_dir=tmp_path / "a")
+    proc = subprocess.run([sys.executable, "-m", "balancer", "run", str(DEMO), "--out", str(tmp_path / "b.h5"),
+                           "--plots", str(tmp_path / "b")], cwd=ROOT, capture_output=True, text=True, timeout=300,
+                          env={**os.environ, "MPLBACKEND": "Agg"})
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    names = [Path(p).name for p in serial.plot_paths]
+    assert sorted(p.name for p in (tmp_path / "b").iterdir()) == sorted(names) and len(names) == 6
+    for name in names:
+        assert (tmp_path / "a" / name).read_bytes() == (tmp_path / "b" / name).read_bytes(), name
+
+
+def test_an_early_plotting_process_reports_a_failed_figure_and_is_dismissed_when_unused(tmp_path):
+    # taken over by a run: a figure that fails there reaches the caller with its stage; not taken over (no
+    # plots, or the run failed first): dismiss_early ends it and no child process is left behind
+    script = f"""
+import json, os, sys
+sys.path.insert(0, {str(ROOT)!r})
+from balancer.scene import plots, run_scene
+def broken(results):
+    raise ValueError("no figure today")
+plots._FIGURES["identify"] = broken   # before the fork: the plotting process has it too
+from balancer import _plotter
+out = {{"started": _plotter.start_early()}}
+try:
+    run_scene({str(DEMO)!r}, out="c.h5", plots_dir="c", plot_jobs=2)
+except RuntimeError as exc:
+    out["error"] = str(exc)
+out["taken"] = _plotter._early is None
+out["second"] = _plotter.start_early()
+_plotter.dismiss_early()
+try:
+    os.waitpid(-1, os.WNOHANG)
+    out["children"] = "left"
+except ChildProcessError:
+    out["children"] = "none"
+print(json.dumps(out))
+"""
+    proc = subprocess.run([sys.executable, "-c", script], cwd=tmp_path, capture_output=True, text=True, timeout=300,
+                          env={**os.environ, "MPLBACKEND": "Agg"})
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    out = json.loads(proc.stdout.strip().splitlines()[-1])
+    assert out["started"] and out["taken"] and out["second"]
+    assert "plots of identify" in out["error"] and "ValueError: no figure today" in out["error"]
+    assert out["children"] == "none"
+    assert not list((tmp_path / "c").glob("*.png"))  # the figures drawn before the failure are removed
+
+
+@pytest.mark.parametrize("case", ["no plots", "missing scene"])
+def test_the_command_line_without_plots_or_with_a_bad_scene_ends_as_before(tmp_path, case):
+    # the early plotting process is dismissed: a run without plots writes its archive and exits 0, a missing
+    # scene exits 1 with its one-line error, and neither waits for the plotting process' imports
+    scene = tmp_path / "scene.toml"
+    if case == "no plots":
+        scene.write_text(DEMO.read_text().replace('plots = ["identify", "adb_stability", "adb_response", "compressor",'
+                                                  ' "mounts"]', "plots = []").replace('file = "demo_frf.csv"',
+                         f'file = {str(DEMO.parent / "demo_frf.csv")!r}'))
+    proc = subprocess.run([sys.executable, "-m", "balancer", "run", str(scene), "--out", str(tmp_path / "d.h5")],
+                          cwd=ROOT, capture_output=True, text=True, timeout=300, env={**os.environ, "MPLBACKEND": "Agg"})
+    if case == "no plots":
+        assert proc.returncode == 0, proc.stderr[-2000:]
+        assert (tmp_path / "d.h5").exists() and not (tmp_path / "d_plots").exists()
+    else:
+        assert proc.returncode == 1
+        assert proc.stderr.strip().splitlines()[-1].startswith("error:") and "Traceback" not in proc.stderr

@@ -113,12 +113,12 @@ _FIGURES = {"identify": _identify, "adb_stability": _stability, "adb_response": 
             "compressor": _compressor, "mounts": _mounts, "drive": _drive, "balance": _balance}
 
 
-#: the modules a stage's figures import when drawn from its plot inputs (runner._PLOT_INPUTS) in a process that
-#: has only the scene runner: the plotting functions and the classes of the results unpickled for them
-#: (tests/test_scene_plot_jobs.py checks it). The scene's plotting process imports them once, before it forks
-#: its helper, instead of each drawing process importing them for itself.
+#: the modules a stage's figures import when drawn from its plot inputs (runner._PLOT_INPUTS) in a plotting
+#: process, which holds only what drawing needs (balancer._plotter): the plotting functions and the classes of
+#: the results unpickled for them (tests/test_scene_plot_jobs.py checks it). The plotting process imports them
+#: once, before it forks its helper, instead of each drawing process importing them for itself.
 PLOT_MODULES = {
-    "identify": ("modal.plots",),
+    "identify": ("modal.plots", "modal.flags"),
     "adb_stability": (),
     "adb_response": ("balancer.adb.plots",),
     "compressor": ("balancer.compressor.crank_plots",),

@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING, Any, Callable
 import modal
 from modal.errors import ArchiveError, SceneError
 
+from .._plotter import Plotter, plot_error
 from .schema import STAGES, Reference, Scene, dependencies, load_scene, parse_scene
 from .stages import STAGE_FUNCTIONS
 
@@ -167,242 +168,6 @@ _PLOT_INPUTS = {"identify": ("frf", "identify"), "adb_stability": ("adb_stabilit
                 "adb_response": ("adb_response", "rotor"), "compressor": ("compressor",), "mounts": ("mounts",),
                 "drive": ("drive",), "balance": ("balance",)}
 
-#: size of one job record on the plotters' pipe: written at once (atomic below PIPE_BUF) and read whole by
-#: whichever drawing process is free
-_RECORD = 1024
-
-
-def _write_report(fd: int, report: dict) -> None:
-    import os
-
-    data = json.dumps(report).encode()
-    while data:
-        data = data[os.write(fd, data):]
-
-
-def _read_report(fd: int) -> dict:
-    import os
-
-    chunks = []
-    while True:
-        chunk = os.read(fd, 65536)
-        if not chunk:
-            break
-        chunks.append(chunk)
-    os.close(fd)
-    return json.loads(b"".join(chunks) or b'{"error": "plot process ended without a report"}')
-
-
-def _fork_quietly() -> int:
-    """``os.fork`` with the garbage collector's objects frozen around it, so that the child's collections
-    do not write to (and copy) every page of the parent's objects."""
-    import gc
-    import os
-    import sys
-
-    sys.stdout.flush()
-    sys.stderr.flush()
-    gc.freeze()
-    pid = os.fork()
-    if pid != 0:
-        gc.unfreeze()
-    return pid
-
-
-def _report_and_exit(work: Callable[[], dict], report_write: int, after: Callable[[], None] | None = None) -> None:
-    """In a forked child: run ``work``, write its report (or the exception) to ``report_write`` and
-    leave with ``os._exit`` (never the parent's exit handlers): 0 on success, 1 on an error.
-
-    The report's pipe is closed before leaving, so the reader has it at once rather than after
-    this process's memory is torn down (a few ms); ``after`` runs then (the plotter reaps its helper).
-    """
-    import os
-
-    code = 1
-    try:
-        report = work()
-        code = 1 if "error" in report else 0
-    except BaseException as exc:  # noqa: BLE001 - reported to the parent, which raises it
-        report = {"error": f"{type(exc).__name__}: {exc}"}
-    try:
-        _write_report(report_write, report)
-        os.close(report_write)
-        if after is not None:
-            after()
-    finally:
-        os._exit(code)
-
-
-def _plot_error(stage: str, exc: BaseException) -> str:
-    """How a failed figure is reported, wherever it was drawn: the stage and the cause."""
-    return f"plots of {stage}: {type(exc).__name__}: {exc}"
-
-
-def _draw_jobs(jobs_read: int, folder: Path) -> dict:
-    """Take job records from the pipe until it is closed and draw each; {"drawn": {stage: paths}}, with
-    "error" naming the stage and the cause of the first failure (the later jobs are then only discarded)."""
-    import os
-    import pickle
-
-    from .plots import save_stage_plot
-
-    drawn: dict[str, list[str]] = {}
-    error = None
-    while True:
-        record = os.read(jobs_read, _RECORD)
-        while record and len(record) < _RECORD:  # not expected (records are written whole), but be exact
-            more = os.read(jobs_read, _RECORD - len(record))
-            if not more:
-                break
-            record += more
-        if not record:
-            return {"drawn": drawn} if error is None else {"drawn": drawn, "error": error}
-        job = json.loads(record)
-        try:
-            if error is None:
-                with open(job["file"], "rb") as handle:
-                    given = pickle.load(handle)
-                drawn[job["stage"]] = [str(p) for p in save_stage_plot(job["stage"], given, folder)]
-        except Exception as exc:  # the same report as from the parent: the stage and the cause
-            error = _plot_error(job["stage"], exc)
-        finally:
-            Path(job["file"]).unlink(missing_ok=True)
-
-
-class _Plotter:
-    """Two forked processes that draw the stage plots while the parent runs the stages (``plot_jobs > 1``).
-
-    The plotter is forked before the first stage and imports the plotting modules (matplotlib) while the
-    parent computes; then it forks a helper, which inherits them, and both take figures from one queue
-    (whichever is free draws the next), so matplotlib is imported once and both CPUs draw once the parent
-    is done.  Each plot stage's results (with those of the stages it depends on) are pickled to a temporary
-    file as soon as they are complete and announced by a fixed-size record on a pipe (the parent never
-    waits on the plotters).  Figures are written atomically, as by
-    :func:`~balancer.scene.plots.save_stage_plot`.  ``started`` is False (everything drawn in the parent)
-    where ``os.fork`` is missing or more than one thread is alive (forking a threaded process is unsafe).
-    """
-
-    def __init__(self, jobs: int, folder: Path, stages=()):
-        import os
-        import threading
-
-        self.folder = folder
-        self.stages = tuple(stages)  # the plot stages it will be handed (their modules are imported at once)
-        self.pid: int | None = None
-        self._payloads: list[str] = []
-        self._drawn: list[Path] = []
-        if max(1, int(jobs)) > 1 and hasattr(os, "fork") and threading.active_count() == 1:
-            self._fork()
-
-    @property
-    def started(self) -> bool:
-        return self.pid is not None
-
-    def _fork(self) -> None:
-        import os
-
-        self.folder.mkdir(parents=True, exist_ok=True)
-        jobs_read, self._jobs = os.pipe()
-        self._report, report_write = os.pipe()
-        pid = _fork_quietly()
-        if pid == 0:  # plotter: draw, report, leave without running the parent's exit handlers
-            def plotter() -> dict:
-                os.close(self._jobs)
-                os.close(self._report)
-                return self._serve(jobs_read)
-
-            _report_and_exit(plotter, report_write, after=self._reap_helper)
-        os.close(jobs_read)
-        os.close(report_write)
-        self.pid = pid
-
-    def _reap_helper(self) -> None:
-        import os
-
-        if getattr(self, "_helper", None):
-            os.waitpid(self._helper, 0)
-
-    def _serve(self, jobs_read: int) -> dict:
-        """The plotter: import, fork the helper, draw; the two reports merged."""
-        import gc
-        import os
-
-        # a short-lived process that ends with os._exit: cyclic garbage (a drawn figure) need not be
-        # collected, and not collecting saves ~7 % of the drawing
-        gc.disable()
-        from . import plots  # matplotlib, imported while the parent computes
-
-        plots.preload(self.stages)  # and what drawing them imports: once, not in each drawing process
-
-        read, write = os.pipe()
-        helper = _fork_quietly()
-        if helper == 0:
-            def drawer() -> dict:
-                os.close(read)
-                return _draw_jobs(jobs_read, self.folder)
-
-            _report_and_exit(drawer, write)
-        os.close(write)
-        self._helper = helper  # reaped after this process has reported (_reap_helper)
-        mine = _draw_jobs(jobs_read, self.folder)
-        theirs = _read_report(read)
-        errors = [r["error"] for r in (mine, theirs) if "error" in r]
-        return {"drawn": {**mine.get("drawn", {}), **theirs.get("drawn", {})},
-                **({"error": "; ".join(errors)} if errors else {})}
-
-    # ---- parent side
-    def submit(self, stage: str, results: dict) -> bool:
-        """Hand a stage's plot to the plotter; False if it stays with the parent."""
-        import os
-        import pickle
-        import tempfile
-
-        if not self.started:
-            return False
-        handle, payload = tempfile.mkstemp(prefix="modalbal-plot-", suffix=".pickle")
-        try:
-            with os.fdopen(handle, "wb") as out:
-                pickle.dump(results, out, protocol=pickle.HIGHEST_PROTOCOL)
-            record = json.dumps({"stage": stage, "file": payload}).encode()
-            if len(record) > _RECORD:
-                raise ValueError("job record too long")
-            os.write(self._jobs, record.ljust(_RECORD))  # one atomic write; the pipe holds 64 records
-        except Exception:  # noqa: BLE001 - results that do not pickle (or a plotter gone) are drawn here
-            Path(payload).unlink(missing_ok=True)
-            return False
-        self._payloads.append(payload)
-        return True
-
-    def collect(self) -> dict[str, list[Path]]:
-        """Tell the plotter there is nothing more, wait for it; the paths of each stage it drew (raises
-        RuntimeError if a figure failed there)."""
-        import os
-
-        if not self.started:
-            return {}
-        os.close(self._jobs)  # the end of the queue for both drawing processes
-        report = _read_report(self._report)
-        os.waitpid(self.pid, 0)
-        self.pid = None
-        for payload in self._payloads:  # left behind by a failure
-            Path(payload).unlink(missing_ok=True)
-        done = {stage: [Path(p) for p in paths] for stage, paths in report.get("drawn", {}).items()}
-        for paths in done.values():
-            self._drawn.extend(paths)
-        if "error" in report:
-            raise RuntimeError(report["error"])
-        return done
-
-    def abandon(self) -> None:
-        """Wait for the plotter and remove the plots it drew (the run failed)."""
-        if self.started:
-            try:
-                self.collect()
-            except RuntimeError:
-                pass
-        for path in self._drawn:
-            path.unlink(missing_ok=True)
-
 
 def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, plots_dir: str | Path | None = None,
               archive: str | Path | None = None, progress: Callable[[str], None] | None = None,
@@ -427,8 +192,9 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, p
         Processes drawing the plots (POSIX only): with 2 or more, two forked processes draw
         them (matplotlib imported once, while this process starts on the stages), each
         stage's plots as soon as the stage is done, while the next stages run
-        (``python -m balancer run`` uses 2 on a machine with several CPUs).  The files are
-        the same as with 1 (default: everything in this process).
+        (``python -m balancer run`` uses 2 on a machine with several CPUs, and its plotting
+        process is started before anything is imported: :mod:`balancer._plotter`).  The files
+        are the same as with 1 (default: everything in this process).
     """
     if isinstance(scene, (str, Path)):
         scene = load_scene(scene)
@@ -459,7 +225,7 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, p
     if plotted:
         folder = Path(plots_dir) if plots_dir is not None else (
             archive_path.with_name(archive_path.stem + "_plots") if archive_path else Path("out") / f"{_slug(name)}_plots")
-    plotter = _Plotter(plot_jobs, folder, plotted) if plotted else None
+    plotter = Plotter(plot_jobs, folder, plotted) if plotted else None
     pending = list(plotted)  # plot stages not yet handed to the child, in output order
 
     def hand_over() -> None:
@@ -503,7 +269,7 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, p
                 try:
                     mine[stage] = save_stage_plot(stage, results, folder)
                 except Exception as exc:  # the same report as from the child: the stage and the cause
-                    raise RuntimeError(_plot_error(stage, exc)) from exc
+                    raise RuntimeError(plot_error(stage, exc)) from exc
             theirs = plotter.collect()
             for stage in plotted:
                 plot_paths += mine.get(stage, theirs.get(stage, []))
