@@ -119,12 +119,12 @@ _FIGURES = {"identify": _identify, "adb_stability": _stability, "adb_response": 
 #: once, before it forks its helper, instead of each drawing process importing them for itself.
 PLOT_MODULES = {
     "identify": ("modal.plots", "modal.flags"),
-    "adb_stability": (),
-    "adb_response": ("balancer.adb.plots",),
-    "compressor": ("balancer.compressor.crank_plots",),
-    "mounts": ("balancer.compressor.mounts",),
-    "drive": ("balancer.drive", "balancer.drive.shaft"),
-    "balance": ("balancer.influence.plots", "balancer.influence.study"),
+    "adb_stability": ("balancer.scene.stages",),  # the stage results' classes (StabilityStage, ...)
+    "adb_response": ("balancer.adb.plots", "balancer.scene.stages"),
+    "compressor": ("balancer.compressor.crank_plots", "balancer.scene.stages"),
+    "mounts": ("balancer.compressor.mounts", "balancer.scene.stages"),
+    "drive": ("balancer.drive", "balancer.drive.shaft", "balancer.scene.stages"),
+    "balance": ("balancer.influence.plots", "balancer.influence.study", "balancer.scene.stages"),
 }
 
 
