@@ -31,13 +31,17 @@ def _stencil(frequency: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]
 
 
 _NOT_GIVEN = object()
+#: the misfit's normalisation 1/(1 + w_l² + w_r²) on an evenly spaced axis (weights ½)
+EVEN_NORM = 2.0 / 3.0
 
 
-def _misfit_power(frequency: np.ndarray, values: np.ndarray, stencil=_NOT_GIVEN) -> np.ndarray:
+def _misfit_power(frequency: np.ndarray, values: np.ndarray, stencil=_NOT_GIVEN, scaled: bool = True) -> np.ndarray:
     """Each inner line's squared misfit to the straight line through its neighbours, over
     (1 + w_l² + w_r²), so that white noise of variance σ² gives E = σ²; ``values`` (n_rows, n_freq),
     the result (n_rows, n_freq − 2). ``stencil``: :func:`_stencil` of ``frequency``, when the caller
-    has it (rows taken in blocks)."""
+    has it (rows taken in blocks). ``scaled=False`` on an evenly spaced axis leaves out the factor
+    2/3 (:data:`EVEN_NORM`) for the caller to apply to the order statistic it takes: a positive
+    factor keeps the order, so that is the same number."""
     if stencil is _NOT_GIVEN:
         stencil = _stencil(frequency)
     values = np.asarray(values, dtype=complex)
@@ -52,7 +56,7 @@ def _misfit_power(frequency: np.ndarray, values: np.ndarray, stencil=_NOT_GIVEN)
         misfit = np.add(before, after)
         misfit *= -0.5
         misfit += centre
-        norm = 2.0 / 3.0
+        norm = EVEN_NORM if scaled else None
     else:
         w_left, w_right, norm = stencil
         misfit = np.multiply(before, w_left)
@@ -60,7 +64,8 @@ def _misfit_power(frequency: np.ndarray, values: np.ndarray, stencil=_NOT_GIVEN)
         np.subtract(centre, misfit, out=misfit)
     misfit *= misfit
     power = np.add(misfit[:, 0::2], misfit[:, 1::2])
-    power *= norm
+    if norm is not None:
+        power *= norm
     return power
 
 
@@ -93,10 +98,12 @@ def neighbour_noise_std(frequency: np.ndarray, values: np.ndarray) -> np.ndarray
     median = np.empty(values.shape[0])
     stencil = _stencil(frequency)
     for start in range(0, values.shape[0], _ROWS_AT_ONCE):  # a block of rows stays in the cache
-        power = _misfit_power(frequency, values[start:start + _ROWS_AT_ONCE], stencil)
+        power = _misfit_power(frequency, values[start:start + _ROWS_AT_ONCE], stencil, scaled=False)
         mid = power.shape[1] // 2
         power.partition(mid, axis=1)  # in place: the misfit is ours
         median[start:start + _ROWS_AT_ONCE] = power[:, mid]
+    if stencil is None:  # the even axis' factor, on the medians (the same numbers: see _misfit_power)
+        median *= EVEN_NORM
     return np.sqrt(median / np.log(2))
 
 

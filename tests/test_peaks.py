@@ -110,7 +110,7 @@ def test_rows_taken_in_blocks_and_by_index_give_each_row_its_own_estimate():
     # axis), and find_modes measures the local noise on sampled rows by index: each row's estimate must be
     # the one it gets alone, exactly (the same arithmetic on the same numbers), on a jittered axis (weighted
     # stencil) and an even one (weights ½)
-    from modal.peaks import _ROWS_AT_ONCE, local_noise_std, neighbour_noise_std
+    from modal.peaks import _ROWS_AT_ONCE, _misfit_power, local_noise_std, neighbour_noise_std
 
     rng = np.random.default_rng(11)
     n_rows = 2 * _ROWS_AT_ONCE + 7
@@ -119,6 +119,10 @@ def test_rows_taken_in_blocks_and_by_index_give_each_row_its_own_estimate():
         values *= rng.uniform(0.1, 10.0, n_rows)[:, None]
         alone = np.array([neighbour_noise_std(f, row[None, :])[0] for row in values])
         np.testing.assert_array_equal(neighbour_noise_std(f, values), alone)
+        # the even axis' factor 2/3 is applied to the medians, not to every line: the same numbers
+        power = _misfit_power(f, values)
+        middle = np.sort(power, axis=1)[:, power.shape[1] // 2]
+        np.testing.assert_array_equal(neighbour_noise_std(f, values), np.sqrt(middle / np.log(2)))
         rows = np.sort(rng.choice(n_rows, 40, replace=False))
         lines, exclude = [100, 300, 560], [10, 20, 5]
         np.testing.assert_array_equal(local_noise_std(f, values, lines, exclude, rows=rows),
