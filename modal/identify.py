@@ -820,10 +820,10 @@ def choose_method(frf: FRF, bands_hz=None, min_prominence_db: float = 6.0) -> st
 
 
 def _auto_choice(frf: FRF, bands_hz, min_prominence_db: float,
-                 indicator=None) -> tuple[str, list | None, np.ndarray | None]:
+                 indicator=None, noise=None) -> tuple[str, list | None, np.ndarray | None]:
     """:func:`choose_method`'s choice, the peaks' bands it found and the raw noise it estimated (None
     when it did not search), so that identify does neither twice (``indicator``:
-    :func:`modal.peaks._indicator_and_peak`, if known)."""
+    :func:`modal.peaks._indicator_and_peak`, and ``noise``, the raw noise per channel, if known)."""
     if bands_hz is not None:
         return "nls", None, None
     from .global_ import channel_grid
@@ -831,7 +831,7 @@ def _auto_choice(frf: FRF, bands_hz, min_prominence_db: float,
     index, _, transposed = channel_grid(frf)
     if index.shape[1] > 1:
         return "global", None, None
-    noise = estimate_noise_std(frf)
+    noise = estimate_noise_std(frf) if noise is None else noise
     try:  # the peaks identify itself would fit: the same noise-aware test (an estimate's noise per line)
         bands = find_modes(frf, min_prominence_db=min_prominence_db, noise_std=noise,
                            line_noise_std=getattr(frf, "noise_std", None), indicator=indicator)
@@ -900,7 +900,13 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
         raise IdentificationError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
     from .scaling import scale_exponent, scaled_frf, unscale_result
 
-    indicator = _indicator_and_peak(frf)  # |H| once: the mode indicator and each channel's max |H|
+    # |H| once: the mode indicator and each channel's max |H|, and (but for the global method, which measures
+    # its own) the raw noise per channel from the same read of the data
+    if method == "global":
+        indicator, raw = _indicator_and_peak(frf), None
+    else:
+        *indicator, raw = _indicator_and_peak(frf, noise=True)
+        indicator = tuple(indicator)
     exponent = scale_exponent(frf, peak=indicator[1])
     if exponent:  # values near over- or underflow: fit 2**e H (exact) and scale the results back
         gain = 2.0**exponent
@@ -912,7 +918,7 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
     found = raw_noise = None  # peak bands the automatic choice already searched, and its noise estimate
     if method == "auto":  # chosen on the (possibly rescaled) data, so the choice never overflows
         method, found, raw_noise = (("global", None, None) if global_options
-                                    else _auto_choice(frf, bands_hz, min_prominence_db, indicator))
+                                    else _auto_choice(frf, bands_hz, min_prominence_db, indicator, raw))
     if method == "global":
         from .global_ import identify_global
 
@@ -920,7 +926,7 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
         return identify_global(frf, band_hz=band, noise_std=noise_std, driving_point=driving_point, **global_options)
     power = KIND_POWER[frf.kind]
     n_ch = frf.n_channels
-    estimated_noise = estimate_noise_std(frf) if raw_noise is None else raw_noise
+    estimated_noise = raw if raw_noise is None else raw_noise
     # an FRF estimated from time data carries its own calibrated noise per line (modal.estimate_frf)
     line_noise = getattr(frf, "noise_std", None)
     if bands_hz is not None:

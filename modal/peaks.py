@@ -71,6 +71,24 @@ def _misfit_power(frequency: np.ndarray, values: np.ndarray, stencil=_NOT_GIVEN,
 
 #: rows of :func:`neighbour_noise_std` computed together (their misfit, 2 MB at 2000 lines, stays in the cache)
 _ROWS_AT_ONCE = 128
+#: rows of :func:`_indicator_and_peak` taken together: their data are read from memory once for |H| and, when
+#: asked for, the misfit (64 channels of 2000 lines: 2 MB, in the cache for the second pass)
+_INDICATOR_ROWS = 64
+
+
+def _noise_medians(frequency: np.ndarray, values: np.ndarray, stencil) -> np.ndarray:
+    """Each row's median misfit power (:func:`neighbour_noise_std` before its factors), without the even
+    axis' 2/3 (applied by the caller to all rows at once)."""
+    power = _misfit_power(frequency, values, stencil, scaled=False)
+    mid = power.shape[1] // 2
+    power.partition(mid, axis=1)  # in place: the misfit is ours
+    return power[:, mid]
+
+
+def _noise_from_medians(median: np.ndarray, stencil) -> np.ndarray:
+    if stencil is None:  # the even axis' factor, on the medians (the same numbers: see _misfit_power)
+        median *= EVEN_NORM
+    return np.sqrt(median / np.log(2))
 
 
 def neighbour_noise_std(frequency: np.ndarray, values: np.ndarray) -> np.ndarray:
@@ -98,13 +116,8 @@ def neighbour_noise_std(frequency: np.ndarray, values: np.ndarray) -> np.ndarray
     median = np.empty(values.shape[0])
     stencil = _stencil(frequency)
     for start in range(0, values.shape[0], _ROWS_AT_ONCE):  # a block of rows stays in the cache
-        power = _misfit_power(frequency, values[start:start + _ROWS_AT_ONCE], stencil, scaled=False)
-        mid = power.shape[1] // 2
-        power.partition(mid, axis=1)  # in place: the misfit is ours
-        median[start:start + _ROWS_AT_ONCE] = power[:, mid]
-    if stencil is None:  # the even axis' factor, on the medians (the same numbers: see _misfit_power)
-        median *= EVEN_NORM
-    return np.sqrt(median / np.log(2))
+        median[start:start + _ROWS_AT_ONCE] = _noise_medians(frequency, values[start:start + _ROWS_AT_ONCE], stencil)
+    return _noise_from_medians(median, stencil)
 
 
 def estimate_noise_std(frf: FRF) -> np.ndarray:
@@ -122,17 +135,37 @@ def mode_indicator(frf: FRF) -> np.ndarray:
     return _indicator_and_peak(frf)[0]
 
 
-def _indicator_and_peak(frf: FRF) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`mode_indicator` and each channel's max |H| (n_channels,), from one |H| (squared in place;
-    the channels' normalised squares summed by one matrix-vector product)."""
-    mag = np.abs(frf.channels)
-    peak = mag.max(axis=1)
-    scale = np.where(peak > 0, peak, 1.0)
-    if not 1e-150 < scale.min() <= scale.max() < 1e150:  # |H|² would leave the float range: normalise first
-        mag /= scale[:, None]
-        scale = np.ones_like(scale)
-    mag *= mag
-    return np.sqrt(((1.0 / scale**2) @ mag) / mag.shape[0]), peak
+def _indicator_and_peak(frf: FRF, noise: bool = False) -> tuple[np.ndarray, ...]:
+    """:func:`mode_indicator` and each channel's max |H| (n_channels,), and with ``noise`` each channel's
+    :func:`estimate_noise_std` as well, from one read of the data: blocks of rows, each block's |H| squared
+    in place and its normalised squares summed over the channels by a matrix-vector product, its misfit
+    medians taken while the block is in the cache."""
+    channels = frf.channels
+    n_ch, n_freq = channels.shape
+    peak = np.empty(n_ch)
+    total = np.zeros(n_freq)
+    median = np.empty(n_ch) if noise and n_freq >= 5 else None
+    stencil = _stencil(frf.frequency_hz) if median is not None else None
+    for start in range(0, n_ch, _INDICATOR_ROWS):
+        block = channels[start:start + _INDICATOR_ROWS]
+        if median is not None:
+            # data near over- or underflow (identify rescales them and measures again) square out of range
+            with np.errstate(over="ignore", under="ignore"):
+                median[start:start + _INDICATOR_ROWS] = _noise_medians(frf.frequency_hz, block, stencil)
+        mag = np.abs(block)
+        peak[start:start + _INDICATOR_ROWS] = block_peak = mag.max(axis=1)
+        scale = np.where(block_peak > 0, block_peak, 1.0)
+        if not 1e-150 < scale.min() <= scale.max() < 1e150:  # |H|² would leave the float range: normalise first
+            mag /= scale[:, None]
+            scale = np.ones_like(scale)
+        mag *= mag
+        total += (1.0 / scale**2) @ mag
+    indicator = np.sqrt(total / n_ch)
+    if not noise:
+        return indicator, peak
+    if median is None:  # fewer than 5 lines: no misfit (neighbour_noise_std's NaN)
+        return indicator, peak, peak * np.nan
+    return indicator, peak, _noise_from_medians(median, stencil)
 
 
 @dataclass(frozen=True)

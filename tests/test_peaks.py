@@ -128,3 +128,30 @@ def test_rows_taken_in_blocks_and_by_index_give_each_row_its_own_estimate():
         np.testing.assert_array_equal(local_noise_std(f, values, lines, exclude, rows=rows),
                                       local_noise_std(f, values[rows], lines, exclude))
         assert np.all(np.isfinite(local_noise_std(f, values, lines, exclude, rows=rows)))
+
+
+def test_indicator_peaks_and_noise_from_one_read_are_each_ones_own():
+    # identify takes the mode indicator, each channel's max |H| and the raw noise from one read of the data in
+    # blocks of rows: the peaks and the noise are exactly their own functions' (elementwise work and per-row
+    # medians), the indicator the RMS over channels of |H|/max to rounding (its sum runs block by block), also
+    # for channels whose |H|² would leave the float range (normalised first) and fewer lines than the misfit needs
+    from modal import FRF
+    from modal.peaks import _INDICATOR_ROWS, _indicator_and_peak, mode_indicator
+
+    rng = np.random.default_rng(12)
+    n_ch = 2 * _INDICATOR_ROWS + 9
+    f = np.linspace(10.0, 200.0, 400)
+    values = rng.standard_normal((n_ch, f.size)) + 1j * rng.standard_normal((n_ch, f.size))
+    values *= np.geomspace(1e-3, 1e3, n_ch)[:, None]
+    for scale in (1.0, 1e-200, 1e200):
+        frf = FRF(f, values * scale)
+        indicator, peak, noise = _indicator_and_peak(frf, noise=True)  # no warning where |H|² leaves the range
+        magnitude = np.abs(frf.channels)
+        np.testing.assert_array_equal(peak, magnitude.max(axis=1))
+        with np.errstate(over="ignore"):  # (identify rescales such data before it uses their noise)
+            np.testing.assert_array_equal(noise, estimate_noise_std(frf))
+        direct = np.sqrt(np.mean((magnitude / magnitude.max(axis=1)[:, None]) ** 2, axis=0))
+        np.testing.assert_allclose(indicator, direct, rtol=1e-13, atol=0)
+        np.testing.assert_array_equal(mode_indicator(frf), indicator)
+    short = FRF(f[:4], values[:, :4])
+    assert np.all(np.isnan(_indicator_and_peak(short, noise=True)[2]))
