@@ -313,7 +313,7 @@ class Plotter:
 
     def collect(self) -> dict[str, list[Path]]:
         """Tell the plotters there is nothing more, wait for them; the paths of each stage they drew
-        (raises RuntimeError if a figure failed there)."""
+        (raises :class:`~modal.errors.PlotError`, a RuntimeError, if a figure failed there)."""
         if not self.started:
             return {}
         os.close(self._jobs)  # the end of the queue for both drawing processes
@@ -326,7 +326,9 @@ class Plotter:
         for paths in done.values():
             self._drawn.extend(paths)
         if "error" in report:
-            raise RuntimeError(report["error"])
+            from modal.errors import PlotError
+
+            raise PlotError(report["error"])
         return done
 
     def abandon(self) -> None:

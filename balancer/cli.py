@@ -2,7 +2,8 @@
 and ``python -m balancer influence READINGS.toml ...`` (see :mod:`balancer.influence.cli`).
 
 Exit codes: 0 success, 1 bad scene or input (one line on stderr naming the
-file, the key and what was expected), 2 usage error. The summary (or JSON with
+file, the key and what was expected) or a figure that could not be drawn or written
+(the stage and the cause), 2 usage error. The summary (or JSON with
 ``--json``) goes to stdout; progress and warnings go to stderr.
 """
 from __future__ import annotations

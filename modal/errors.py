@@ -16,6 +16,7 @@ __all__ = [
     "ParameterError",
     "ArchiveError",
     "SceneError",
+    "PlotError",
     "ModalWarning",
     "ResolutionWarning",
     "QualityWarning",
@@ -49,6 +50,10 @@ class ArchiveError(ModalError, ValueError):
 
 class SceneError(ModalError, ValueError):
     """A scene file is invalid: names the file, the key and what was expected."""
+
+
+class PlotError(ModalError, RuntimeError):
+    """A figure could not be drawn or written: names the stage (or figure) and the cause."""
 
 
 class ModalWarning(UserWarning):

@@ -248,3 +248,21 @@ def test_the_command_line_without_plots_or_with_a_bad_scene_ends_as_before(tmp_p
     else:
         assert proc.returncode == 1
         assert proc.stderr.strip().splitlines()[-1].startswith("error:") and "Traceback" not in proc.stderr
+
+
+def test_a_failed_figure_ends_the_command_line_with_a_one_line_error(tmp_path, monkeypatch, capsys):
+    # a figure that cannot be drawn or written (a full disk, a plots folder that went away) is the run's error:
+    # exit code 1 and one line naming the stage and the cause, no traceback (modal.errors.PlotError)
+    from balancer import cli
+    from balancer.scene import plots
+    from modal.errors import ModalError, PlotError
+
+    def broken(results):
+        raise ValueError("no figure today")
+
+    monkeypatch.setitem(plots._FIGURES, "identify", broken)
+    code = cli.main(["run", str(DEMO), "--out", str(tmp_path / "e.h5"), "--plots", str(tmp_path / "e")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 1
+    assert err[-1] == "error: plots of identify: ValueError: no figure today"
+    assert issubclass(PlotError, ModalError) and issubclass(PlotError, RuntimeError)  # callers catching either

@@ -10,7 +10,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable
 
 import modal
-from modal.errors import ArchiveError, SceneError
+from modal.errors import ArchiveError, PlotError, SceneError
 
 from .._plotter import Plotter, plot_error
 from .schema import STAGES, Reference, Scene, dependencies, load_scene, parse_scene
@@ -269,7 +269,7 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, p
                 try:
                     mine[stage] = save_stage_plot(stage, results, folder)
                 except Exception as exc:  # the same report as from the child: the stage and the cause
-                    raise RuntimeError(plot_error(stage, exc)) from exc
+                    raise PlotError(plot_error(stage, exc)) from exc
             theirs = plotter.collect()
             for stage in plotted:
                 plot_paths += mine.get(stage, theirs.get(stage, []))
