@@ -905,8 +905,8 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
     if method == "global":
         indicator, raw = _indicator_and_peak(frf), None
     else:
-        *indicator, raw = _indicator_and_peak(frf, noise=True)
-        indicator = tuple(indicator)
+        mode_indicator, channel_peak, raw = _indicator_and_peak(frf, noise=True)
+        indicator = (mode_indicator, channel_peak)
     exponent = scale_exponent(frf, peak=indicator[1])
     if exponent:  # values near over- or underflow: fit 2**e H (exact) and scale the results back
         gain = 2.0**exponent
