@@ -206,18 +206,24 @@ def start_early() -> bool:
     global _early
     if _early is not None or not hasattr(os, "fork") or threading.active_count() != 1 or (os.cpu_count() or 1) < 2:
         return False
+    _early = _spawn(_early_plotter)
+    return True
+
+
+def _spawn(work: Callable[[int, list[int]], dict]) -> tuple[int, int, int]:
+    """Fork a plotting process that runs ``work(jobs_read, helpers)`` and reports; (pid, the write end of its
+    jobs pipe, the read end of its report pipe)."""
     jobs_read, jobs_write = os.pipe()
     report_read, report_write = os.pipe()
     pid = _fork_quietly()
-    if pid == 0:
+    if pid == 0:  # draw, report, leave without running the parent's exit handlers
         os.close(jobs_write)
         os.close(report_read)
         helpers: list[int] = []
-        _report_and_exit(lambda: _early_plotter(jobs_read, helpers), report_write, helpers)
+        _report_and_exit(lambda: work(jobs_read, helpers), report_write, helpers)
     os.close(jobs_read)
     os.close(report_write)
-    _early = (pid, jobs_write, report_read)
-    return True
+    return pid, jobs_write, report_read
 
 
 def dismiss_early() -> None:
@@ -273,21 +279,9 @@ class Plotter:
             _early = None
             _write_record(self._jobs, {"folder": str(self.folder), "stages": self.stages})
         elif hasattr(os, "fork") and threading.active_count() == 1:
-            jobs_read, self._jobs = os.pipe()
-            self._report, report_write = os.pipe()
-            pid = _fork_quietly()
-            if pid == 0:  # plotter: draw, report, leave without running the parent's exit handlers
-                helpers: list[int] = []
-
-                def plotter() -> dict:
-                    os.close(self._jobs)
-                    os.close(self._report)
-                    return _serve(jobs_read, self.folder, self.stages, helpers)
-
-                _report_and_exit(plotter, report_write, helpers)
-            os.close(jobs_read)
-            os.close(report_write)
-            self.pid = pid
+            folder, stages = self.folder, self.stages
+            self.pid, self._jobs, self._report = _spawn(
+                lambda jobs_read, helpers: _serve(jobs_read, folder, stages, helpers))
 
     @property
     def started(self) -> bool:

@@ -820,24 +820,24 @@ def choose_method(frf: FRF, bands_hz=None, min_prominence_db: float = 6.0) -> st
 
 
 def _auto_choice(frf: FRF, bands_hz, min_prominence_db: float,
-                 indicator=None, noise=None) -> tuple[str, list | None, np.ndarray | None]:
-    """:func:`choose_method`'s choice, the peaks' bands it found and the raw noise it estimated (None
-    when it did not search), so that identify does neither twice (``indicator``:
-    :func:`modal.peaks._indicator_and_peak`, and ``noise``, the raw noise per channel, if known)."""
+                 indicator=None, noise=None) -> tuple[str, list | None]:
+    """:func:`choose_method`'s choice and the peaks' bands it found (None when it did not search), so that
+    identify does not search twice (``indicator``: :func:`modal.peaks._indicator_and_peak`, and ``noise``,
+    the raw noise per channel, when the caller has them)."""
     if bands_hz is not None:
-        return "nls", None, None
+        return "nls", None
     from .global_ import channel_grid
 
     index, _, transposed = channel_grid(frf)
     if index.shape[1] > 1:
-        return "global", None, None
+        return "global", None
     noise = estimate_noise_std(frf) if noise is None else noise
     try:  # the peaks identify itself would fit: the same noise-aware test (an estimate's noise per line)
         bands = find_modes(frf, min_prominence_db=min_prominence_db, noise_std=noise,
                            line_noise_std=getattr(frf, "noise_std", None), indicator=indicator)
     except IdentificationError:
-        return "nls", None, noise
-    return ("global" if len(bands) >= AUTO_GLOBAL_PEAKS else "nls"), bands, noise
+        return "nls", None
+    return ("global" if len(bands) >= AUTO_GLOBAL_PEAKS else "nls"), bands
 
 
 def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, driving_point=None,
@@ -915,10 +915,10 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
                           driving_point=driving_point, min_prominence_db=min_prominence_db, max_modes=max_modes,
                           **global_options)
         return unscale_result(result, gain)
-    found = raw_noise = None  # peak bands the automatic choice already searched, and its noise estimate
+    found = None  # peak bands the automatic choice already searched
     if method == "auto":  # chosen on the (possibly rescaled) data, so the choice never overflows
-        method, found, raw_noise = (("global", None, None) if global_options
-                                    else _auto_choice(frf, bands_hz, min_prominence_db, indicator, raw))
+        method, found = (("global", None) if global_options
+                         else _auto_choice(frf, bands_hz, min_prominence_db, indicator, raw))
     if method == "global":
         from .global_ import identify_global
 
@@ -926,7 +926,7 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
         return identify_global(frf, band_hz=band, noise_std=noise_std, driving_point=driving_point, **global_options)
     power = KIND_POWER[frf.kind]
     n_ch = frf.n_channels
-    estimated_noise = raw if raw_noise is None else raw_noise
+    estimated_noise = raw  # the raw noise per channel, from the indicator's read of the data
     # an FRF estimated from time data carries its own calibrated noise per line (modal.estimate_frf)
     line_noise = getattr(frf, "noise_std", None)
     if bands_hz is not None:
