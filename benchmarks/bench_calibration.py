@@ -7,7 +7,7 @@ band, ±4 widths), and on a two-mode, three-channel case (mobility, 10 lines per
 channel 0 the driving point), prints per quantity the standard deviation of z (1 when
 calibrated), its mean (0 when unbiased) and the fraction of 2σ intervals that hold the
 truth (0.954). The modal constant has one standard error for the complex value: its RMS
-|z| (1 when calibrated). The same cases as ``tests/test_calibration.py``, which asserts
+|z| (1 when calibrated). The same cases as ``tests/calibration/test_calibration.py``, which asserts
 SD within ±0.15, |mean| ≤ 0.3 and coverage within ±0.044 at 200 seeds.
 
 Works on any checkout whose ``modal.identify`` has the methods (run with

@@ -31,7 +31,7 @@ METHODS = ("halfpower", "circle", "nls", "global")
 QUANTITIES = ("natural_frequency_hz", "damping_ratio", "modal_constant", "stiffness_n_per_m", "damping_n_s_per_m",
               "mass_kg")
 ENV = "MODALBAL_PERTURB"
-DEFAULT_TESTS = ("tests/test_calibration.py",)
+DEFAULT_TESTS = ("tests/calibration/test_calibration.py",)
 
 
 def _scale(value, factor):

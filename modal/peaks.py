@@ -378,7 +378,7 @@ def find_modes(frf: FRF, min_prominence_db: float = 6.0, noise_factor: float = 1
             # ... and the peak must stand PEAK_SIGMAS of its own noise above zero: a zero of the force
             # spectrum (a hammer pulse of length T has them at k/T) makes H1 peak where its noise peaks
             # (1 ms pulse: |H|/σ 0.9-3.3 at 1.5-4.5 kHz, the window's median 200x lower), while a mode
-            # beyond the hammer's band with force noise stands 4.3σ (tests/test_estimate_identify.py)
+            # beyond the hammer's band with force noise stands 4.3σ (tests/modal/estimate/test_estimate_identify.py)
             with np.errstate(invalid="ignore", divide="ignore"):
                 own = np.sqrt(np.nanmean((mag / near) ** 2, axis=0))
             standing = ~(own <= PEAK_SIGMAS)

@@ -43,10 +43,23 @@ if getattr(modal, "__toolkit_id__", None) != "modalbal":  # pragma: no cover
         "Modal Labs cloud client, shadows it); use a virtual environment of its own"
     )
 
-ROOT = Path(__file__).resolve().parent.parent
-SYNTHETIC = ROOT / "data" / "synthetic"
-#: real measured files shipped with the project (MIT, from ladisk/pyuff; see data/real/README.md)
-REAL = ROOT / "data" / "real"
+from support.paths import REAL, ROOT, SYNTHETIC  # noqa: E402,F401
+
+#: folders of the special suites and the marker each of their tests carries (the long runs of
+#: tests/stress/ carry ``stress`` themselves: its quick checks stay in the default run)
+SUITE_MARKERS = {"fuzz": "fuzz", "calibration": "calibration"}
+
+
+def pytest_collection_modifyitems(config, items):
+    """Mark every test of a special suite's folder with that suite's marker (``-m fuzz`` etc.)."""
+    tests = Path(__file__).resolve().parent
+    for item in items:
+        try:
+            top = Path(item.path).resolve().relative_to(tests).parts[0]
+        except ValueError:
+            continue
+        if top in SUITE_MARKERS:
+            item.add_marker(getattr(pytest.mark, SUITE_MARKERS[top]))
 
 
 @pytest.fixture
@@ -62,6 +75,6 @@ def real_dir() -> Path:
 @pytest.fixture(scope="session")
 def dask_cluster(tmp_path_factory):
     """A real ``dask scheduler`` and two ``dask worker`` processes on 127.0.0.1: (address, folder, processes)."""
-    from daskcluster import cluster
+    from support.daskcluster import cluster
 
     yield from cluster(tmp_path_factory)

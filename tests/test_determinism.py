@@ -25,7 +25,7 @@ import modal
 from modal import add_noise, identify, matrix_frf, modal_frf
 from modal.archive import read_archive, write_archive
 
-from conftest import ROOT, SYNTHETIC
+from support.paths import ROOT, SYNTHETIC
 
 
 def _frfs():

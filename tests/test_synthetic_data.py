@@ -1,7 +1,7 @@
 """The committed synthetic files are what the generator makes (reproducible from the seed)."""
 import importlib.util
 
-from conftest import SYNTHETIC
+from support.paths import SYNTHETIC
 
 
 def test_generator_reproduces_committed_files(tmp_path):

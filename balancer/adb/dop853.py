@@ -5,7 +5,7 @@ output as ``scipy.integrate.solve_ivp(method="DOP853", t_eval=...)``, in one loo
 solver, wrapper or interpolant objects per step, and no import of ``scipy.integrate``
 (whose package import also loads ``scipy.optimize``: ~0.1-0.2 s, more than a scene's
 run-up takes to integrate).  The arithmetic is SciPy's, operation for operation, so the
-samples agree with ``solve_ivp`` to rounding (tests/test_adb_dop853.py).
+samples agree with ``solve_ivp`` to rounding (tests/balancer/adb/test_dop853.py).
 
 The local error per step is kept below ``atol + rtol |y|`` (RMS norm over components),
 as in SciPy.

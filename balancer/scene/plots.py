@@ -115,7 +115,7 @@ _FIGURES = {"identify": _identify, "adb_stability": _stability, "adb_response": 
 
 #: the modules a stage's figures import when drawn from its plot inputs (runner._PLOT_INPUTS) in a plotting
 #: process, which holds only what drawing needs (balancer._plotter): the plotting functions and the classes of
-#: the results unpickled for them (tests/test_scene_plot_jobs.py checks it). The plotting process imports them
+#: the results unpickled for them (tests/balancer/scene/test_plot_jobs.py checks it). The plotting process imports them
 #: once, before it forks its helper, instead of each drawing process importing them for itself.
 PLOT_MODULES = {
     "identify": ("modal.plots", "modal.flags"),

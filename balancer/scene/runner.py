@@ -162,7 +162,7 @@ def _open_earlier(path) -> h5py.File | None:
     return f
 
 
-#: the results each stage's figures read (balancer.scene.plots; tests/test_scene_plot_jobs.py checks it): a
+#: the results each stage's figures read (balancer.scene.plots; tests/balancer/scene/test_plot_jobs.py checks it): a
 #: plotting process is handed only these, so it unpickles (and imports the classes of) nothing more
 _PLOT_INPUTS = {"identify": ("frf", "identify"), "adb_stability": ("adb_stability",),
                 "adb_response": ("adb_response", "rotor"), "compressor": ("compressor",), "mounts": ("mounts",),

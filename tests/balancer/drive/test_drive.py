@@ -14,7 +14,8 @@ import math
 import numpy as np
 import pytest
 from matplotlib.figure import Figure
-from numpydoc_sections import documented
+from support.numpydoc_sections import documented
+from support.paths import ROOT
 
 from balancer import drive, drive_report, shaft
 from balancer.drive import (
@@ -378,7 +379,7 @@ def test_docs_worked_example_runs(capsys):
     # The code block in docs/drive.md must run as printed and give the numbers the doc quotes.
     from pathlib import Path
 
-    text = (Path(__file__).resolve().parent.parent / "docs" / "drive.md").read_text(encoding="utf-8")
+    text = (ROOT / "docs" / "drive.md").read_text(encoding="utf-8")
     block = text.split("```python\n", 1)[1].split("```", 1)[0]
     namespace: dict = {}
     exec(compile(block, "docs/drive.md", "exec"), namespace)  # noqa: S102 - our own documentation

@@ -10,7 +10,7 @@ from matplotlib.ticker import LogFormatterSciNotation
 
 from modal.figures import PlainLogFormatter, margins
 
-ROOT = Path(__file__).resolve().parent.parent
+from support.paths import ROOT  # noqa: E402
 DEMO = ROOT / "data" / "synthetic" / "demo_scene.toml"
 
 

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parent.parent
+from support.paths import ROOT  # noqa: E402
 _SPEC = importlib.util.spec_from_file_location("perturb_errors", ROOT / "benchmarks" / "perturb_errors.py")
 perturb = importlib.util.module_from_spec(_SPEC)
 _SPEC.loader.exec_module(perturb)

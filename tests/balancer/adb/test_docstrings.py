@@ -8,7 +8,7 @@ import inspect
 
 import numpy as np
 import pytest
-from numpydoc_sections import documented
+from support.numpydoc_sections import documented
 
 MODULES = ["parameters", "equations", "linear", "equilibria", "stability", "speed", "integrate", "analysis", "simulate", "drag", "studies", "plots", "verdict", "montecarlo", "dop853"]
 

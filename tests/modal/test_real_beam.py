@@ -13,7 +13,7 @@ LSCF_HZ = [51.5, 142.2, 278.7, 460.4, 687.2]
 
 @pytest.fixture(scope="module")
 def beam():
-    from conftest import REAL
+    from support.paths import REAL
 
     paths = sorted(REAL.glob("pyuff_meas_point_*.txt"))
     assert len(paths) == 3, "data/real must ship the three beam files"
@@ -53,9 +53,9 @@ def test_sdof_methods_are_flagged_resolution_limited(beam, method):
 def test_no_model_inadequate_fatigue_on_the_real_files(method):
     """model_inadequate is calibrated on these files (modal.flags.RELATIVE_MISFIT): their modes are explained
     to 0.2-2.4 % near each peak, as well as a linear viscous model explains measured data, so no mode of any
-    file carries it, while modes merged into one peak (4.5-5.3 % misfit) still do (tests/test_identify.py:
+    file carries it, while modes merged into one peak (4.5-5.3 % misfit) still do (tests/modal/test_identify.py:
     test_close_modes_are_flagged, test_three_modes_merged_into_one_peak_are_flagged)."""
-    from conftest import REAL
+    from support.paths import REAL
 
     for path in sorted(REAL.glob("pyuff_meas_point_*.txt")):
         frf = modal.read_frf(path, frequency_step=1.0, kind="accelerance").cropped(10.0, 1000.0)

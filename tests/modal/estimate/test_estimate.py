@@ -10,7 +10,7 @@ import modal
 from modal.errors import ParameterError
 from modal.estimate import overlap_variance_factor
 from modal.estimate.windows import segment_window
-from timedata import DigitalModes, hammer_force
+from support.timedata import DigitalModes, hammer_force
 
 FS = 1024.0
 #: median of |e|/σ for a circular complex Gaussian e with E|e|² = σ² (Rayleigh): √ln 2

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import modal
-from timedata import DigitalModes, hammer_force
+from support.timedata import DigitalModes, hammer_force
 
 FS = 4096.0
 

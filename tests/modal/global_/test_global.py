@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import modal
-from conftest import REAL
+from support.paths import REAL
 from modal.global_ import channel_grid, mpc, plscf_poles
 
 #: the real beam's modes by an independent LSCF + LSFD fit (sdypy-EMA, data/real/README.md)
@@ -184,7 +184,7 @@ def test_cli_global_on_the_real_beam_with_a_stabilisation_plot(tmp_path):
     import subprocess
     import sys
 
-    from conftest import ROOT
+    from support.paths import ROOT
 
     paths = sorted(REAL.glob("pyuff_meas_point_*.txt"))
     plot = tmp_path / "stab.png"

@@ -14,7 +14,7 @@ import pytest
 from balancer.influence.job import balance, load_job, parse_job
 from modal.errors import FormatError, ParameterError, SceneError
 
-ROOT = Path(__file__).resolve().parents[1]
+from support.paths import ROOT  # noqa: E402
 READINGS = ROOT / "data" / "synthetic" / "balance_readings.toml"
 STUDY_SCENE = ROOT / "data" / "synthetic" / "balance_scene.toml"
 

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parent.parent
+from support.paths import ROOT  # noqa: E402
 DEMO = ROOT / "data" / "synthetic" / "demo_scene.toml"
 pytestmark = pytest.mark.skipif(not hasattr(os, "fork"), reason="plot_jobs > 1 needs os.fork (POSIX)")
 
@@ -125,7 +125,7 @@ def test_every_figure_draws_the_same_in_a_plotting_process_with_only_the_drawing
     import pickle
 
     from balancer.scene import plots, run_scene, runner
-    from test_scene import DRIVE
+    from support.scenes import DRIVE
 
     scenes = [DEMO, ROOT / "data" / "synthetic" / "balance_scene.toml",
               {"scene": {"name": "drive"}, "drive": DRIVE, "outputs": {"plots": ["drive"]}}]

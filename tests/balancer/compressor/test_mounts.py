@@ -35,7 +35,7 @@ from balancer.mounts import (
     stiffness_matrix,
 )
 from modal.errors import ParameterError
-from identified import identified_mode, within
+from support.identified import identified_mode, within
 
 SPEED_RPM = 2950.0
 CRANK_CENTRE_M = (0.005, 0.008, 0.005)

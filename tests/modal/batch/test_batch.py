@@ -26,7 +26,7 @@ from modal.errors import ParameterError
 from modal.io import write_frf
 from modal.synthetic import add_noise, modal_frf
 
-from daskcluster import free_port, start_worker, wait_for_workers
+from support.daskcluster import free_port, start_worker, wait_for_workers
 
 FREQ = np.linspace(20.0, 200.0, 301)  # 0.6 Hz lines; the modes are 2.4 and 5 Hz wide (>= 4 lines per bandwidth)
 NOISE = 1e-3  # of the peak magnitude: the NLS standard errors of f_n are ~1e-5 relative

@@ -97,7 +97,7 @@ def test_no_half_written_plot_on_failure(tmp_path):
 
 
 def test_real_beam_files_and_time_data_refused():
-    from conftest import REAL
+    from support.paths import REAL
 
     real = REAL
     beams = sorted(real.glob("pyuff_meas_point_*.txt"))

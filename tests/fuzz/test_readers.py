@@ -14,7 +14,7 @@ or a :class:`modal.errors.ModalError` subclass (FormatError,
 FRFValidationError, SceneError, ...).  ModalWarning warnings are allowed.
 Anything else — another exception, a hang beyond ``TIME_LIMIT_S`` — is a
 finding; the test lists each distinct one with the format and index that
-reproduce it (``python tests/test_fuzz_readers.py FORMAT INDEX OUT`` writes
+reproduce it (``python tests/fuzz/test_readers.py FORMAT INDEX OUT`` writes
 that input to OUT).
 
 The default run tries ``FAST_COUNT`` inputs per format; ``-m stress`` tries
@@ -41,14 +41,14 @@ from typing import Callable
 import numpy as np
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # tests/: support and conftest
 os.environ.setdefault("MPLBACKEND", "Agg")
 
 import modal  # noqa: E402
 from modal.errors import ModalError, ModalWarning  # noqa: E402
 from modal.io import write_frf  # noqa: E402
 
-from conftest import SYNTHETIC  # noqa: E402
+from support.paths import SYNTHETIC  # noqa: E402
 
 FAST_COUNT = int(os.environ.get("FUZZ_FAST_COUNT", "60"))
 STRESS_COUNT = int(os.environ.get("FUZZ_STRESS_COUNT", "10000"))
@@ -410,7 +410,7 @@ def fuzz(fmt: str, count: int, folder: Path) -> Tally:
     while start < count:
         env = {**os.environ, "MPLBACKEND": "Agg"}
         proc = subprocess.run([sys.executable, __file__, "--child", fmt, str(start), str(count), str(folder), str(log)],
-                              cwd=Path(__file__).resolve().parent.parent, env=env, capture_output=True, text=True,
+                              cwd=Path(__file__).resolve().parents[2], env=env, capture_output=True, text=True,
                               timeout=count * TIME_LIMIT_S + 120)
         started: dict[int, str] = {}
         done: set[int] = set()
@@ -538,7 +538,7 @@ def test_mat_v5_char_marked_sparse_is_a_format_error(tmp_path):
     """Stress finding (fixed in da3e38b): scipy.io.loadmat died (SIGSEGV) on a char array whose
     class byte says sparse; run in a subprocess so that a regression cannot take pytest down."""
     proc = subprocess.run([sys.executable, "-c", _MAT_CRASH.format(path=str(tmp_path / "crash.mat"))],
-                          cwd=Path(__file__).resolve().parent.parent, capture_output=True, text=True, timeout=120)
+                          cwd=Path(__file__).resolve().parents[2], capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, f"exit {proc.returncode}: {proc.stderr[-500:]}"
     assert "FormatError" in proc.stdout, proc.stdout
 
@@ -593,7 +593,7 @@ def test_mat_v5_damaged_cell_element_is_a_format_error(tmp_path):
     """Stress finding (fixed in 22bb339): a cell element whose dimensions length is wrong killed
     the process inside scipy.io.loadmat, past the whosmat check of da3e38b (50 of 10 000 inputs)."""
     proc = subprocess.run([sys.executable, "-c", _MAT_CELL_CRASH.format(path=str(tmp_path / "cell.mat"))],
-                          cwd=Path(__file__).resolve().parent.parent, capture_output=True, text=True, timeout=120)
+                          cwd=Path(__file__).resolve().parents[2], capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, f"exit {proc.returncode}: {proc.stderr[-500:]}"
     assert "FormatError" in proc.stdout, proc.stdout
 
@@ -621,7 +621,7 @@ try:
 except modal.FormatError as exc:
     print(exc)
 """
-    proc = subprocess.run([sys.executable, "-c", script], cwd=Path(__file__).resolve().parent.parent,
+    proc = subprocess.run([sys.executable, "-c", script], cwd=Path(__file__).resolve().parents[2],
                           capture_output=True, text=True, timeout=60)
     assert proc.returncode == 0, proc.stderr[-500:]
     assert "hang.h5" in proc.stdout and "did not finish" in proc.stdout, proc.stdout
@@ -640,7 +640,7 @@ try:
 except modal.ModalError as exc:
     print(type(exc).__name__)
 """
-    proc = subprocess.run([sys.executable, "-c", script], cwd=Path(__file__).resolve().parent.parent,
+    proc = subprocess.run([sys.executable, "-c", script], cwd=Path(__file__).resolve().parents[2],
                           capture_output=True, text=True, timeout=60)
     assert proc.returncode == 0, proc.stderr[-500:]
     assert "FormatError" in proc.stdout, proc.stdout

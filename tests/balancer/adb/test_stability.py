@@ -273,7 +273,7 @@ def test_rounding_bound_of_a_nearly_defective_eigenvalue_is_its_real_sensitivity
 
 
 def test_a_huge_condition_number_at_one_grid_speed_does_not_split_a_stable_interval():
-    # stress finding 30 (tests/test_stress_adb.py with tests/test_stress_identify.py): five
+    # stress finding 30 (tests/stress/test_adb.py with tests/stress/test_identify.py): five
     # balls, stable from 1.373 wn on with a growth rate of -0.029/s throughout, but at 4.3 wn
     # the critical condition number was 4e16 and the first-order rounding bound 2.9e4/s, so
     # that one grid speed came out marginal and the interval was cut there (4.2875–4.3125 wn

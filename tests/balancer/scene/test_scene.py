@@ -15,6 +15,7 @@ import pytest
 from balancer import read_archive, run_scene
 from balancer.adb import stable_speed_intervals
 from balancer.scene import STAGES
+from support.scenes import DRIVE
 from modal import FRF
 from modal.errors import SceneError
 
@@ -238,13 +239,6 @@ def test_sigkill_during_write_never_damages_the_previous_archive(tmp_path):
             old = target.read_bytes()
     # the kills must have hit writes in progress, or the test proves nothing
     assert outcomes["old"] >= 5, outcomes
-
-
-DRIVE = {"motor_speed_rpm": 930.0, "power_w": 750.0, "service_factor": 1.3,
-         "stages": [{"driver_diameter_m": 0.100, "driven_diameter_m": 0.120, "center_distance_m": 0.300,
-                     "per_belt_rating_w": 1275.0}],
-         "shaft": {"length_m": 1.30, "bearing_a_m": 0.0, "bearing_b_m": 1.15, "diameter_m": 0.025,
-                   "rotor_position_m": 1.30, "rotor_mass_kg": 2.0, "youngs_modulus_pa": 205e9}}
 
 
 def test_drive_hands_speed_and_stiffness_to_the_rotor():

@@ -12,10 +12,10 @@ import numpy as np
 import pytest
 
 import modal
-from conftest import REAL, ROOT
+from support.paths import REAL, ROOT
 from modal.errors import FormatError
 from modal.io.timedata import read_time
-from timedata import DigitalModes
+from support.timedata import DigitalModes
 
 FS = 1024.0
 PLANT = DigitalModes(np.array([40.0, 95.0]), np.array([0.03, 0.02]), np.array([[1.0, 0.5], [0.6, -0.8]]), FS)
@@ -138,7 +138,7 @@ def test_unknown_channel_names_the_choices(tmp_path):
 
 
 def test_impact_file_fit_with_plots(tmp_path):
-    from timedata import hammer_force
+    from support.timedata import hammer_force
 
     n = int(8 * FS)
     force = hammer_force(n, FS, [0.5, 2.5, 2.51, 4.5, 6.5])

@@ -22,7 +22,7 @@ from balancer.adb.stability import characteristic_polynomial
 from modal.errors import ModalWarning
 from modal.synthetic import add_noise, sdof_frf
 
-#: the rotor of tests/test_adb_stability.py (S1): M = 1 kg, k = 1e4 N/m, c = 20 N s/m (ζ = 0.1)
+#: the rotor of tests/balancer/adb/test_stability.py (S1): M = 1 kg, k = 1e4 N/m, c = 20 N s/m (ζ = 0.1)
 ROTOR = dict(M=1.0, k=1e4, c=20.0)
 BALLS = dict(m=0.02, n=2, R=0.05, e=0.5e-3, D=1e-3)
 N_SEEDS = 200

@@ -10,7 +10,7 @@ import pytest
 
 from balancer.adb import ADBParameters, ParameterBatch, identified_std
 from modal.errors import ParameterError
-from identified import identified_mode, within
+from support.identified import identified_mode, within
 
 REFERENCE = dict(M=1.0, m=0.02, n=2, R=0.05, e=0.5e-3, k=1e4, c=20.0, D=1e-3)
 
