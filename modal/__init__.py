@@ -21,10 +21,12 @@ from .io import read_frf, write_frf  # noqa: E402
 from .estimate import EstimatedFRF, estimate_frf  # noqa: E402
 from .results import FLAG_TEXT, IdentificationResult, ModeResult, ModeStd, physical_parameters  # noqa: E402
 from .synthetic import add_noise, matrix_frf, modal_frf, sdof_frf  # noqa: E402
+from .geometry import Geometry, line_geometry  # noqa: E402
+from .io.geometry import read_geometry  # noqa: E402
 
 __all__ = [
     "FRF", "FRF_KINDS", "identify", "estimate_frf", "EstimatedFRF", "read_frf", "write_frf", "METHODS", "IdentificationResult", "ModeResult", "ModeStd",
-    "FLAG_TEXT", "physical_parameters", "modal_frf", "matrix_frf", "sdof_frf", "add_noise",
+    "FLAG_TEXT", "physical_parameters", "Geometry", "line_geometry", "read_geometry", "modal_frf", "matrix_frf", "sdof_frf", "add_noise",
     "errors", "units", "ModalError", "FRFValidationError", "FormatError", "IdentificationError",
     "ParameterError", "ModalWarning", "ResolutionWarning", "QualityWarning",
 ]
