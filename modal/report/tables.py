@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .results import IdentificationResult
+from ..results import IdentificationResult
 
 __all__ = ["format_table", "jsonable"]
 
