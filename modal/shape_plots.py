@@ -30,17 +30,17 @@ def _check_mode(shapes: ModeShapes, mode: int) -> None:
         raise ParameterError(f"mode must be 1..{shapes.n_modes} (as numbered in the report), got {int(mode) + 1}")
 
 
-def _draw_structure(ax, geometry: Geometry, positions: np.ndarray, **style):
-    """Trace lines (or, without any, the nodes as points) at ``positions`` (n_nodes, 3); returns the artists."""
-    artists = []
+def _draw_structure(ax, geometry: Geometry, positions: np.ndarray, color: str, lw: float):
+    """Trace lines (one collection) and nodes at ``positions`` (n_nodes, 3); returns (lines or None, nodes)."""
+    from mpl_toolkits.mplot3d.art3d import Line3DCollection
+
+    lines = None
     if geometry.lines.size:
         rows = geometry.node_index(geometry.lines.ravel()).reshape(-1, 2)
-        for a, b in rows:
-            (line,) = ax.plot(*positions[[a, b]].T, **style)
-            artists.append(line)
-    (points,) = ax.plot(*positions.T, "o", ms=3, color=style.get("color", "k"), alpha=style.get("alpha", 1.0))
-    artists.append(points)
-    return artists
+        lines = Line3DCollection(positions[rows], colors=color, linewidths=lw)
+        ax.add_collection3d(lines)
+    (points,) = ax.plot(*positions.T, "o", ms=3, color=color)
+    return lines, points
 
 
 def _equal_box(ax, frames: np.ndarray) -> None:
@@ -104,17 +104,18 @@ def animate_mode_shape(shapes: ModeShapes, mode: int = 0, geometry: Geometry | N
     fig = figure if figure is not None else Figure(figsize=(5, 4), dpi=80, layout="constrained")
     ax = fig.add_subplot(projection="3d")
     _draw_structure(ax, placed, placed.coordinates_m, color="0.75", lw=0.8)
-    moving = _draw_structure(ax, placed, frames[0], color="tab:blue", lw=1.6)
+    lines, points = _draw_structure(ax, placed, frames[0], color="tab:blue", lw=1.6)
     _equal_box(ax, frames)
+    ax.set_axis_off()  # a slide shows the structure; the axes' panes and ticks would cost most of each frame
     ax.set_title(_mode_title(shapes, mode), fontsize="medium")
     rows = placed.node_index(placed.lines.ravel()).reshape(-1, 2) if placed.lines.size else np.zeros((0, 2), int)
 
     def update(k):
         pos = frames[k]
-        for line, (a, b) in zip(moving[:-1], rows):
-            line.set_data_3d(*pos[[a, b]].T)
-        moving[-1].set_data_3d(*pos.T)
-        return moving
+        if lines is not None:
+            lines.set_segments(pos[rows])
+        points.set_data_3d(*pos.T)
+        return [a for a in (lines, points) if a is not None]
 
     return FuncAnimation(fig, update, frames=len(frames), interval=1000 / 12, blit=False)
 
