@@ -72,6 +72,8 @@ def build_parser() -> argparse.ArgumentParser:
                      help="--plot: draw only channel N (0-based); default every channel (the RMS over channels "
                           "above 8)")
     fit.add_argument("--archive", metavar="OUT.h5", help="write the FRF and results to an HDF5 archive")
+    fit.add_argument("--geometry", metavar="GEOM", help="--archive: the test geometry to keep with the results "
+                     "(UFF 15/2411 and 82, CSV or TOML; see python -m modal report)")
     frf = sub.add_parser("frf", help="estimate FRFs from a time record (force and responses)",
                          description="Estimate FRFs with coherence and noise per line from a time file "
                                      "(UFF 58/58b function type 1, CSV with a time column, MAT, HDF5).")
@@ -83,6 +85,20 @@ def build_parser() -> argparse.ArgumentParser:
     frf.add_argument("--plot", metavar="OUT.png", help="write the FRFs with coherence and error band "
                      "(and OUT_hits.png with the hits for --impact)")
     add_time_options(frf)
+    report = sub.add_parser("report", help="write a self-contained HTML report of an archive",
+                            description="One HTML file that opens offline: the test at a glance, the modes and "
+                                        "their flags, FRFs with the fitted models, the stabilisation diagram, MAC, "
+                                        "and the mode shapes animated on the test geometry (and a scene's results).")
+    report.add_argument("archive", metavar="ARCHIVE.h5", help="archive of python -m modal fit --archive or "
+                        "python -m balancer run")
+    report.add_argument("--out", required=True, metavar="REPORT.html", help="the HTML file to write")
+    report.add_argument("--geometry", metavar="GEOM", help="test geometry (UFF 15/2411 and 82, CSV or TOML); "
+                        "default the archive's own, else the channels on a line in file order")
+    report.add_argument("--gif", metavar="OUT.gif", help="also write one mode's animation as a GIF")
+    report.add_argument("--mode", type=int, default=1, metavar="N",
+                        help="--gif: the mode to animate, numbered as in the report (default 1)")
+    report.add_argument("--method", metavar="METHOD",
+                        help="--gif: the result whose mode is animated (default the archive's first)")
     from .batch.cli import add_batch_parser
 
     add_batch_parser(sub, add_fit_options)
@@ -149,10 +165,21 @@ def _fit(args) -> int:
         with atomic_path(target) as tmp:
             fig.savefig(tmp, dpi=110, format=target.suffix.lstrip(".") or "png")
         print(f"plot: {target}", file=sys.stderr)
+    if args.geometry and not args.archive:
+        raise ModalError("--geometry is kept with the results in the archive: give --archive OUT.h5 as well")
     if args.archive:
         from .archive import write_archive
 
-        write_archive(args.archive, {"frf": frf, **{f"identify_{r.method}": r for r in results}})
+        items = {"frf": frf, **{f"identify_{r.method}": r for r in results}, "source_files": list(args.path)}
+        if args.geometry:
+            from .io.geometry import read_geometry
+            from .shapes import mode_shapes
+
+            geometry = read_geometry(args.geometry)
+            shapes = mode_shapes(results[0], frf.response_points, frf.reference_points)
+            shapes.placed_on(geometry)  # every channel must stand on a node of the geometry: one line if not
+            items["geometry"] = geometry
+        write_archive(args.archive, items)
         print(f"archive: {args.archive}", file=sys.stderr)
     return 0
 
@@ -188,6 +215,35 @@ def _frf(args) -> int:
     return 0
 
 
+def _report(args) -> int:
+    from .report import write_report
+
+    geometry = None
+    if args.geometry:
+        from .io.geometry import read_geometry
+
+        geometry = read_geometry(args.geometry)
+    out = write_report(args.archive, args.out, geometry)
+    print(f"report: {out}", file=sys.stderr)
+    if args.gif:
+        from .report.content import report_content
+        from .shape_plots import write_gif
+
+        content = report_content(args.archive, geometry)
+        available = [(r.method, s) for r, s in zip(content.results, content.shapes) if s is not None]
+        if args.method is not None:
+            available = [(m, s) for m, s in available if m == args.method]
+        if not available:
+            raise ModalError(f"{args.archive}: no result{' of method ' + args.method if args.method else ''} with mode "
+                             f"shapes to animate")
+        shapes = available[0][1]
+        if not 1 <= args.mode <= shapes.n_modes:
+            raise ModalError(f"--mode must be 1..{shapes.n_modes} (the modes of method {shapes.method}), got {args.mode}")
+        write_gif(args.gif, shapes, args.mode - 1, content.geometry)
+        print(f"gif: {args.gif}", file=sys.stderr)
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit code."""
     parser = build_parser()
@@ -202,11 +258,14 @@ def main(argv: list[str] | None = None) -> int:
             return _fit(args)
         if args.command == "frf":
             return _frf(args)
+        if args.command == "report":
+            return _report(args)
     except ModalError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 1
     except OSError as exc:
-        path = args.path if isinstance(args.path, str) else args.path[0]
+        path = getattr(args, "path", None) or args.archive
+        path = path if isinstance(path, str) else path[0]
         print(f"error: {exc.filename or path}: {exc.strerror or exc}", file=sys.stderr)
         return 1
     return 2
