@@ -41,6 +41,15 @@
     return { ctx: ctx, w: width, h: height };
   }
 
+  // a canvas is drawn at its container's width: draw again when that changes (a scroll bar appearing included)
+  function redrawOnResize(element, draw) {
+    if (!window.ResizeObserver) return;
+    var width = element.clientWidth;
+    new ResizeObserver(function () {
+      if (element.clientWidth !== width) { width = element.clientWidth; draw(); }
+    }).observe(element);
+  }
+
   // ---------------------------------------------------------------- 2D plots
   function Plot(canvas, opts) {
     this.canvas = canvas; this.opts = opts; this.series = []; this.marks = []; this.xr = null; this.full = null;
@@ -63,6 +72,7 @@
     });
     canvas.addEventListener("mouseleave", function () { if (start !== null) { start = null; self.draw(); } });
     canvas.addEventListener("dblclick", function () { self.linked.forEach(function (p) { p.xr = null; p.draw(); }); });
+    redrawOnResize(canvas.parentElement, function () { self.draw(); });
   }
   Plot.prototype.set = function (series, marks) {
     this.series = series; this.marks = marks || [];
@@ -337,7 +347,8 @@
       window.requestAnimationFrame(tick);
     }
     window.requestAnimationFrame(tick);
-    window.addEventListener("resize", function () { view.draw(); view.drawArgand(); });
+    redrawOnResize(view.canvas.parentElement, function () { view.draw(); });
+    redrawOnResize(view.argand.parentElement, function () { view.drawArgand(); });
   }
 
   [setupFRF, setupStabilisation, setupShapes].forEach(function (f) {

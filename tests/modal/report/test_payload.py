@@ -42,3 +42,16 @@ def test_frf_payload_of_many_channels_offers_a_sample_and_the_rms_of_all():
     rms = payload["entries"][0]
     np.testing.assert_allclose(rms["mag"], np.sqrt(np.mean(np.abs(frf.channels) ** 2, axis=0)))
     assert "32 of 200 channels" in payload["note"]
+
+
+def test_an_frf_estimated_from_time_data_brings_its_coherence():
+    rng = np.random.default_rng(8)
+    fs = 1024.0
+    force = rng.normal(size=16384)
+    response = np.convolve(force, np.exp(-np.arange(200) / 20.0) * np.sin(np.arange(200) * 0.6), mode="same")
+    response = response + 0.5 * rng.normal(size=force.size)  # output noise lowers the coherence
+    est = modal.estimate_frf(force, response, fs, segment_length=512)
+    payload = frf_payload(est, [])
+    drawn = payload["entries"][0]
+    np.testing.assert_allclose(drawn["coherence"], np.atleast_2d(est.coherence)[0])
+    assert 0 < np.nanmin(drawn["coherence"]) < 0.999  # the noise shows as coherence below 1
