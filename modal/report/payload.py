@@ -18,7 +18,7 @@ __all__ = ["MAX_DRAWN_CHANNELS", "MAX_DRAWN_LINES", "frf_payload", "stabilisatio
            "to_json", "drawn_lines", "drawn_channels"]
 
 MAX_DRAWN_CHANNELS = 32
-MAX_DRAWN_LINES = 4000
+MAX_DRAWN_LINES = 2000
 
 
 class _Numbers:
@@ -31,9 +31,10 @@ class _Numbers:
     def json(self) -> str:
         if self.values.size == 0:
             return "[]"
-        text = np.char.mod(f"%.{self.digits}g", self.values)
-        text[~np.isfinite(self.values)] = "null"
-        return "[" + ",".join(text.tolist()) + "]"
+        text = list(map(f"%.{self.digits}g".__mod__, self.values.tolist()))  # 2-3x numpy.char.mod's speed
+        for k in np.flatnonzero(~np.isfinite(self.values)):
+            text[k] = "null"
+        return "[" + ",".join(text) + "]"
 
 
 def to_json(obj) -> str:
@@ -66,20 +67,22 @@ def drawn_lines(magnitude: np.ndarray, limit: int = MAX_DRAWN_LINES) -> np.ndarr
     Parameters
     ----------
     magnitude : ndarray, shape (n_freq,)
-        What decides which lines carry the envelope (|H| over the drawn channels).
+        What decides which lines carry the envelope (|H| of the channel drawn).
     """
     n = magnitude.size
     if n <= limit:
         return np.arange(n)
-    buckets = limit // 2
-    edges = np.linspace(0, n, buckets + 1).astype(int)
-    keep = [0, n - 1]
-    for lo, hi in zip(edges[:-1], edges[1:]):
-        if hi > lo:
-            block = magnitude[lo:hi]
-            keep += [lo + int(np.nanargmin(block)), lo + int(np.nanargmax(block))] if np.any(np.isfinite(block)) \
-                else [lo]
-    return np.unique(keep)
+    buckets = max(limit // 2, 1)
+    width = -(-n // buckets)
+    padded = np.full(buckets * width, np.nan)
+    padded[:n] = magnitude
+    blocks = padded.reshape(buckets, width)
+    finite = np.isfinite(blocks)
+    low = np.argmin(np.where(finite, blocks, np.inf), axis=1)
+    high = np.argmax(np.where(finite, blocks, -np.inf), axis=1)
+    starts = np.arange(buckets) * width
+    keep = np.concatenate([[0, n - 1], starts + low, starts + high])
+    return np.unique(keep[keep < n])
 
 
 def drawn_channels(n_channels: int, limit: int = MAX_DRAWN_CHANNELS) -> np.ndarray:

@@ -31,7 +31,8 @@
   }
   function setupCanvas(canvas, height) {
     var ratio = window.devicePixelRatio || 1;
-    var width = canvas.parentElement.clientWidth || 800;
+    var parent = canvas.parentElement, style = window.getComputedStyle(parent);
+    var width = (parent.clientWidth - parseFloat(style.paddingLeft) - parseFloat(style.paddingRight)) || 800;
     canvas.style.width = width + "px";
     canvas.style.height = height + "px";
     canvas.width = Math.round(width * ratio);
