@@ -72,8 +72,8 @@ def build_parser() -> argparse.ArgumentParser:
                      help="--plot: draw only channel N (0-based); default every channel (the RMS over channels "
                           "above 8)")
     fit.add_argument("--archive", metavar="OUT.h5", help="write the FRF and results to an HDF5 archive")
-    fit.add_argument("--geometry", metavar="GEOM", help="--archive: the test geometry to keep with the results "
-                     "(UFF 15/2411 and 82, CSV or TOML; see python -m modal report)")
+    fit.add_argument("--geometry", metavar="GEOM", help="the test geometry (UFF 15/2411 and 82, CSV or TOML): kept "
+                     "with the results by --archive, written before the shapes by --export-uff")
     frf = sub.add_parser("frf", help="estimate FRFs from a time record (force and responses)",
                          description="Estimate FRFs with coherence and noise per line from a time file "
                                      "(UFF 58/58b function type 1, CSV with a time column, MAT, HDF5).")
@@ -149,10 +149,20 @@ def _fit(args) -> int:
             for path in save_time_plots(stem.with_name(f"{stem.stem}_estimate{stem.suffix}"), *time_data,
                                         hits_target=stem.with_name(f"{stem.stem}_hits{stem.suffix}")):
                 print(f"plot: {path}", file=sys.stderr)
+    geometry = None
+    if args.geometry:
+        if not (args.archive or args.export_uff):
+            raise ModalError("--geometry goes with the results: give --archive OUT.h5 or --export-uff OUT.uff as well")
+        from .io.geometry import read_geometry
+        from .shapes import mode_shapes
+
+        geometry = read_geometry(args.geometry)
+        shapes = mode_shapes(results[0], frf.response_points, frf.reference_points)
+        shapes.placed_on(geometry)  # every channel must stand on a node of the geometry: one line if not
     if getattr(args, "export_uff", None):
         from .global_.export import export_uff
 
-        export_uff(results[0], frf, args.export_uff)
+        export_uff(results[0], frf, args.export_uff, geometry)
         print(f"uff: {args.export_uff}", file=sys.stderr)
     if getattr(args, "stabilisation_plot", None):
         if results[0].stabilisation is None:
@@ -165,19 +175,11 @@ def _fit(args) -> int:
         with atomic_path(target) as tmp:
             fig.savefig(tmp, dpi=110, format=target.suffix.lstrip(".") or "png")
         print(f"plot: {target}", file=sys.stderr)
-    if args.geometry and not args.archive:
-        raise ModalError("--geometry is kept with the results in the archive: give --archive OUT.h5 as well")
     if args.archive:
         from .archive import write_archive
 
         items = {"frf": frf, **{f"identify_{r.method}": r for r in results}, "source_files": list(args.path)}
-        if args.geometry:
-            from .io.geometry import read_geometry
-            from .shapes import mode_shapes
-
-            geometry = read_geometry(args.geometry)
-            shapes = mode_shapes(results[0], frf.response_points, frf.reference_points)
-            shapes.placed_on(geometry)  # every channel must stand on a node of the geometry: one line if not
+        if geometry is not None:
             items["geometry"] = geometry
         write_archive(args.archive, items)
         print(f"archive: {args.archive}", file=sys.stderr)

@@ -61,8 +61,9 @@ def shape_dataset(mode, number: int, frf: FRF) -> dict:
     }
 
 
-def export_uff(result: IdentificationResult, frf: FRF, path: str | os.PathLike) -> None:
-    """Write the mode shapes (UFF 55) and the synthesised FRFs (UFF 58) of ``result`` to ``path``.
+def export_uff(result: IdentificationResult, frf: FRF, path: str | os.PathLike, geometry=None) -> None:
+    """Write the mode shapes (UFF 55) and the synthesised FRFs (UFF 58) of ``result`` to ``path``, after the
+    test geometry (UFF 15 nodes and 82 trace lines) when one is given.
 
     Parameters
     ----------
@@ -72,6 +73,9 @@ def export_uff(result: IdentificationResult, frf: FRF, path: str | os.PathLike) 
         The fitted FRF: its channels' point ids place the shapes and its lines carry the synthesis.
     path : path-like
         Target file, written to a temporary file beside it and renamed.
+    geometry : Geometry, optional
+        Written first, so that a viewer of the file draws the shapes on it (the shapes stand on the nodes of
+        the channels' point ids).
     """
     import pyuff
 
@@ -84,10 +88,17 @@ def export_uff(result: IdentificationResult, frf: FRF, path: str | os.PathLike) 
         scratch = Path(scratch_dir)
         part58 = scratch / "frf.uff"
         write_frf_uff(synth, part58)
+        part15 = scratch / "geometry.uff"
+        if geometry is not None:
+            from ..io.geometry import write_geometry_uff
+
+            write_geometry_uff(geometry, part15)
         with atomic_path(path) as tmp:
             try:
                 with open(tmp, "wb") as out, warnings.catch_warnings():
                     warnings.simplefilter("ignore")  # pyuff leaves file handles to the garbage collector
+                    if geometry is not None:
+                        out.write(part15.read_bytes())
                     for number, mode in enumerate(result.modes, start=1):
                         one = scratch / f"mode{number}.uff"
                         one.write_bytes(b"")

@@ -93,3 +93,22 @@ def test_a_geometry_that_lacks_a_channels_node_writes_no_archive(tmp_path):
     assert not (tmp_path / "a.h5").exists()
     out = run("fit", PLATE_FRF, "--geometry", geometry)
     assert out.returncode == 1 and "give --archive" in out.stderr
+
+
+def test_uff_export_carries_the_geometry_before_the_shapes(tmp_path):
+    import pyuff
+
+    from modal.io import read_frf
+    from modal.io.geometry import read_geometry
+
+    target = tmp_path / "plate_modes.uff"
+    out = run("fit", PLATE_FRF, "--export-uff", target, "--geometry", PLATE_GEOMETRY)
+    assert out.returncode == 0, out.stderr
+    types = [int(t) for t in pyuff.UFF(str(target)).get_set_types()]
+    assert types[0] == 15 and set(types) == {15, 82, 55, 58} and types.index(55) > max(i for i, t in enumerate(types)
+                                                                                      if t == 82)
+    geometry = read_geometry(target)
+    assert geometry.n_nodes == 30
+    shapes = [d for d in pyuff.UFF(str(target)).read_sets() if d["type"] == 55]
+    assert len(shapes) == 5 and set(shapes[0]["node_nums"].astype(int)) <= set(geometry.node_id.tolist())
+    assert read_frf(target).n_channels == 12  # the synthesised FRFs still read as FRFs
