@@ -150,12 +150,13 @@ class Geometry:
             A point id is malformed or names a node the geometry does not have.
         """
         nodes, directions = [], []
+        known = set(self.node_id.tolist())
         for k, point in enumerate(points):
             try:
                 node, direction = direction_vector(point)
             except ValueError as exc:
                 raise ParameterError(f"{self.source}: channel {k}: {exc}") from None
-            if node not in set(self.node_id.tolist()):
+            if node not in known:
                 raise ParameterError(f"{self.source}: channel {k} (point {point!r}) stands on node {node}, which the "
                                      f"geometry does not have (nodes {_id_range(self.node_id)})")
             nodes.append(node)
