@@ -19,7 +19,8 @@ from .frf import FRF, FRF_KINDS  # noqa: E402
 from .identify import METHODS, identify  # noqa: E402
 from .io import read_frf, write_frf  # noqa: E402
 from .estimate import EstimatedFRF, estimate_frf  # noqa: E402
-from .results import FLAG_TEXT, IdentificationResult, ModeResult, ModeStd, physical_parameters  # noqa: E402
+from .flags import FLAG_TEXT  # noqa: E402
+from .results import IdentificationResult, ModeResult, ModeStd, physical_parameters  # noqa: E402
 from .synthetic import add_noise, matrix_frf, modal_frf, sdof_frf  # noqa: E402
 from .geometry import Geometry, line_geometry  # noqa: E402
 from .io.geometry import read_geometry  # noqa: E402

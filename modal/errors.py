@@ -6,6 +6,7 @@ Messages name the file, the field and what was expected.
 """
 from __future__ import annotations
 
+import sys
 import warnings
 
 __all__ = [
@@ -21,6 +22,7 @@ __all__ = [
     "ResolutionWarning",
     "QualityWarning",
     "warn",
+    "warn_caller",
 ]
 
 
@@ -71,3 +73,12 @@ class QualityWarning(ModalWarning):
 def warn(message: str, category: type[Warning] = ModalWarning, stacklevel: int = 3) -> None:
     """Issue a toolkit warning pointing at the caller's caller."""
     warnings.warn(message, category, stacklevel=stacklevel)
+
+
+def warn_caller(message: str, category: type[Warning] = ModalWarning) -> None:
+    """Issue a toolkit warning pointing at the first caller outside the ``modal`` package: the line
+    that called the toolkit, however deep inside it the warning is raised."""
+    frame, level = sys._getframe(1), 2
+    while frame is not None and frame.f_globals.get("__name__", "").partition(".")[0] == "modal":
+        frame, level = frame.f_back, level + 1
+    warnings.warn(message, category, stacklevel=level)

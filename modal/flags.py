@@ -1,18 +1,19 @@
-"""Quality flags, defined once: what each means (:data:`modal.results.FLAG_TEXT`), what a user
-should do about it (:data:`FLAG_ACTION`), which flags belong to a channel rather than to the
-mode, and which combinations would contradict each other.
-
-``python -m modal.flags > docs/flags.md`` writes the table of the documentation.
+"""Quality flags, defined once: what each means (:data:`FLAG_TEXT`), the limits that raise them,
+what a user should do about it (:data:`FLAG_ACTION`), which flags belong to a channel rather than
+to the mode, which combinations would contradict each other, and the rules every method applies
+(:func:`model_inadequate`, :func:`overlap`). :mod:`modal.flag_table` writes them as the table of
+docs/flags.md.
 """
 from __future__ import annotations
 
 import numpy as np
 
 from .frf import line_spacing
-from .results import FLAG_TEXT
 
-__all__ = ["CHI2_LIMIT", "RELATIVE_MISFIT", "lines_near_mode", "FLAG_ACTION", "INFORMATIONAL", "DRIVING_POINT_ONLY", "TRANSFER_ONLY", "channel_flags", "contradictions",
-           "flags_markdown"]
+__all__ = ["FLAG_TEXT", "FLAG_ACTION", "CHI2_LIMIT", "RELATIVE_MISFIT", "REL_STD_LIMIT", "OVERLAP_LIMIT", "BIAS_LIMIT",
+           "COMPLEX_PHASE_DEG", "MPC_LIMIT", "WEAK_FRACTION", "RIGID_BODY_RATIO", "GRID_FLAGS", "RESOLUTION_FLAGS",
+           "INFORMATIONAL", "DRIVING_POINT_ONLY", "TRANSFER_ONLY", "lines_near_mode", "model_inadequate", "overlap",
+           "channel_flags", "contradictions", "flags_markdown"]
 
 #: chi-square (residual variance over the noise variance) above which a model may be flagged model_inadequate
 CHI2_LIMIT = 3.0
@@ -23,6 +24,64 @@ CHI2_LIMIT = 3.0
 #: into one peak show 4.5 % (three modes, exact data) and 5.3 % (a pair 1 Hz apart, 0.2 % noise). On noisy
 #: data chi-square alone decides: a misfit of 3 noise σ there is above this fraction already.
 RELATIVE_MISFIT = 0.03
+#: relative standard error of ζ above which an estimate is flagged high_uncertainty
+REL_STD_LIMIT = 0.1
+#: modal overlap 2·max(ζωn)/|Δωn| with another mode above which close_modes is raised: up to 1.5 the
+#: NLS errors match the scatter (SD of z 0.95 at 1.2, 1.15 at 1.5, over 100 seeds at 1.6 % noise); at 2
+#: they are 2–4× optimistic (docs/stress.md)
+OVERLAP_LIMIT = 1.5
+#: half-power and circle fits: an estimate further than this many of its own standard errors from the
+#: least-squares refinement of the same modes is flagged method_bias
+BIAS_LIMIT = 3.0
+#: phase of a driving point's modal constant (deg) above which complex_mode is raised
+COMPLEX_PHASE_DEG = 10.0
+#: MPC below which a mode's shape counts as complex (complex_shape)
+MPC_LIMIT = 0.8
+#: a selected pole stable (in frequency) in fewer than this fraction of the swept orders has weak evidence
+WEAK_FRACTION = 0.5
+#: a mode below this fraction of the next mode's frequency counts as a rigid-body / suspension mode
+RIGID_BODY_RATIO = 0.1
+
+#: Every quality flag with the reason it is raised.
+FLAG_TEXT = {
+    "resolution_limited": "fewer than 3 lines above the half-power level: damping is below what the lines resolve",
+    "missing_crossing": "a half-power (-3 dB) crossing is missing in the band",
+    "band_edge_peak": "the peak lies at the edge of the band: the band does not contain the resonance",
+    "too_few_points": "too few lines near resonance for this method",
+    "damping_pair_spread": "circle fit: the damping estimates from point pairs disagree by more than 10 %",
+    "model_inadequate": (f"residual is much larger than the noise (chi-square > {CHI2_LIMIT:g}) and more than "
+                         f"{100 * RELATIVE_MISFIT:g} % of the data near the mode: the model does not explain the data "
+                         "(close modes, missing mode, nonlinearity)"),
+    "high_uncertainty": (f"standard error of the damping ratio exceeds {100 * REL_STD_LIMIT:g} % of its value, or the "
+                         "errors are undetermined (the data do not determine this mode's pole apart from another's)"),
+    "did_not_converge": "least-squares refinement did not converge; the start values are reported",
+    "driving_point_assumed": "single-channel FRF without point ids: taken as a driving point",
+    "not_driving_point": "transfer FRF (response point differs from reference): k, c, m are not defined for it",
+    "complex_mode": (f"modal constant of a driving point is far from real (phase > {COMPLEX_PHASE_DEG:g} deg): "
+                     "k, c, m are approximate"),
+    "non_positive_constant": "driving-point modal constant has a negative real part: k, c, m not defined",
+    "close_modes": ("another mode lies within this mode's fitting band, or overlaps it "
+                    f"(2*zeta*wn/delta_wn > {OVERLAP_LIMIT:g}): the standard errors understate the scatter"),
+    "missing_mode": ("the residual holds another mode in or next to this band that peak detection missed (one more "
+                     "mode reduces it significantly, F-test at 1e-6), or this mode moves by more than 3 of its errors "
+                     "once that mode is in the model; the estimates are biased by it: give bands_hz for both modes "
+                     "or lower min_prominence_db"),
+    "window_damping_dominates": ("the exponential window's decay 1/tau is not below the mode's measured decay rate: "
+                                 "all its damping may be the window's, so it was not removed; use a longer tau"),
+    "weak_evidence": ("global: the pole is stable in fewer than half of the upper half of the model orders of the "
+                      "stabilisation diagram (or a modes_hz hint picked a pole stable in fewer than 3): a weakly "
+                      "excited mode or a noise pole; check the diagram and the shape before using it"),
+    "outside_band": ("global: the mode lies below the first resolvable lines or above the band: its parameters "
+                     "are extrapolated; widen the band or treat it as a residual"),
+    "rigid_body": ("global: the mode lies below a tenth of the next mode's frequency: a rigid-body or suspension "
+                   "mode of a free structure, not a flexible mode"),
+    "complex_shape": (f"global: the modal constants are far from collinear in phase (MPC < {MPC_LIMIT:g}): a complex "
+                      "mode, or noise/close modes; k, c, m and shape comparisons are approximate"),
+    "method_bias": (f"half-power or circle estimate lies more than {BIAS_LIMIT:g} of its standard errors from the "
+                    "least-squares refinement of the same modes (the method's own bias: line spacing, noise at the "
+                    "peak, a neighbouring mode); its standard errors include the difference, method 'nls' gives the "
+                    "refined values"),
+}
 
 
 def lines_near_mode(omega: np.ndarray, omega_n: float, damping_ratio: float) -> np.ndarray:
@@ -30,6 +89,27 @@ def lines_near_mode(omega: np.ndarray, omega_n: float, damping_ratio: float) -> 
     ``omega_n`` (rad/s): within ±3 half-power widths of it, at least ±3 line spacings."""
     spacing = line_spacing(omega) if omega.size > 1 else 0.0
     return np.abs(omega - omega_n) <= max(3 * 2 * damping_ratio * omega_n, 3 * spacing)
+
+
+def model_inadequate(chi2: float, relative_misfit: float) -> bool:
+    """Whether a mode's model is inadequate where a user should act: the misfit near it exceeds the noise
+    (``chi2`` above :data:`CHI2_LIMIT`) and is more than :data:`RELATIVE_MISFIT` of the data there (a NaN
+    relative misfit, not measured, leaves the chi-square alone to decide)."""
+    return bool(np.isfinite(chi2) and chi2 > CHI2_LIMIT and not relative_misfit <= RELATIVE_MISFIT)
+
+
+def overlap(omega_n: np.ndarray, damping_ratio: np.ndarray, index: int) -> float:
+    """Largest modal overlap 2·max(ζωn)/|Δωn| of mode ``index`` with any other mode (modes without a finite
+    pole are left out; infinite for two modes at one frequency); compared with :data:`OVERLAP_LIMIT`."""
+    wn, zeta = omega_n[index], damping_ratio[index]
+    worst = 0.0
+    for other, (wn_o, zeta_o) in enumerate(zip(omega_n, damping_ratio)):
+        if other == index or not (np.isfinite(wn_o) and np.isfinite(zeta_o)):
+            continue
+        gap = abs(wn_o - wn)
+        width = 2 * max(zeta * wn, zeta_o * wn_o)
+        worst = max(worst, width / gap if gap > 0 else np.inf)
+    return worst
 
 #: What to do when a flag is raised.
 FLAG_ACTION = {
@@ -60,6 +140,10 @@ FLAG_ACTION = {
     "method_bias": "use the nls (or global) values, which the half-power and circle estimates start from",
 }
 
+#: Flags of an estimate the line spacing limits: its error includes the grid's quantisation
+GRID_FLAGS = frozenset({"resolution_limited", "missing_crossing", "too_few_points"})
+#: Flags raised with a :class:`~modal.errors.ResolutionWarning` (any other serious flag: a QualityWarning)
+RESOLUTION_FLAGS = GRID_FLAGS | {"outside_band"}
 #: Flags that describe the setting, not a defect (``ModeResult.ok`` ignores them).
 INFORMATIONAL = frozenset({"driving_point_assumed", "not_driving_point"})
 #: Flags about a driving-point channel's constant (never on a transfer channel).
@@ -94,33 +178,3 @@ def contradictions(row: dict) -> list[str]:
     unknown = flags - set(FLAG_TEXT)
     found += [f"flag {f} is not defined in FLAG_TEXT" for f in sorted(unknown)]
     return found
-
-
-def flags_markdown() -> str:
-    """The flag table of docs/flags.md (generated: ``python -m modal.flags > docs/flags.md``)."""
-    lines = [
-        "# Quality flags",
-        "",
-        "<!-- generated by `python -m modal.flags > docs/flags.md` from modal/results.py FLAG_TEXT and",
-        "     modal/flags.py FLAG_ACTION; tests/test_first_use.py fails when this file differs -->",
-        "",
-        "Every identified mode carries a tuple of flags (`ModeResult.flags`, the `flags` column of the table and",
-        "of `--json`). An empty tuple means the estimate is sound. `driving_point_assumed` and `not_driving_point`",
-        "describe the setting rather than a defect (`ModeResult.ok` ignores them). In the per-channel rows",
-        "(`IdentificationResult.rows()`, the table, `--json`) a channel shows only the flags that apply to it:",
-        "`not_driving_point` only on transfer channels; `driving_point_assumed`, `complex_mode` and",
-        "`non_positive_constant` only on driving points.",
-        "",
-        "| flag | meaning | what to do |",
-        "|---|---|---|",
-    ]
-    for name, text in FLAG_TEXT.items():
-        action = FLAG_ACTION.get(name, "")
-        lines.append(f"| `{name}` | {text.replace('|', '/')} | {action.replace('|', '/')} |")
-    return "\n".join(lines) + "\n"
-
-
-if __name__ == "__main__":  # pragma: no cover
-    import sys
-
-    sys.stdout.write(flags_markdown())

@@ -9,9 +9,9 @@ import numpy as np
 from .checks import (find_missing_mode, fit_residual, fit_residual_noise_std, residual_noise_std, residual_structure,
                      restart_pole)
 from .circlefit import circle_fit_curve
-from .errors import IdentificationError, QualityWarning, ResolutionWarning, warn
-from .estimate.correction import remove_window_damping
-from .flags import CHI2_LIMIT, RELATIVE_MISFIT, lines_near_mode
+from .assemble import ModeEstimate, assemble_modes, driving_points
+from .errors import IdentificationError
+from .flags import BIAS_LIMIT, GRID_FLAGS, REL_STD_LIMIT, lines_near_mode, model_inadequate
 from .frf import FRF, KIND_POWER, line_spacing
 from .halfpower import half_power_curve
 from .model import mode_basis, solve_linear
@@ -19,7 +19,7 @@ from .nls import fit_modes, truncation_shift
 from .rational import rational_pole
 from .propagate import combine_poles, constant_covariance, magnitude_to_complex
 from .peaks import ModeBand, _indicator_and_peak, bands_from_hz, channel_sample, estimate_noise_std, find_modes
-from .results import FLAG_TEXT, IdentificationResult, ModeResult, ModeStd, correlation_of, physical_covariance, physical_parameters
+from .results import IdentificationResult
 from .units import TWO_PI
 
 __all__ = ["identify", "METHODS"]
@@ -27,17 +27,8 @@ __all__ = ["identify", "METHODS"]
 #: the band-wise methods (one band per mode) and all methods
 BANDWISE_METHODS = ("nls", "circle", "halfpower")
 METHODS = BANDWISE_METHODS + ("global",)
-#: relative standard error of ζ above which an estimate is flagged
-REL_STD_LIMIT = 0.1
-#: modal overlap 2·max(ζωn)/Δωn with a neighbour above which ``close_modes`` is raised:
-#: up to 1.5 the NLS errors match the scatter (SD of z 0.95 at 1.2, 1.15 at 1.5, over
-#: 100 seeds at 1.6 % noise); at 2 they are 2–4× optimistic (docs/stress.md finding 12)
-OVERLAP_LIMIT = 1.5
 #: channels (strongest first) used for the NLS start values
 START_CHANNELS = 8
-#: half-power and circle fits: an estimate further than this many of its own standard
-#: errors from the least-squares refinement of the same modes is flagged ``method_bias``
-BIAS_LIMIT = 3.0
 #: relative precision of the refinement's poles (the stopping rule of :func:`modal.nls.fit_modes`)
 REFINEMENT_PRECISION = 1e-13
 #: half-power and circle fits: the pole comes from at most this many strongest channels;
@@ -46,7 +37,6 @@ POLE_CHANNELS = 32
 #: a fit whose residual variance is more than this many times its line-to-line noise
 #: (checks.residual_structure) has a smooth misfit: its truncation shift is measured
 STRUCTURED_RATIO = 4.0
-_RESOLUTION_FLAGS = {"resolution_limited", "missing_crossing", "too_few_points"}
 
 
 def _combine(values, stds, weights):
@@ -217,7 +207,7 @@ def _combine_channels(omega, h, raw, const, flags, q, scale=None):
         wn_c = float(omega[np.argmax(np.abs(h).max(axis=0))])
         z_c = float(np.min(np.diff(omega)) / (2 * wn_c)) if omega.size > 1 else np.nan
         flags.add("too_few_points")
-    if flags & _RESOLUTION_FLAGS and omega.size > 1:
+    if flags & GRID_FLAGS and omega.size > 1:
         # grid quantisation is the same on every channel: it does not average down
         spacing = float(np.min(np.diff(omega)))
         floor = np.array([spacing / np.sqrt(12), spacing / (2 * wn_c)])
@@ -759,52 +749,6 @@ def _missing_mode(frf, bands, power, omega_n, damping_ratio, estimated_noise, re
                                  bands_rad, residual, residual_noise, peak)
 
 
-def _overlap(per_mode, index) -> float:
-    """Largest modal overlap 2·max(ζωn)/|Δωn| of mode ``index`` with any other mode."""
-    wn, zeta = per_mode[index][0], per_mode[index][1]
-    worst = 0.0
-    for other, m in enumerate(per_mode):
-        if other == index or not (np.isfinite(m[0]) and np.isfinite(m[1])):
-            continue
-        gap = abs(m[0] - wn)
-        width = 2 * max(zeta * wn, m[1] * m[0])
-        worst = max(worst, width / gap if gap > 0 else np.inf)
-    return worst
-
-
-def _physical(frf, wn, zeta, const, cov, driving, flags, reference=None):
-    """k, c, m, their standard errors and covariance (n_ch, 3, 3) of a mode; flags on the way.
-
-    ``reference`` (ωn, ζ, constants, covariance before the fold) of a biased estimate
-    (flag ``method_bias``): the difference of k, c, m from those of the reference is
-    folded into their covariance (exactly, not to first order: a rotated constant
-    changes |A| only to second order).
-    """
-    (k, c, m), _ = physical_parameters(wn, zeta, const)
-    cov_kcm = physical_covariance(wn, zeta, const, cov if reference is None else reference[3])
-    if reference is not None:
-        (k_r, c_r, m_r), _ = physical_parameters(*reference[:3])
-        diff = np.nan_to_num(np.stack([k - k_r, c - c_r, m - m_r], axis=-1))
-        cov_kcm = cov_kcm + diff[..., :, None] * diff[..., None, :]
-    const = np.asarray(const)
-    if driving.any():
-        dp_phase = np.abs(np.angle(const[driving]))
-        if np.any(dp_phase > np.deg2rad(10)) and np.all(const[driving].real > 0):
-            flags.add("complex_mode")
-        if np.any(const[driving].real <= 0):
-            flags.add("non_positive_constant")
-    undefined = ~driving | (const.real <= 0)
-    for arr in (k, c, m):
-        arr[undefined] = np.nan
-    cov_kcm[undefined] = np.nan
-    sk, sc, sm = (np.sqrt(np.maximum(cov_kcm[..., i, i], 0.0)) for i in range(3))
-    for arr in (sk, sc, sm):
-        arr[undefined] = np.nan
-    if (~driving).any():
-        flags.add("not_driving_point")
-    return (k, c, m), (sk, sc, sm), cov_kcm
-
-
 #: automatic choice: the global method for a poly-reference grid or at least this many peaks
 AUTO_GLOBAL_PEAKS = 5
 
@@ -945,12 +889,6 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
         noise = np.broadcast_to(np.asarray(noise_std, float), (n_ch,)).copy()
         if not np.all(np.isfinite(noise)) or np.any(noise < 0):
             raise IdentificationError(f"noise_std must be finite and >= 0, got {noise_std!r}")
-    if driving_point is None:
-        driving = frf.is_driving_point()
-    else:
-        driving = np.broadcast_to(np.asarray(driving_point, bool), (n_ch,)).copy()
-    assumed = driving_point is None and n_ch == 1 and frf.response_points is None
-
     per_mode = []  # (wn, zeta, const (n_ch,), cov (n_ch,4,4) or None, std_wn, std_z, flags, quality, chi2)
     if method in ("halfpower", "circle"):
         poles = []
@@ -985,15 +923,14 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
         for b, (band, (wn, zeta, s_wn, s_z, _, flags, q, _e), const, cov, reference) in enumerate(zip(
                 bands, poles, consts, errors, check)):
             d_wn, d_z, d_const, chi2, bound_wn, bound_z = reference
-            # inadequate where a user should act (as for nls: modal.flags.RELATIVE_MISFIT)
-            if np.isfinite(chi2) and chi2 > CHI2_LIMIT and not relative[b] <= RELATIVE_MISFIT:
+            if model_inadequate(chi2, relative[b]):
                 flags.add("model_inadequate")
             # the difference from the refinement has at most the variance of the two errors
             # together (equality when they are independent; less when both see the same noise)
             scale_wn = np.hypot(np.nan_to_num(s_wn), bound_wn)
             scale_z = np.hypot(np.nan_to_num(s_z), bound_z)
             pole_biased = abs(d_wn) > BIAS_LIMIT * scale_wn or abs(d_z) > BIAS_LIMIT * scale_z
-            noise_cov = cov.copy()  # k, c, m take the bias exactly (see _physical), not through it
+            noise_cov = cov.copy()  # k, c, m take the bias exactly (see modal.assemble.physical_with_flags), not through it
             if pole_biased:
                 # the method's own bias dominates its noise error: fold it into the errors, with
                 # the error of the refinement that measures it (its standard error, and at least
@@ -1061,9 +998,7 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
                 flags.add("too_few_points")  # no lines left over for a residual: no errors
             elif not np.all(np.isfinite(fit.mode_cov[r])):
                 flags.add("high_uncertainty")  # errors undetermined: the data do not determine a pole (nls.FISHER_RCOND)
-            # inadequate where a user should act: beyond the noise and beyond what a linear model explains
-            # of clean measured data (modal.flags.RELATIVE_MISFIT)
-            if np.isfinite(chi2) and chi2 > CHI2_LIMIT and not relative[b] <= RELATIVE_MISFIT:
+            if model_inadequate(chi2, relative[b]):
                 flags.add("model_inadequate")
             cov = fit.mode_cov[r] if shift is None else _with_shift(fit.mode_cov[r], shift[0][r], shift[1][r])
             s_wn = float(np.sqrt(max(cov[0, 0, 0], 0))) if np.isfinite(cov[0, 0, 0]) else np.nan
@@ -1073,8 +1008,7 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
                 flags.add("band_edge_peak")
             per_mode.append((wn, zeta, fit.modal_constant[r], cov, s_wn, s_z, flags, chi2, chi2, None))
 
-    decay_s = getattr(frf, "exponential_decay_s", None)
-    modes = []
+    estimates = []
     for index, (band, (wn, zeta, const, cov, s_wn, s_z, flags, quality, chi2, reference)) in enumerate(
             zip(bands, per_mode)):
         flags = set(flags)
@@ -1082,45 +1016,15 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
         if missing_mode is not None and (missing_mode.band == index or index in missing_mode.moved_bands):
             flags.add("missing_mode")
             detail["missing_mode"] = f" (near {missing_mode.frequency_hz:.6g} Hz, zeta {missing_mode.damping_ratio:.3g})"
-        const = np.asarray(const, complex)
-        if np.isfinite(s_z) and np.isfinite(zeta) and zeta > 0 and s_z / zeta > REL_STD_LIMIT:
-            flags.add("high_uncertainty")
-        if assumed:
-            flags.add("driving_point_assumed")
         omega_b = frf.omega_rad_s[_band_mask(frf, band)]
         spacing = line_spacing(omega_b) if omega_b.size > 1 else np.nan
-        lines_per_bw = 2 * zeta * wn / spacing if spacing > 0 else np.nan
-        others = [b.peak_hz for b in bands if b is not band and band.low_hz < b.peak_hz < band.high_hz]
-        if _overlap(per_mode, index) > OVERLAP_LIMIT:
-            others.append(index)
-        if others:
-            flags.add("close_modes")
-        window_zeta = 0.0
-        if decay_s is not None:
-            # the exponential window's damping out again (exact pole shift by 1/τ)
-            wn_measured, zeta_measured = wn, zeta
-            wn, zeta, cov, s_wn, s_z, window_zeta, valid = remove_window_damping(wn, zeta, cov, s_wn, s_z, decay_s)
-            if reference is not None:  # the same exact shift of the reference pole
-                reference = (reference[0] + wn - wn_measured, reference[1] + zeta - zeta_measured, *reference[2:])
-            if not valid:
-                flags.add("window_damping_dominates")
-        (k, c, m), (sk, sc, sm), cov_kcm = _physical(frf, wn, zeta, const, cov, driving, flags, reference)
-        s_const = np.sqrt(np.maximum(cov[:, 2, 2] + cov[:, 3, 3], 0))
-        single = frf.response.ndim == 1
-        sq = (lambda a: a.reshape(-1)[0].item()) if single else (lambda a: np.asarray(a))
-        std = ModeStd(s_wn / TWO_PI, s_z, sq(s_const), sq(sk), sq(sc), sq(sm))
-        flags_t = tuple(sorted(flags))
-        mode = ModeResult(
-            natural_frequency_hz=float(wn / TWO_PI), damping_ratio=float(zeta), modal_constant=sq(const),
-            stiffness_n_per_m=sq(k), damping_n_s_per_m=sq(c), mass_kg=sq(m), std=std, flags=flags_t,
-            method=method, band_hz=(band.low_hz, band.high_hz), n_lines=int(omega_b.size),
-            lines_per_bandwidth=float(lines_per_bw), chi2=chi2, driving_point=sq(driving), quality=quality,
-            window_damping_ratio=window_zeta, kcm_correlation=correlation_of(cov_kcm[0] if single else cov_kcm),
-        )
-        modes.append(mode)
-        serious = set(flags_t) - {"driving_point_assumed", "not_driving_point"}
-        if serious:
-            category = ResolutionWarning if serious & _RESOLUTION_FLAGS else QualityWarning
-            reasons = "; ".join(f"{f}: {FLAG_TEXT[f]}{detail.get(f, '')}" for f in sorted(serious))
-            warn(f"{frf.source}: {method} mode near {wn / TWO_PI:.6g} Hz is flagged ({reasons})", category)
+        if any(b is not band and band.low_hz < b.peak_hz < band.high_hz for b in bands):
+            flags.add("close_modes")  # another mode's peak inside this mode's band
+        estimates.append(ModeEstimate(
+            wn, zeta, np.asarray(const, complex), cov, s_wn, s_z, (band.low_hz, band.high_hz), int(omega_b.size),
+            2 * zeta * wn / spacing if spacing > 0 else np.nan, flags, detail, chi2, quality, reference))
+    driving, assumed = driving_points(frf, driving_point)
+    modes = assemble_modes(estimates, method=method, source=frf.source, single=frf.response.ndim == 1,
+                           driving=driving, driving_assumed=assumed,
+                           window_decay_s=getattr(frf, "exponential_decay_s", None))
     return IdentificationResult(tuple(modes), method, frf.kind, n_ch, noise_std=estimated_noise)

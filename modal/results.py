@@ -11,47 +11,10 @@ from typing import Any, Iterator
 
 import numpy as np
 
+from .flags import INFORMATIONAL, channel_flags
 from .units import TWO_PI
 
-__all__ = ["ModeStd", "ModeResult", "IdentificationResult", "physical_parameters", "physical_covariance", "correlation_of", "FLAG_TEXT"]
-
-#: Every quality flag with the reason it is raised.
-FLAG_TEXT = {
-    "resolution_limited": "fewer than 3 lines above the half-power level: damping is below what the lines resolve",
-    "missing_crossing": "a half-power (-3 dB) crossing is missing in the band",
-    "band_edge_peak": "the peak lies at the edge of the band: the band does not contain the resonance",
-    "too_few_points": "too few lines near resonance for this method",
-    "damping_pair_spread": "circle fit: the damping estimates from point pairs disagree by more than 10 %",
-    "model_inadequate": "residual is much larger than the noise (chi-square > 3) and more than 3 % of the data near the mode: the model does not explain the data (close modes, missing mode, nonlinearity)",
-    "high_uncertainty": ("standard error of the damping ratio exceeds 10 % of its value, or the errors are "
-                         "undetermined (the data do not determine this mode's pole apart from another's)"),
-    "did_not_converge": "least-squares refinement did not converge; the start values are reported",
-    "driving_point_assumed": "single-channel FRF without point ids: taken as a driving point",
-    "not_driving_point": "transfer FRF (response point differs from reference): k, c, m are not defined for it",
-    "complex_mode": "modal constant of a driving point is far from real (phase > 10 deg): k, c, m are approximate",
-    "non_positive_constant": "driving-point modal constant has a negative real part: k, c, m not defined",
-    "close_modes": ("another mode lies within this mode's fitting band, or overlaps it (2*zeta*wn/delta_wn > 1.5): "
-                    "the standard errors understate the scatter"),
-    "missing_mode": ("the residual holds another mode in or next to this band that peak detection missed (one more "
-                     "mode reduces it significantly, F-test at 1e-6), or this mode moves by more than 3 of its errors "
-                     "once that mode is in the model; the estimates are biased by it: give bands_hz for both modes "
-                     "or lower min_prominence_db"),
-    "window_damping_dominates": ("the exponential window's decay 1/tau is not below the mode's measured decay rate: "
-                                 "all its damping may be the window's, so it was not removed; use a longer tau"),
-    "weak_evidence": ("global: the pole is stable in fewer than half of the upper half of the model orders of the "
-                      "stabilisation diagram (or a modes_hz hint picked a pole stable in fewer than 3): a weakly excited mode or a "
-                      "noise pole; check the diagram and the shape before using it"),
-    "outside_band": ("global: the mode lies below the first resolvable lines or above the band: its parameters "
-                     "are extrapolated; widen the band or treat it as a residual"),
-    "rigid_body": ("global: the mode lies below a tenth of the next mode's frequency: a rigid-body or suspension "
-                   "mode of a free structure, not a flexible mode"),
-    "complex_shape": ("global: the modal constants are far from collinear in phase (MPC < 0.8): a complex mode, "
-                      "or noise/close modes; k, c, m and shape comparisons are approximate"),
-    "method_bias": ("half-power or circle estimate lies more than 3 of its standard errors from the least-squares "
-                    "refinement of the same modes (the method's own bias: line spacing, noise at the peak, "
-                    "a neighbouring mode); its standard errors include the difference, method 'nls' gives the refined values"),
-}
-
+__all__ = ["ModeStd", "ModeResult", "IdentificationResult", "physical_parameters", "physical_covariance", "correlation_of"]
 
 @dataclass(frozen=True)
 class ModeStd:
@@ -89,7 +52,7 @@ class ModeResult:
     std : ModeStd
         Standard errors of all the above.
     flags : tuple of str
-        Quality flags; see :data:`FLAG_TEXT`. Empty when the estimate is sound.
+        Quality flags; see :data:`modal.flags.FLAG_TEXT`. Empty when the estimate is sound.
     method : str
         ``"nls"``, ``"circle"`` or ``"halfpower"``.
     band_hz : tuple of float
@@ -179,8 +142,7 @@ class ModeResult:
     @property
     def ok(self) -> bool:
         """True when the estimate carries no flag other than informational ones."""
-        info = {"driving_point_assumed", "not_driving_point"}
-        return not (set(self.flags) - info)
+        return not (set(self.flags) - INFORMATIONAL)
 
 
 @dataclass(frozen=True)
@@ -258,8 +220,6 @@ class IdentificationResult:
 
     def rows(self) -> list[dict]:
         """One plain dict per mode and channel (JSON-ready; keys as the fields)."""
-        from .flags import channel_flags
-
         out = []
         names = ("modal_constant", "stiffness_n_per_m", "damping_n_s_per_m", "mass_kg")
         for number, mode in enumerate(self.modes, start=1):

@@ -188,13 +188,13 @@ def test_archive_without_frf_says_what_it_holds(tmp_path):
 # ---- item 3: each flag defined once, no result contradicts itself -------------------------------------------
 
 def test_every_flag_has_a_meaning_and_an_action_and_the_docs_table_is_current():
-    from modal.flags import FLAG_ACTION, flags_markdown
-    from modal.results import FLAG_TEXT
+    from modal.flag_table import flags_markdown
+    from modal.flags import FLAG_ACTION, FLAG_TEXT
 
     assert set(FLAG_ACTION) == set(FLAG_TEXT)
     assert all(text.strip() for text in FLAG_ACTION.values())
     docs = (ROOT / "docs" / "flags.md").read_text()
-    assert docs == flags_markdown(), "docs/flags.md is stale: run `python -m modal.flags > docs/flags.md`"
+    assert docs == flags_markdown(), "docs/flags.md is stale: run `python -m modal.flag_table > docs/flags.md`"
 
 
 def _all_results():

@@ -16,36 +16,27 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import IdentificationError, QualityWarning, ResolutionWarning, warn
-from ..flags import CHI2_LIMIT, RELATIVE_MISFIT, lines_near_mode
+from ..assemble import ModeEstimate, assemble_modes, driving_points
+from ..errors import IdentificationError
+from ..flags import MPC_LIMIT, RIGID_BODY_RATIO, WEAK_FRACTION, lines_near_mode, model_inadequate
 from ..frf import FRF, KIND_POWER
 from ..model import mode_basis, solve_linear
 from ..nls import fit_modes
 from ..peaks import estimate_noise_std, find_modes
-from ..results import FLAG_TEXT, IdentificationResult, ModeResult, ModeStd, correlation_of, physical_covariance, physical_parameters
+from ..results import IdentificationResult
 from ..units import TWO_PI
 from .plscf import plscf_poles
 from .stabilisation import outside_band_poles, select_poles, stabilisation
 
 __all__ = ["identify_global", "channel_grid", "mpc"]
 
-#: relative standard error of ζ above which a mode is flagged high_uncertainty
-REL_STD_LIMIT = 0.1
 #: poles up to this factor above the highest line enter the model (flagged outside_band): a mode just above
 #: the band is modelled far better by its pole than by the upper residual term
 BEYOND_BAND = 1.25
-#: a selected pole stable (in frequency) in fewer than this fraction of the swept orders has weak evidence
-WEAK_FRACTION = 0.5
-#: modal overlap 2·max(ζωn)/|Δωn| above which two modes are flagged close_modes (as band-wise)
-OVERLAP_LIMIT = 1.5
 #: relative pole step at which the first stage of the joint refinement stops (significance test) ...
 LOOSE_STEP_TOL = 1e-5
 #: ... and the final one (far below any standard error the data give, far above rounding)
 TIGHT_STEP_TOL = 1e-9
-#: MPC below which a mode's shape counts as complex
-MPC_LIMIT = 0.8
-#: a mode below this fraction of the next mode's frequency counts as a rigid-body / suspension mode
-RIGID_BODY_RATIO = 0.1
 
 
 def channel_grid(frf: FRF):
@@ -281,9 +272,6 @@ def identify_global(frf: FRF, *, modes_hz=None, order: int | None = None, max_or
              - np.outer(kind_factor / omega**2, residuals[:, 1])).T
     misfit = H - model
 
-    driving = (work.is_driving_point() if driving_point is None
-               else np.broadcast_to(np.asarray(driving_point, bool), (n_ch,)).copy())
-    assumed = driving_point is None and n_ch == 1 and work.response_points is None
     spacing = float(np.median(np.diff(work.frequency_hz)))
     order_of = np.argsort(fit.omega_n)
     # shapes and MPC per column of the pLSCF matrix: per reference, or, transposed by reciprocity
@@ -291,8 +279,9 @@ def identify_global(frf: FRF, *, modes_hz=None, order: int | None = None, max_or
     ref_of_channel = np.zeros(n_ch, int)
     for r in range(m):
         ref_of_channel[index[:, r]] = r
-    modes = []
-    for rank, r in enumerate(order_of):
+    single = frf.response.ndim == 1
+    estimates = []
+    for r in order_of:
         wn, zeta = float(fit.omega_n[r]), float(fit.damping_ratio[r])
         pole = selected[int(np.argmin(np.abs(wn0 - wn)))]
         cov = fit.mode_cov[r]
@@ -301,21 +290,12 @@ def identify_global(frf: FRF, *, modes_hz=None, order: int | None = None, max_or
         if not fit.converged:
             flags.add("did_not_converge")
         chi2, relative = _local_misfit(omega, H, misfit, noise, wn, zeta)
-        # inadequate where a user should act: the misfit near the mode exceeds the noise (chi-square) and is
-        # more than RELATIVE_MISFIT of the data there. Clean real data (data/real beam: 1-2 % misfit at
-        # 170-33 000 times a noise the lines hardly show) is explained as well as a linear model can
-        if np.isfinite(chi2) and chi2 > CHI2_LIMIT and relative > RELATIVE_MISFIT:
+        # Clean real data (data/real beam: 1-2 % misfit at 170-33 000 times a noise the lines hardly show)
+        # is explained as well as a linear model can: the relative misfit keeps it unflagged
+        if model_inadequate(chi2, relative):
             flags.add("model_inadequate")
-        others = np.delete(fit.omega_n, r)
-        if others.size:
-            gap = np.min(np.abs(others - wn))
-            partner = np.delete(fit.damping_ratio * fit.omega_n, r)[np.argmin(np.abs(others - wn))]
-            if gap == 0 or 2 * max(zeta * wn, partner) / gap > OVERLAP_LIMIT:
-                flags.add("close_modes")
         s_wn = float(np.sqrt(max(cov[0, 0, 0], 0))) if np.isfinite(cov[0, 0, 0]) else np.nan
         s_z = float(np.sqrt(max(cov[0, 1, 1], 0))) if np.isfinite(cov[0, 1, 1]) else np.nan
-        if np.isfinite(s_z) and zeta > 0 and s_z / zeta > REL_STD_LIMIT:
-            flags.add("high_uncertainty")
         if pole.n_stable_orders < WEAK_FRACTION * pole.n_orders or (pole.hinted and pole.n_stable_orders < 3):
             flags.add("weak_evidence")
         fn = wn / TWO_PI
@@ -336,36 +316,16 @@ def identify_global(frf: FRF, *, modes_hz=None, order: int | None = None, max_or
         mode_mpc = float(np.mean(values)) if values else float("nan")
         if np.isfinite(mode_mpc) and mode_mpc < MPC_LIMIT:
             flags.add("complex_shape")
-        (k, c, mass), (sk, sc, sm) = physical_parameters(wn, zeta, const, cov)
-        cov_kcm = physical_covariance(wn, zeta, const, cov)
-        dp = np.asarray(driving, bool)
-        if dp.any() and np.any(const[dp].real <= 0):
-            flags.add("non_positive_constant")
-        undefined = ~dp | (const.real <= 0)
-        for arr in (k, c, mass, sk, sc, sm):
-            arr[undefined] = np.nan
-        cov_kcm[undefined] = np.nan
-        if (~dp).any():
-            flags.add("not_driving_point")
-        if assumed:
-            flags.add("driving_point_assumed")
-        s_const = np.sqrt(np.maximum(cov[:, 2, 2] + cov[:, 3, 3], 0))
-        single = frf.response.ndim == 1
-        sq = (lambda a: a.reshape(-1)[0].item()) if single else (lambda a: np.asarray(a))
-        std = ModeStd(s_wn / TWO_PI, s_z, sq(s_const), sq(sk), sq(sc), sq(sm))
-        modes.append(ModeResult(
-            natural_frequency_hz=fn, damping_ratio=zeta, modal_constant=sq(const), stiffness_n_per_m=sq(k),
-            damping_n_s_per_m=sq(c), mass_kg=sq(mass), std=std, flags=tuple(sorted(flags)), method="global",
-            band_hz=(float(work.frequency_hz[0]), float(work.frequency_hz[-1])), n_lines=int(work.n_freq),
-            lines_per_bandwidth=2 * zeta * fn / spacing if spacing > 0 else np.nan, chi2=chi2,
-            driving_point=sq(dp), quality=pole.n_stable_orders / max(pole.n_orders, 1),
-            mode_shape=shapes[0] if single else shapes, participation=np.asarray(pole.participation),
-            mpc=mode_mpc, kcm_correlation=correlation_of(cov_kcm[0] if single else cov_kcm)))
-        serious = set(flags) - {"driving_point_assumed", "not_driving_point"}
-        if serious:
-            category = ResolutionWarning if "outside_band" in serious else QualityWarning
-            reasons = "; ".join(f"{f}: {FLAG_TEXT[f]}" for f in sorted(serious))
-            warn(f"{src}: global mode near {fn:.6g} Hz is flagged ({reasons})", category)
+        estimates.append(ModeEstimate(
+            wn, zeta, const, cov, s_wn, s_z, (float(work.frequency_hz[0]), float(work.frequency_hz[-1])),
+            int(work.n_freq), 2 * zeta * fn / spacing if spacing > 0 else np.nan, flags, chi2=chi2,
+            quality=pole.n_stable_orders / max(pole.n_orders, 1), mode_shape=shapes[0] if single else shapes,
+            participation=np.asarray(pole.participation), mpc=mode_mpc))
+    driving, assumed = driving_points(work, driving_point)
+    # complexity is judged by the shapes' MPC (complex_shape), not by a driving point's phase; the global
+    # fit does not take an exponential window's damping out of the poles
+    modes = assemble_modes(estimates, method="global", source=src, single=single, driving=driving,
+                           driving_assumed=assumed, phase_check=False)
     settings = {"orders": [int(orders[0]), int(orders[-1])], "references": [str(r) for r in references],
                 "transposed_by_reciprocity": bool(transposed),
                 "band_hz": [float(work.frequency_hz[0]), float(work.frequency_hz[-1])],

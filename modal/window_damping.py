@@ -9,13 +9,16 @@ the residues stay. So the true pole is the identified one moved right by 1/τ
 
 The modal constants are unchanged (so is m = 1/|A|); k and c follow from the
 corrected ωn and ζ. Covariances go through the Jacobian of the map.
+
+The correction acts on identified poles and their covariances, so it lives with
+identification (:func:`modal.assemble.assemble_modes` applies it); the FRF only
+carries the fact it needs, the window's τ (:attr:`modal.frf.FRF.exponential_decay_s`).
 """
 from __future__ import annotations
 
 import numpy as np
 
 __all__ = ["remove_window_damping"]
-
 
 
 def remove_window_damping(omega_n: float, damping_ratio: float, cov: np.ndarray, std_omega_n: float,
