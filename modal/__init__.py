@@ -12,7 +12,7 @@ from .errors import (
     ResolutionWarning,
 )
 
-__version__ = "0.1.0"
+from ._version import __version__  # noqa: E402
 #: Identifies this toolkit's ``modal`` (an unrelated PyPI package has the same import name).
 __toolkit_id__ = "modalbal"
 from .frf import FRF, FRF_KINDS  # noqa: E402

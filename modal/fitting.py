@@ -113,7 +113,7 @@ class FitOptions:
 
     def settings_json(self) -> str:
         """Canonical JSON of :meth:`settings` with the toolkit version (what a result depends on)."""
-        from . import __version__
+        from ._version import __version__
 
         return json.dumps({"options": self.settings(), "modalbal": __version__}, sort_keys=True)
 

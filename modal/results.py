@@ -66,7 +66,7 @@ class ModeResult:
         the data; NaN when not computed). The noise is estimated without the
         model: each line against the straight line through its neighbours, on
         the raw data and on the residual, the smaller of the two
-        (:func:`modal.checks.residual_noise_std`). The median over the channels
+        (:func:`modal.sdof.checks.residual_noise_std`). The median over the channels
         (for ``"nls"`` with more than 128 channels, over a fixed random sample
         of 128: :func:`modal.peaks.channel_sample`).
     driving_point : bool or ndarray of bool

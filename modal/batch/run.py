@@ -189,7 +189,7 @@ def chunk_size(n_files: int, n_workers: int) -> int:
 def _fit_pending(pending, options, hashes, client, workers, store, done, statuses, bar) -> Iterator[Outcome]:
     from distributed import as_completed
 
-    from .. import __version__
+    from .._version import __version__
     from .cluster import open_client
     from .task import fit_and_store
 

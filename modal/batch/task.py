@@ -62,7 +62,7 @@ def fit_and_store(paths: list[str], options: FitOptions, hashes: list[str], arch
     :class:`Entry` per file (small: the table rows and where the result is, or the result itself when
     it is not stored). A worker with another version of the toolkit than the client's
     (``client_version``) fits nothing: every file fails with that reason (and a rerun tries again)."""
-    from .. import __version__
+    from .._version import __version__
 
     if client_version is not None and client_version != __version__:
         error = (f"worker has modalbal {__version__}, the client {client_version}; expected the same version on "

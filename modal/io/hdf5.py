@@ -209,7 +209,7 @@ def write_root_attrs(h5file, created: str | None = None) -> None:
     once: a variable-length string overwritten leaves its old bytes in the file's
     global heap, so two archives written a second apart would differ there.
     """
-    from .. import __version__
+    from .._version import __version__
 
     h5file.attrs["schema"] = SCHEMA
     h5file.attrs["schema_version"] = SCHEMA_VERSION

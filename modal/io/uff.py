@@ -426,7 +426,7 @@ def write_frf_uff(frf: FRF, path: str | os.PathLike, binary: bool = False) -> No
     """
     import pyuff
 
-    from .. import __version__
+    from .._version import __version__
 
     src = source_name(path)
     freq = np.asarray(frf.frequency_hz, dtype=float)

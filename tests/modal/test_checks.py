@@ -1,7 +1,7 @@
 """The fit's residual: its noise (residual_noise_std), whiteness (residual_structure), truncation."""
 import numpy as np
 
-from modal.checks import residual_noise_std, residual_structure
+from modal.sdof.checks import residual_noise_std, residual_structure
 from modal.nls import fit_modes, truncation_shift
 from modal.peaks import estimate_noise_std
 from modal.synthetic import add_noise, modal_frf
@@ -46,7 +46,7 @@ def test_noise_level_of_a_residual_energy_is_one_for_noise():
     # white noise averaged over n channels the level must be 1 whatever n (it took ln 2 as the
     # median for every n, so eight channels read 1.39 and the screen went deaf by that much).
     # 4000 lines: the median's relative scatter is ≈ 1.25/sqrt(4000·n) ≤ 0.02, so 0.08 is four
-    from modal.checks import _level
+    from modal.sdof.checks import _level
 
     rng = np.random.default_rng(4)
     for n_channels in (1, 2, 8):
@@ -100,7 +100,7 @@ def test_missing_mode_check_channels_are_not_chosen_by_their_noise_estimates_luc
     # missing-mode screen then reads noise as residual. The check's channels must be an unbiased draw:
     # their mean σ²-estimate within 4 standard errors (4 s/sqrt(8)) of all channels' mean. The old
     # ranking misses that by far, which shows the test can fail.
-    from modal.checks import CHECK_CHANNELS, _check_channels, _strongest
+    from modal.sdof.checks import CHECK_CHANNELS, _check_channels, _strongest
     from modal.peaks import neighbour_noise_std
 
     rng = np.random.default_rng(7)
@@ -121,7 +121,7 @@ def test_missing_mode_check_channels_are_not_chosen_by_their_noise_estimates_luc
 def test_missing_mode_check_channels_leave_out_a_loud_but_much_noisier_channel():
     # the highest peak, but its σ 10x the others' (peak/σ a fifth of the best): not among the chosen,
     # which are the next-highest peaks; with eight channels or fewer all are used
-    from modal.checks import CHECK_CHANNELS, _check_channels
+    from modal.sdof.checks import CHECK_CHANNELS, _check_channels
 
     peak = np.array([5.0] + [1.0 + 0.1 * k for k in range(20)])
     noise = np.array([0.1] + [0.01] * 20)

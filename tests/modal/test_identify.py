@@ -6,7 +6,7 @@ import pytest
 
 import modal
 from modal import QualityWarning, ResolutionWarning, identify
-from modal.checks import find_missing_mode
+from modal.sdof.checks import find_missing_mode
 from modal.identify import BANDWISE_METHODS
 from modal.model import cramer_rao_sdof
 from modal.nls import fit_modes
@@ -564,7 +564,7 @@ def test_one_invalid_pole_leaves_the_refinement_check_to_the_others():
     # stress finding 25: at 16 % noise half-power gave one mode ζ < 0; the refinement check
     # then stood down for every mode of the fit, and a neighbour 46 of its errors off went
     # unflagged. The invalid pole now starts the refinement from its band.
-    from modal.identify import _refinement_check
+    from modal.sdof.quality import refinement_check
     from modal.peaks import bands_from_hz, estimate_noise_std
 
     f = np.linspace(80, 180, 2001)
@@ -575,7 +575,7 @@ def test_one_invalid_pole_leaves_the_refinement_check_to_the_others():
     poles = [(two_pi * 100.3, 0.012, 1e-3, 1e-4, None, set(), 1.0),   # 0.3 % and 20 % off
              (two_pi * 150.0, -0.01, 1e-3, 1e-4, None, set(), 1.0)]   # not a pole at all
     consts = np.ones((2, 1), complex)
-    check, _ = _refinement_check(frf, bands, 0, poles, consts, noise, noise)
+    check, _ = refinement_check(frf, bands, 0, poles, consts, noise, noise)
     d_wn, d_z, _, _, std_wn_ref, std_z_ref = check[0]
     assert std_wn_ref > 0 and std_z_ref > 0  # the first mode has its reference
     # the refined pole is the truth to its error (1 % noise, ~240 lines: ~1e-3 Hz, ~1e-5 in ζ),

@@ -1,4 +1,4 @@
-"""The one-mode rational start (modal.rational) and the NLS start that uses it."""
+"""The one-mode rational start (modal.sdof.rational) and the NLS start that uses it."""
 import importlib
 
 import numpy as np
@@ -6,9 +6,9 @@ import pytest
 
 from modal import FRF, identify
 from modal.model import mode_basis
-from modal.rational import rational_pole
+from modal.sdof.rational import rational_pole
 
-identify_module = importlib.import_module("modal.identify")
+starts_module = importlib.import_module("modal.sdof.starts")
 
 
 def band(power, offset=0.0, noise=0.0, seed=0, n_channels=1):
@@ -53,14 +53,14 @@ def test_nls_falls_back_to_the_careful_start_when_the_quick_one_gives_no_pole(mo
     frf = FRF(omega / (2 * np.pi), h[0], kind="receptance")
     quick = identify(frf, "nls", bands_hz=[(90.0, 110.0)])
     calls = []
-    original = identify_module._start_pole
+    original = starts_module.start_pole
 
     def counting(*args):
         calls.append(args)
         return original(*args)
 
-    monkeypatch.setattr(identify_module, "_quick_start", lambda *args: None)
-    monkeypatch.setattr(identify_module, "_start_pole", counting)
+    monkeypatch.setattr(starts_module, "quick_start", lambda *args: None)
+    monkeypatch.setattr(starts_module, "start_pole", counting)
     careful = identify(frf, "nls", bands_hz=[(90.0, 110.0)])
     assert calls, "the half-power and circle start was not used"
     # one least-squares optimum: both starts reach it (to the fit's stopping rule, 1e-13 relative step)

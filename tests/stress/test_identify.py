@@ -457,13 +457,17 @@ def test_circle_fit_fallback_stays_within_the_selected_lines():
 
 def test_channel_combination_does_not_underflow():
     """Stress finding 2 (fixed in 5e4b387): 1/max(std, 1e-300)**2 overflowed to a division by zero."""
-    from modal.identify import _combine
+    from modal.sdof.propagate import combine_poles
 
+    theta = np.array([[100.0, 0.1], [100.0, 0.1]])
+    # one channel's errors far below any other's: 1e-200 squares to a variance that underflows to 0
+    cov = np.array([np.diag([1e-200, 1e-200]) ** 2, np.diag([1e-3, 1e-3]) ** 2])
     with warnings.catch_warnings():
         warnings.simplefilter("error", RuntimeWarning)
-        value, std = _combine(np.array([0.1, 0.1]), np.array([1e-200, 1e-3]), np.array([1.0, 1.0]))
-    # the inverse-variance combination is dominated by the tiny error; it must stay finite and > 0
-    assert value == 0.1 and np.isfinite(std) and 0 < std < 1e-150
+        value, covariance, gain = combine_poles(theta, cov, np.array([1.0, 1.0]))
+    # the channel without a usable error is left out; the combination stays finite and > 0
+    assert np.allclose(value, [100.0, 0.1], rtol=1e-12, atol=0)
+    assert np.all(np.isfinite(covariance)) and np.all(np.diag(covariance) > 0)
 
 
 # --------------------------------------------------------------------------- well-posed cases

@@ -163,7 +163,7 @@ for stage, path in {pickled!r}.items():
     with os.fdopen(read) as report:
         out[stage] = json.loads(report.read() or '"no report"')
     os.wait()
-out["toolkit"] = sorted(m for m in ("modal.identify", "modal.checks", "modal.nls", "scipy.special", "h5py")
+out["toolkit"] = sorted(m for m in ("modal.identify", "modal.sdof.checks", "modal.nls", "scipy.special", "h5py")
                         if m in sys.modules)
 print(json.dumps(out))
 """

@@ -34,11 +34,11 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import special
 
-from .frf import line_spacing
-from .model import mode_basis, solve_linear
-from .nls import fit_modes
-from .peaks import neighbour_noise_std
-from .units import TWO_PI
+from ..frf import line_spacing
+from ..model import mode_basis, solve_linear
+from ..nls import fit_modes
+from ..peaks import neighbour_noise_std
+from ..units import TWO_PI
 
 __all__ = [
     "MissingMode", "find_missing_mode", "fit_residual", "fit_residual_noise_std", "residual_noise_std",

@@ -1,8 +1,8 @@
 """Standard errors of the single-mode methods (half-power, circle fit), propagated to first order.
 
 Each channel's estimate is a function of that channel's lines; its linearisation
-(:attr:`modal.halfpower.HalfPowerEstimate.jacobian`,
-:attr:`modal.circlefit.CircleEstimate.jacobian`) times the noise of the lines
+(:attr:`modal.sdof.halfpower.HalfPowerEstimate.jacobian`,
+:attr:`modal.sdof.circlefit.CircleEstimate.jacobian`) times the noise of the lines
 (white circular noise σ: σ²/2 on the real and on the imaginary part of each line,
 independent) gives the covariance of that estimate. Here the channels' poles are
 combined and the modal constants that are solved linearly with the poles get
@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .model import mode_basis
+from ..model import mode_basis
 
 __all__ = ["magnitude_to_complex", "combine_poles", "constant_covariance"]
 

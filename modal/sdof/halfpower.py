@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .model import mode_basis
+from ..model import mode_basis
 
 __all__ = ["HalfPowerEstimate", "half_power_curve", "invert_half_power"]
 

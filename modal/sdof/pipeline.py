@@ -1,0 +1,232 @@
+"""The band-wise methods, one mode per band: half-power, circle fit and least squares (``"nls"``).
+
+:func:`identify_bands` runs one method on given bands, in one sequence:
+
+1. the noise per channel: the FRF's own per line (an estimate from time data), the
+   caller's, or the raw-data estimate;
+2. the method's poles and modal constants (:mod:`modal.sdof.estimates` for half-power
+   and circle, :mod:`modal.sdof.refine` for least squares) with their covariance;
+3. its checks (:mod:`modal.sdof.quality`): chi-square and misfit near each mode, a
+   mode the bands missed and, for half-power and circle, the distance from the
+   least-squares refinement of the same modes (a bias beyond the errors is folded
+   into them, flag ``method_bias``);
+4. the results, through :func:`modal.assemble.assemble_modes`.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..assemble import ModeEstimate, assemble_modes, driving_points
+from ..errors import IdentificationError
+from ..flags import BIAS_LIMIT, model_inadequate
+from ..frf import KIND_POWER, line_spacing
+from ..peaks import channel_sample
+from ..results import IdentificationResult
+from ..units import TWO_PI
+from .bands import POLE_CHANNELS, band_data, band_mask, band_noise, band_peaks, constants_at_poles, strongest_channels
+from .checks import fit_residual, fit_residual_noise_std
+from .estimates import bandwise_covariance, rescaled, sdof_estimates, without_neighbours
+from .quality import chi2_of, constant_distance, fit_noise, local_misfit, missing_mode_in_bands, refinement_check
+from .refine import nls_fit, truncation, with_shift
+
+__all__ = ["BANDWISE_METHODS", "identify_bands"]
+
+#: the band-wise methods (one band per mode)
+BANDWISE_METHODS = ("nls", "circle", "halfpower")
+#: relative precision of the refinement's poles (the stopping rule of :func:`modal.nls.fit_modes`)
+REFINEMENT_PRECISION = 1e-13
+
+
+def identify_bands(frf, method: str, bands, *, raw_noise: np.ndarray, noise_std=None,
+                   driving_point=None) -> IdentificationResult:
+    """Identify one mode per band with a band-wise method.
+
+    Parameters
+    ----------
+    frf : FRF
+    method : {"nls", "circle", "halfpower"}
+    bands : list of ModeBand
+        One band per mode, in increasing frequency (:func:`modal.peaks.find_modes`,
+        :func:`modal.peaks.bands_from_hz`).
+    raw_noise : ndarray, shape (n_channels,)
+        The raw-data noise estimate per channel (:func:`modal.peaks.estimate_noise_std`).
+    noise_std : float or array_like over channels, optional
+        Known noise σ per channel (finite, >= 0); default: the FRF's own per line, else ``raw_noise``.
+    driving_point : bool or array_like of bool, optional
+        Overrides which channels are driving points.
+    """
+    power = KIND_POWER[frf.kind]
+    n_ch = frf.n_channels
+    estimated_noise = raw_noise
+    # an FRF estimated from time data carries its own calibrated noise per line (modal.estimate_frf)
+    line_noise = getattr(frf, "noise_std", None)
+    known_noise = noise_std is None and line_noise is not None
+    if known_noise:
+        estimated_noise = band_noise(frf, bands, line_noise)
+    if noise_std is None:
+        noise = estimated_noise
+    else:
+        noise = np.broadcast_to(np.asarray(noise_std, float), (n_ch,)).copy()
+        if not np.all(np.isfinite(noise)) or np.any(noise < 0):
+            raise IdentificationError(f"noise_std must be finite and >= 0, got {noise_std!r}")
+    if method in ("halfpower", "circle"):
+        estimates, missing_mode = _single_mode_fits(frf, bands, power, method, noise, estimated_noise, known_noise,
+                                                    rescale=noise_std is None and not known_noise)
+    else:
+        estimates, missing_mode = _least_squares_fits(frf, bands, power, noise, estimated_noise, known_noise)
+    for index, (band, estimate) in enumerate(zip(bands, estimates)):
+        if missing_mode is not None and (missing_mode.band == index or index in missing_mode.moved_bands):
+            estimate.flags.add("missing_mode")
+            estimate.details["missing_mode"] = (f" (near {missing_mode.frequency_hz:.6g} Hz, "
+                                                f"zeta {missing_mode.damping_ratio:.3g})")
+        if any(b is not band and band.low_hz < b.peak_hz < band.high_hz for b in bands):
+            estimate.flags.add("close_modes")  # another mode's peak inside this mode's band
+    driving, assumed = driving_points(frf, driving_point)
+    modes = assemble_modes(estimates, method=method, source=frf.source, single=frf.response.ndim == 1,
+                           driving=driving, driving_assumed=assumed,
+                           window_decay_s=getattr(frf, "exponential_decay_s", None))
+    return IdentificationResult(modes, method, frf.kind, n_ch, noise_std=estimated_noise)
+
+
+def _estimate(frf, band, wn, zeta, const, cov, s_wn, s_z, flags, chi2, quality, reference=None) -> ModeEstimate:
+    """A band's mode as a :class:`~modal.assemble.ModeEstimate` (its band, lines and resolution with it)."""
+    omega_b = frf.omega_rad_s[band_mask(frf, band)]
+    spacing = line_spacing(omega_b) if omega_b.size > 1 else np.nan
+    return ModeEstimate(wn, zeta, np.asarray(const, complex), cov, s_wn, s_z, (band.low_hz, band.high_hz),
+                        int(omega_b.size), 2 * zeta * wn / spacing if spacing > 0 else np.nan, set(flags),
+                        chi2=chi2, quality=quality, reference=reference)
+
+
+def _single_mode_fits(frf, bands, power, method, noise, estimated_noise, known_noise, rescale):
+    """Half-power or circle estimates of every band's mode, checked against their least-squares refinement.
+
+    ``rescale``: the errors follow the noise the refinement's residual shows (the noise was not given).
+    Returns the modes' :class:`~modal.assemble.ModeEstimate` and the missing mode found, or None.
+    """
+    n_ch = frf.n_channels
+    poles = []
+    for band in bands:
+        strongest = None
+        if n_ch > POLE_CHANNELS:
+            strongest = strongest_channels(frf, band, noise, POLE_CHANNELS)
+        poles.append(sdof_estimates(frf, band, power, noise, method, strongest))
+    if method == "halfpower" and len(bands) > 1:
+        poles = without_neighbours(frf, bands, power, noise, poles)
+    consts = np.array([p[4] for p in poles])  # (n_modes, n_ch)
+    missing = ~np.isfinite(consts)
+    if method == "halfpower":
+        # half-power gives poles only: every constant from one solve with all the poles
+        # (a peak-height constant ignores the neighbours' contribution)
+        missing[:] = True
+    if missing.any():
+        filled = constants_at_poles(frf, bands, power, [p[0] for p in poles], [p[1] for p in poles])
+        consts[missing] = filled[missing]
+    refined = {}
+    check, missing_mode = refinement_check(frf, bands, power, poles, consts, noise, estimated_noise, known_noise,
+                                           refined)
+    if rescale:
+        poles = rescaled(frf, bands, power, poles, noise, refined.get("noise_var"))
+    errors = bandwise_covariance(frf, bands, power, poles, noise, ~missing if method == "circle" else None)
+    # the misfit near each mode of the refined model (the model whose chi-square is tested)
+    refined_poles = np.array([[p[0] - c[0], p[1] - c[1]] for p, c in zip(poles, check)], float)
+    usable = np.all(np.isfinite(refined_poles), axis=1) & np.all(refined_poles > 0, axis=1)
+    relative = np.full(len(bands), np.nan)
+    if usable.all():
+        relative = local_misfit(frf, bands, power, refined_poles[:, 0], refined_poles[:, 1])
+    estimates = []
+    for b, (band, (wn, zeta, s_wn, s_z, _, flags, q, _e), const, cov, reference) in enumerate(zip(
+            bands, poles, consts, errors, check)):
+        d_wn, d_z, d_const, chi2, bound_wn, bound_z = reference
+        if model_inadequate(chi2, relative[b]):
+            flags.add("model_inadequate")
+        # the difference from the refinement has at most the variance of the two errors
+        # together (equality when they are independent; less when both see the same noise)
+        scale_wn = np.hypot(np.nan_to_num(s_wn), bound_wn)
+        scale_z = np.hypot(np.nan_to_num(s_z), bound_z)
+        pole_biased = abs(d_wn) > BIAS_LIMIT * scale_wn or abs(d_z) > BIAS_LIMIT * scale_z
+        noise_cov = cov.copy()  # k, c, m take the bias exactly (modal.assemble.physical_with_flags), not through it
+        if pole_biased:
+            # the method's own bias dominates its noise error: fold it into the errors, with
+            # the error of the refinement that measures it (its standard error, and at least
+            # its stopping rule, relative step 1e-13: on exact data its actual error is that
+            # rounding, 30x its rounding-level standard error)
+            fold_wn = abs(d_wn) + np.hypot(bound_wn, REFINEMENT_PRECISION * abs(wn - d_wn))
+            fold_z = abs(d_z) + np.hypot(bound_z, REFINEMENT_PRECISION * abs(zeta - d_z))
+            cov[:, 0, 0] += fold_wn**2
+            cov[:, 1, 1] += fold_z**2
+            s_wn = float(np.hypot(np.nan_to_num(s_wn), fold_wn))
+            s_z = float(np.hypot(np.nan_to_num(s_z), fold_z))
+        # modal constants against each channel's own error (the circle's come from its
+        # geometry, which a neighbour bends even when the pole passes)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            z_const = constant_distance(d_const, cov[:, 2:, 2:], REFINEMENT_PRECISION * np.abs(const - d_const))
+        const_biased = pole_biased | (z_const > BIAS_LIMIT)
+        # biased: the difference is added to the covariance along it
+        diff = np.column_stack([d_const.real, d_const.imag])
+        extra = np.where(const_biased, 1.0, 0.0)
+        cov[:, 2:, 2:] += extra[:, None, None] * diff[:, :, None] * diff[:, None, :]
+        finite = z_const[np.isfinite(z_const)]
+        if pole_biased or (finite.size and np.median(finite) > BIAS_LIMIT):
+            flags.add("method_bias")
+        reference = None
+        if pole_biased or np.any(const_biased):
+            reference = (wn - d_wn, zeta - d_z, np.where(const_biased, const - d_const, const), noise_cov)
+        estimates.append(_estimate(frf, band, wn, zeta, const, cov, s_wn, s_z, flags, chi2, q, reference))
+    return estimates, missing_mode
+
+
+def _least_squares_fits(frf, bands, power, noise, estimated_noise, known_noise):
+    """The joint least-squares fit of every band's mode (method ``"nls"``) and its checks.
+
+    Returns the modes' :class:`~modal.assemble.ModeEstimate` and the missing mode found, or None.
+    """
+    data = band_data(frf, bands)  # the lines of the bands, taken out once
+    band_peak = band_peaks(bands, data)
+    fit = nls_fit(frf, bands, power, noise, data, band_peak)
+    # the checks all measure the residual of the same modes on the same lines: the fit's own when it is
+    # unweighted (no second solve), else computed once
+    own = fit.residual is not None and not fit.line_weighted
+    if own:
+        residual = fit.residual
+    else:
+        with np.errstate(all="ignore"):
+            residual = fit_residual(data[0], data[1], power, data[2], fit.omega_n, fit.damping_ratio)
+    # χ² is a median over the channels: many channels are sampled (peaks.channel_sample)
+    rows = channel_sample(frf.n_channels)
+    if known_noise:
+        residual_noise = estimated_noise[rows]
+    elif own:
+        with np.errstate(all="ignore"):
+            residual_noise = fit_residual_noise_std(data[0], fit, estimated_noise[rows], rows)
+    else:
+        residual_noise = fit_noise(frf, bands, power, fit.omega_n, fit.damping_ratio, estimated_noise,
+                                   residual=residual, data=data)[rows]
+    chi2 = chi2_of(fit.noise_var[rows], residual_noise)
+    # the check's noise is the residual's own (of every channel, when at hand; else it measures its own)
+    missing_mode = missing_mode_in_bands(frf, bands, power, fit.omega_n, fit.damping_ratio, estimated_noise, residual,
+                                         None if known_noise or isinstance(rows, np.ndarray) else residual_noise,
+                                         data, fit.channel_scale)
+    # near-exact data: the offset's truncation (modes outside the bands) biases the poles
+    # beyond their white-noise errors; its measured shift is added to them
+    shift = truncation(frf, bands, power, fit, residual=residual, data=data)
+    order = np.argsort(fit.omega_n)  # two close poles may cross during the fit
+    relative = local_misfit(frf, bands, power, fit.omega_n[order], fit.damping_ratio[order], data, band_peak)
+    estimates = []
+    for b, (band, r) in enumerate(zip(bands, order)):
+        flags: set[str] = set()
+        if not fit.converged:
+            flags.add("did_not_converge")
+        if not np.all(np.isfinite(fit.noise_var)):
+            flags.add("too_few_points")  # no lines left over for a residual: no errors
+        elif not np.all(np.isfinite(fit.mode_cov[r])):
+            flags.add("high_uncertainty")  # errors undetermined: the data do not determine a pole (nls.FISHER_RCOND)
+        if model_inadequate(chi2, relative[b]):
+            flags.add("model_inadequate")
+        cov = fit.mode_cov[r] if shift is None else with_shift(fit.mode_cov[r], shift[0][r], shift[1][r])
+        s_wn = float(np.sqrt(max(cov[0, 0, 0], 0))) if np.isfinite(cov[0, 0, 0]) else np.nan
+        s_z = float(np.sqrt(max(cov[0, 1, 1], 0))) if np.isfinite(cov[0, 1, 1]) else np.nan
+        wn, zeta = float(fit.omega_n[r]), float(fit.damping_ratio[r])
+        if not (band.low_hz <= wn / TWO_PI <= band.high_hz):
+            flags.add("band_edge_peak")
+        estimates.append(_estimate(frf, band, wn, zeta, fit.modal_constant[r], cov, s_wn, s_z, flags, chi2, chi2))
+    return estimates, missing_mode
