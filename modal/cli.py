@@ -14,7 +14,8 @@ import warnings
 from pathlib import Path
 
 
-from .cli_time import add_time_options, frf_from_time, save_time_plots
+from .cli_time import add_time_options, save_time_plots
+from .time_frf import frf_from_time
 from .errors import ModalError
 from .frf import FRF_KINDS
 from .report import jsonable
@@ -113,7 +114,7 @@ def _fit(args) -> int:
     from .fitting import FitOptions, fit_path
 
     fitted = fit_path(args.path if len(args.path) > 1 else args.path[0], FitOptions.from_args(args),
-                      report_estimate=_report_estimate)
+                      report_estimate=_report_estimate, report=_note)
     frf, results = fitted.frf, list(fitted.results)
     time_data = None if fitted.time_data is None else (frf, *fitted.time_data)
     label = args.path[0] if len(args.path) == 1 else f"{args.path[0]} (+{len(args.path) - 1} files)"
@@ -186,6 +187,10 @@ def _fit(args) -> int:
     return 0
 
 
+def _note(line: str) -> None:
+    print(line, file=sys.stderr)
+
+
 def _report_estimate(frf) -> None:
     """One line on stderr: what the estimate averaged and what it rejected."""
     print(f"{frf.source}: {frf.estimator} estimate, {frf.averages} average(s), window {frf.window}"
@@ -198,7 +203,7 @@ def _report_estimate(frf) -> None:
 def _frf(args) -> int:
     from .io import write_frf
 
-    frf, *record = frf_from_time(args.path, args)
+    frf, *record = frf_from_time(args.path, args, _note)
     _report_estimate(frf)
     write_frf(frf, args.out)
     if args.plot:

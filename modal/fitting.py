@@ -16,6 +16,7 @@ from types import SimpleNamespace
 from typing import Any
 
 from .errors import ModalError, ParameterError
+from .validate import one_of
 
 __all__ = ["FitOptions", "FitOutput", "fit_path", "READ_HINTS", "GLOBAL_OPTIONS"]
 
@@ -44,7 +45,7 @@ class FitOptions:
     kind, frequency_axis, frequency_step, frequency_start, layout, delimiter, decimal, dataset
         Read hints (:func:`modal.read_frf`); ``frequency_step`` and ``frequency_start`` in Hz.
     excitation, response, impact, estimator, window, exponential_decay_s, segment_length, overlap
-        Time-data options: a time file is turned into FRFs first (:mod:`modal.cli_time`).
+        Time-data options: a time file is turned into FRFs first (:mod:`modal.time_frf`).
     """
 
     method: str = "auto"
@@ -71,8 +72,7 @@ class FitOptions:
     overlap: float | None = None
 
     def __post_init__(self) -> None:
-        if self.method not in _METHODS:
-            raise ParameterError(f"method must be one of {', '.join(_METHODS)}, got {self.method!r}")
+        one_of("method", self.method, _METHODS)
         given = [name for name in GLOBAL_OPTIONS if getattr(self, name) is not None]
         if given and self.method not in ("auto", "global"):
             raise ParameterError(f"--{given[0].replace('_', '-')} applies to --method global only")
@@ -126,7 +126,7 @@ class FitOptions:
         return {k: getattr(self, k) for k in READ_HINTS if getattr(self, k) is not None}
 
     def namespace(self) -> SimpleNamespace:
-        """The options as the attribute names of the command line (for :mod:`modal.cli_time`)."""
+        """The options as the attribute names of the command line (for :func:`modal.time_frf.frf_from_time`)."""
         values = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
         values["response"] = list(self.response) if self.response is not None else None
         values["band"] = self.bands_hz
@@ -153,7 +153,7 @@ class FitOutput:
 
 
 def fit_path(path: str | os.PathLike | Sequence[str | os.PathLike], options: FitOptions,
-             report_estimate=None) -> FitOutput:
+             report_estimate=None, report=None) -> FitOutput:
     """Read an FRF (or time) file and identify its modes, as ``modal fit`` does.
 
     Parameters
@@ -163,6 +163,8 @@ def fit_path(path: str | os.PathLike | Sequence[str | os.PathLike], options: Fit
     options : FitOptions
     report_estimate : callable, optional
         Called with the estimate when the file held time data (the command line prints a line).
+    report : callable, optional
+        Called with a one-line note on how a time file was read (the command line prints it).
 
     Returns
     -------
@@ -173,7 +175,7 @@ def fit_path(path: str | os.PathLike | Sequence[str | os.PathLike], options: Fit
     ModalError
         Unreadable file or failed identification (the message names the file).
     """
-    from .cli_time import frf_from_time, wants_time
+    from .time_frf import frf_from_time, wants_time
     from .identify import identify
     from .io import read_frf
 
@@ -181,7 +183,7 @@ def fit_path(path: str | os.PathLike | Sequence[str | os.PathLike], options: Fit
     args = options.namespace()
     time_data = None
     if len(paths) == 1 and wants_time(args, paths[0]):
-        frf, *record = frf_from_time(paths[0], args)
+        frf, *record = frf_from_time(paths[0], args, report)
         time_data = tuple(record)
         if report_estimate is not None:
             report_estimate(frf)

@@ -14,6 +14,7 @@ import numpy as np
 
 from .errors import FRFValidationError, ModalWarning, warn
 from .units import TWO_PI
+from .validate import positive_number
 
 __all__ = ["FRF", "FRF_KINDS", "KIND_POWER", "DEFAULT_UNITS", "kind_factor"]
 
@@ -86,6 +87,15 @@ class FRF:
         Unit of ``response``; defaults to the SI unit of ``kind``.
     source : str
         Where the data came from (file name); used in error messages.
+    noise_std : array_like, shape like ``response``, optional
+        Standard deviation of the complex random error of each line, E|Ĥ − H|² = noise_std², in
+        the unit of ``response``: an FRF estimated from time records knows it
+        (:func:`modal.estimate_frf`), and :func:`modal.identify` then weights the lines by it and
+        takes it as the noise. None when unknown (identification estimates it from the data).
+    exponential_decay_s : float, optional
+        τ of an exponential window applied to the records the FRF was estimated from, s: every
+        pole's real part is more negative by 1/τ, and :func:`modal.identify` takes that damping
+        back out. None without such a window.
 
     Attributes
     ----------
@@ -102,6 +112,8 @@ class FRF:
     units: str | None = None
     source: str = "<array>"
     _single: bool = field(default=False, repr=False)
+    noise_std: np.ndarray | None = None
+    exponential_decay_s: float | None = None
 
     def __post_init__(self) -> None:
         src = self.source
@@ -162,6 +174,8 @@ class FRF:
             warn(f"{src}: frequency lines were not increasing; sorted them", ModalWarning, stacklevel=4)
             freq = sorted_freq
             resp = resp[:, order]
+        else:
+            order = None
         freq.setflags(write=False)
         resp.setflags(write=False)
         n_ch = resp.shape[0]
@@ -172,6 +186,18 @@ class FRF:
         object.__setattr__(self, "reference_points", _as_point_ids(self.reference_points, n_ch, "reference_points", src))
         if self.units is None:
             object.__setattr__(self, "units", DEFAULT_UNITS[self.kind])
+        if self.noise_std is not None:
+            noise = np.array(self.noise_std, dtype=float)
+            shape = resp[0].shape if single else resp.shape
+            if noise.shape != shape or not np.all(np.isfinite(noise)) or np.any(noise < 0):
+                raise FRFValidationError(f"{src}: field 'noise_std' must be finite, >= 0 and shaped like 'response' {shape}")
+            if order is not None:
+                noise = noise[..., order]
+            noise.setflags(write=False)
+            object.__setattr__(self, "noise_std", noise)
+        if self.exponential_decay_s is not None:
+            object.__setattr__(self, "exponential_decay_s", positive_number(
+                "exponential_decay_s", self.exponential_decay_s, "time in s", FRFValidationError, src))
 
     # ------------------------------------------------------------------ views
     @property
@@ -216,7 +242,7 @@ class FRF:
 
     # ------------------------------------------------------------ transforms
     def as_kind(self, kind: Kind) -> "FRF":
-        """Exact conversion to another FRF kind (multiplies by (iω)**Δp).
+        """Exact conversion to another FRF kind (multiplies by (iω)**Δp; ``noise_std`` by |ω|**Δp).
 
         Converting a line at 0 Hz to a lower kind (for example accelerance to
         receptance) divides by zero and is refused.
@@ -233,7 +259,8 @@ class FRF:
             )
         resp = self.response * iw ** delta
         units = DEFAULT_UNITS[kind] if self.units == DEFAULT_UNITS[self.kind] else None
-        return replace(self, response=resp, kind=kind, units=units)
+        noise = None if self.noise_std is None else self.noise_std * np.abs(self.omega_rad_s) ** delta
+        return replace(self, response=resp, kind=kind, units=units, noise_std=noise)
 
     def cropped(self, f_low_hz: float, f_high_hz: float) -> "FRF":
         """The lines with ``f_low_hz <= f <= f_high_hz``."""
@@ -242,7 +269,8 @@ class FRF:
             raise FRFValidationError(
                 f"{self.source}: band {f_low_hz}–{f_high_hz} Hz holds {int(keep.sum())} lines, expected at least 2"
             )
-        return replace(self, frequency_hz=self.frequency_hz[keep], response=self.response[..., keep])
+        return replace(self, frequency_hz=self.frequency_hz[keep], response=self.response[..., keep],
+                       noise_std=None if self.noise_std is None else self.noise_std[..., keep])
 
     def channel(self, index: int) -> "FRF":
         """A single-channel FRF of channel ``index``."""
@@ -252,6 +280,7 @@ class FRF:
             response=self.channels[index],
             response_points=pts(self.response_points),
             reference_points=pts(self.reference_points),
+            noise_std=None if self.noise_std is None else np.atleast_2d(self.noise_std)[index],
         )
 
     def __eq__(self, other: object) -> bool:

@@ -14,6 +14,7 @@ from .frf import FRF
 from .peaks import _indicator_and_peak, bands_from_hz, estimate_noise_std, find_modes
 from .results import IdentificationResult
 from .sdof import BANDWISE_METHODS, identify_bands
+from .validate import non_negative, one_of
 
 __all__ = ["identify", "choose_method", "METHODS", "BANDWISE_METHODS"]
 
@@ -50,7 +51,7 @@ def _auto_choice(frf: FRF, bands_hz, min_prominence_db: float,
     noise = estimate_noise_std(frf) if noise is None else noise
     try:  # the peaks identify itself would fit: the same noise-aware test (an estimate's noise per line)
         bands = find_modes(frf, min_prominence_db=min_prominence_db, noise_std=noise,
-                           line_noise_std=getattr(frf, "noise_std", None), indicator=indicator)
+                           line_noise_std=frf.noise_std, indicator=indicator)
     except IdentificationError:
         return "nls", None
     return ("global" if len(bands) >= AUTO_GLOBAL_PEAKS else "nls"), bands
@@ -112,8 +113,10 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
         raise TypeError(f"identify() expects a modal.FRF, got {type(frf).__name__}")
     if global_options and method not in ("global", "auto"):
         raise TypeError(f"identify() got options {', '.join(sorted(global_options))} that only method='global' takes")
-    if method not in METHODS and method != "auto":
-        raise IdentificationError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
+    one_of("method", method, METHODS + ("auto",), IdentificationError)
+    if noise_std is not None:
+        noise_std = np.broadcast_to(non_negative("noise_std", noise_std, IdentificationError),
+                                    (frf.n_channels,)).copy()
     from .scaling import scale_exponent, scaled_frf, unscale_result
 
     # |H| once: the mode indicator and each channel's max |H|, and (but for the global method, which measures
@@ -127,7 +130,7 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
     if exponent:  # values near over- or underflow: fit 2**e H (exact) and scale the results back
         gain = 2.0**exponent
         result = identify(scaled_frf(frf, exponent), method, bands_hz,
-                          noise_std=None if noise_std is None else np.asarray(noise_std, float) * gain,
+                          noise_std=None if noise_std is None else noise_std * gain,
                           driving_point=driving_point, min_prominence_db=min_prominence_db, max_modes=max_modes,
                           **global_options)
         return unscale_result(result, gain)
@@ -146,6 +149,6 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
         bands = found
     else:
         bands = find_modes(frf, min_prominence_db=min_prominence_db, max_modes=max_modes, noise_std=raw,
-                           line_noise_std=getattr(frf, "noise_std", None), indicator=indicator)
+                           line_noise_std=frf.noise_std, indicator=indicator)
     return identify_bands(frf, method, bands, raw_noise=raw, noise_std=noise_std, driving_point=driving_point)
 

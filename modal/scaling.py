@@ -47,11 +47,8 @@ def scale_exponent(frf: FRF, peak: np.ndarray | None = None) -> int:
 def scaled_frf(frf: FRF, exponent: int) -> FRF:
     """The FRF multiplied by ``2**exponent`` (and its per-line noise, when it carries one)."""
     gain = 2.0**exponent
-    changes = {"response": np.asarray(frf.response) * gain}
-    noise = getattr(frf, "noise_std", None)
-    if noise is not None and any(f.name == "noise_std" for f in dataclasses.fields(frf)):
-        changes["noise_std"] = np.asarray(noise) * gain
-    return dataclasses.replace(frf, **changes)
+    noise = None if frf.noise_std is None else np.asarray(frf.noise_std) * gain
+    return dataclasses.replace(frf, response=np.asarray(frf.response) * gain, noise_std=noise)
 
 
 def _times(value, factor):

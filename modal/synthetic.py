@@ -10,15 +10,9 @@ import numpy as np
 from .errors import ParameterError
 from .frf import FRF, kind_factor
 from .units import TWO_PI
+from .validate import non_negative, one_of, positive
 
 __all__ = ["modal_frf", "matrix_frf", "add_noise", "sdof_frf", "frequency_axis"]
-
-
-def _positive(name: str, value) -> np.ndarray:
-    arr = np.atleast_1d(np.asarray(value, dtype=float))
-    if not np.all(np.isfinite(arr)) or np.any(arr <= 0):
-        raise ParameterError(f"'{name}' must be finite and > 0, got {value!r}")
-    return arr
 
 
 def frequency_axis(f_low_hz: float, f_high_hz: float, n_lines: int) -> np.ndarray:
@@ -62,7 +56,7 @@ def modal_frf(
     response_points, reference_points : sequence of str, optional
     """
     freq = np.asarray(frequency_hz, dtype=float)
-    fn = _positive("natural_frequency_hz", natural_frequency_hz)
+    fn = positive("natural_frequency_hz", natural_frequency_hz)
     zeta = np.atleast_1d(np.asarray(damping_ratio, dtype=float))
     if zeta.shape != fn.shape or np.any(zeta < 0) or not np.all(np.isfinite(zeta)):
         raise ParameterError(f"'damping_ratio' must be finite, >= 0 and one per mode, got {damping_ratio!r}")
@@ -95,11 +89,9 @@ def modal_frf(
 def sdof_frf(frequency_hz, mass_kg: float, stiffness_n_per_m: float, damping_n_s_per_m: float,
              kind: str = "receptance") -> FRF:
     """Driving-point FRF of a single mass–spring–damper, ``1/(k − mω² + icω)`` times (iω)**p."""
-    m = _positive("mass_kg", mass_kg)[0]
-    k = _positive("stiffness_n_per_m", stiffness_n_per_m)[0]
-    c = float(damping_n_s_per_m)
-    if not np.isfinite(c) or c < 0:
-        raise ParameterError(f"'damping_n_s_per_m' must be finite and >= 0, got {damping_n_s_per_m!r}")
+    m = positive("mass_kg", mass_kg)[0]
+    k = positive("stiffness_n_per_m", stiffness_n_per_m)[0]
+    c = float(non_negative("damping_n_s_per_m", damping_n_s_per_m)[0])
     omega = np.asarray(frequency_hz, dtype=float) * TWO_PI
     h = 1.0 / (k - m * omega**2 + 1j * c * omega) * kind_factor(omega, kind)
     return FRF(frequency_hz, h, kind=kind, source="<synthetic>")
@@ -177,10 +169,8 @@ def add_noise(frf: FRF, level: float, seed: int | np.random.Generator | None = 0
     seed : int or Generator
         Seed for reproducible noise.
     """
-    if not np.isfinite(level) or level < 0:
-        raise ParameterError(f"noise 'level' must be finite and >= 0, got {level!r}")
-    if relative_to not in ("max", "line"):
-        raise ParameterError(f"'relative_to' must be 'max' or 'line', got {relative_to!r}")
+    non_negative("level", level)
+    one_of("relative_to", relative_to, ("max", "line"))
     rng = np.random.default_rng(seed)
     h = frf.channels
     scale = np.abs(h).max(axis=1, keepdims=True) if relative_to == "max" else np.abs(h)

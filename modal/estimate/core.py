@@ -21,6 +21,7 @@ import numpy as np
 
 from ..errors import FRFValidationError, ParameterError
 from ..frf import FRF, FRF_KINDS, KIND_POWER
+from ..validate import finite_samples, one_of, positive_number
 from . import spectra
 from .hits import find_hits
 from .windows import WINDOWS, exponential_window, force_window, segment_window
@@ -46,8 +47,8 @@ class EstimatedFRF(FRF):
         Multiple coherence of each output on all inputs (equal to the ordinary
         coherence for one input).
     noise_std : ndarray, shape like ``response``, or None
-        Standard deviation of the complex random error of each line,
-        E|Ĥ − H|² = noise_std², in the FRF's unit. None with one average (undefined).
+        (:class:`~modal.frf.FRF`'s field) Standard deviation of the complex random error of
+        each line, E|Ĥ − H|² = noise_std², in the FRF's unit. None with one average (undefined).
     averages : int
         Records (segments or accepted hits) averaged.
     rejected : list of dict
@@ -55,8 +56,8 @@ class EstimatedFRF(FRF):
     estimator : {"H1", "H2", "Hv"}
     window : str
     exponential_decay_s : float or None
-        τ of the exponential window, s: every pole's real part is more negative
-        by 1/τ; :func:`modal.identify` takes it back out.
+        (:class:`~modal.frf.FRF`'s field) τ of the exponential window, s: every pole's real
+        part is more negative by 1/τ; :func:`modal.identify` takes it back out.
     sample_rate_hz : float
     segment_length : int
         Samples per record.
@@ -70,12 +71,10 @@ class EstimatedFRF(FRF):
 
     coherence: np.ndarray | None = None
     multiple_coherence: np.ndarray | None = None
-    noise_std: np.ndarray | None = None
     averages: int = 1
     rejected: list = field(default_factory=list)
     estimator: str = "H1"
     window: str = "rect"
-    exponential_decay_s: float | None = None
     sample_rate_hz: float | None = None
     segment_length: int | None = None
     overlap: float = 0.0
@@ -85,17 +84,14 @@ class EstimatedFRF(FRF):
     def __post_init__(self) -> None:
         super().__post_init__()
         shape = np.shape(self.response)
-        for name in ("coherence", "noise_std"):
-            value = getattr(self, name)
-            if value is None:
-                continue
-            arr = np.array(value, dtype=float)
+        if self.coherence is not None:
+            arr = np.array(self.coherence, dtype=float)
             if arr.shape != shape or not np.all(np.isfinite(arr)) or np.any(arr < 0):
                 raise FRFValidationError(
-                    f"{self.source}: field {name!r} must be finite, >= 0 and shaped like 'response' {shape}"
+                    f"{self.source}: field 'coherence' must be finite, >= 0 and shaped like 'response' {shape}"
                 )
             arr.setflags(write=False)
-            object.__setattr__(self, name, arr)
+            object.__setattr__(self, "coherence", arr)
         if self.multiple_coherence is not None:
             arr = np.atleast_2d(np.array(self.multiple_coherence, dtype=float))
             arr.setflags(write=False)
@@ -129,14 +125,6 @@ class EstimatedFRF(FRF):
                            self.multiple_coherence)[output] if self.multiple_coherence is not None else None,
                        n_inputs=1)
 
-    def as_kind(self, kind) -> "EstimatedFRF":
-        """Exact conversion to another kind; ``noise_std`` scales with |iω|^Δp."""
-        converted = super().as_kind(kind)
-        if converted is self or self.noise_std is None:
-            return converted
-        delta = KIND_POWER[kind] - KIND_POWER[self.kind]
-        return replace(converted, noise_std=self.noise_std * np.abs(self.omega_rad_s) ** delta)
-
 
 def _as_signals(value, name: str, source: str):
     """(channels, samples) view of an array-like; ndarray/memmap/h5py slices stream."""
@@ -152,19 +140,6 @@ def _as_signals(value, name: str, source: str):
             f"{source}: field {name!r} has shape {tuple(value.shape)}; expected (samples,) or (channels, samples)"
         )
     return value
-
-
-def _check_finite(signal, name: str, source: str, block: int = 2**22) -> None:
-    n = signal.shape[1]
-    for first in range(0, n, block):
-        part = np.asarray(signal[:, first:first + block], dtype=float)
-        bad = ~np.isfinite(part)
-        if bad.any():
-            ch, i = (int(v) for v in np.argwhere(bad)[0])
-            raise ParameterError(
-                f"{source}: field {name!r} has a non-finite sample at channel {ch + 1}, sample {first + i}; "
-                "expected finite numbers"
-            )
 
 
 def _default_segment_length(n_samples: int) -> int:
@@ -225,19 +200,12 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
     EstimatedFRF
     """
     estimator = {"h1": "H1", "h2": "H2", "hv": "Hv"}.get(str(estimator).lower(), estimator)
-    if estimator not in spectra.ESTIMATORS:
-        raise ParameterError(f"field 'estimator' is {estimator!r}; expected one of {', '.join(spectra.ESTIMATORS)}")
-    if kind not in FRF_KINDS:
-        raise ParameterError(f"field 'kind' is {kind!r}; expected one of {', '.join(FRF_KINDS)}")
-    if response_quantity is not None and response_quantity not in RESPONSE_QUANTITIES:
-        raise ParameterError(
-            f"field 'response_quantity' is {response_quantity!r}; expected one of {', '.join(RESPONSE_QUANTITIES)}"
-        )
-    if window not in WINDOWS:
-        raise ParameterError(f"field 'window' is {window!r}; expected one of {', '.join(WINDOWS)}")
-    fs = float(sample_rate_hz)
-    if not (np.isfinite(fs) and fs > 0):
-        raise ParameterError(f"field 'sample_rate_hz' is {sample_rate_hz!r}; expected a positive rate in Hz")
+    one_of("estimator", estimator, spectra.ESTIMATORS)
+    one_of("kind", kind, FRF_KINDS)
+    if response_quantity is not None:
+        one_of("response_quantity", response_quantity, tuple(RESPONSE_QUANTITIES))
+    one_of("window", window, WINDOWS)
+    fs = positive_number("sample_rate_hz", sample_rate_hz, "rate in Hz")
     if not (0.0 <= overlap < 1.0):
         raise ParameterError(f"field 'overlap' is {overlap!r}; expected a fraction in [0, 1)")
     x = _as_signals(excitation, "excitation", source)
@@ -247,8 +215,8 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
             f"{source}: 'excitation' has {x.shape[1]} samples and 'response' {y.shape[1]}; expected equal lengths"
         )
     n = x.shape[1]
-    _check_finite(x, "excitation", source)
-    _check_finite(y, "response", source)
+    finite_samples(x, "excitation", source)
+    finite_samples(y, "response", source)
 
     rejected: list[dict] = []
     hit_times: tuple = ()

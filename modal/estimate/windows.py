@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ParameterError
+from ..validate import positive_number
 
 __all__ = ["WINDOWS", "segment_window", "force_window", "exponential_window"]
 
@@ -75,7 +76,6 @@ def exponential_window(length: int, sample_rate_hz: float, decay_s: float, pretr
     decay_s : float
         Time constant τ, s.
     """
-    if not (np.isfinite(decay_s) and decay_s > 0):
-        raise ParameterError(f"field 'exponential_decay_s' is {decay_s!r}; expected a positive time in s")
+    positive_number("exponential_decay_s", decay_s, "time in s")
     t = (np.arange(length) - pretrigger) / sample_rate_hz
     return np.exp(-t / decay_s)

@@ -222,7 +222,7 @@ def identify_global(frf: FRF, *, modes_hz=None, order: int | None = None, max_or
         raise IdentificationError(f"{src}: no stable pole in the stabilisation diagram (orders {orders[0]}–"
                                   f"{orders[-1]}); give modes_hz hints or a higher max_order")
 
-    line_noise = getattr(frf, "noise_std", None)
+    line_noise = frf.noise_std
     if noise_std is not None:
         noise = np.broadcast_to(np.asarray(noise_std, float), (n_ch,)).copy()
     elif line_noise is not None:

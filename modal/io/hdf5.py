@@ -19,6 +19,7 @@ result archive (``modal.archive``) can hold FRFs next to its other groups;
 from __future__ import annotations
 
 import os
+from dataclasses import replace
 from datetime import datetime, timezone
 from typing import Any
 
@@ -87,8 +88,12 @@ def write_frf_group(group, frf: FRF) -> None:
         ids = getattr(frf, name)
         if ids is not None:
             group.attrs[name] = np.array(list(ids), dtype=h5py.string_dtype())
-    if getattr(frf, "averages", None) is not None:  # an estimate from time data (modal.estimate_frf)
+    from ..estimate.core import EstimatedFRF
+
+    if isinstance(frf, EstimatedFRF):  # an estimate from time data (modal.estimate_frf)
         _write_estimate(group, frf)
+    else:
+        _write_known(group, frf, {"noise_std": None}, {"exponential_decay_s": "s"})
 
 
 #: per-line arrays of an estimate from time data, and their units (None: the FRF's own unit)
@@ -98,29 +103,44 @@ _ESTIMATE_NUMBERS = {"averages": "1", "sample_rate_hz": "Hz", "segment_length": 
                      "n_inputs": "1", "exponential_decay_s": "s"}
 
 
-def _write_estimate(group, frf) -> None:
-    """Coherence, noise per line and the estimate's settings beside an estimated FRF's response."""
-    import json
-
-    for name, unit in _ESTIMATE_ARRAYS.items():
+def _write_known(group, frf, arrays: dict, numbers: dict) -> None:
+    """The FRF's fields named in ``arrays`` (float64, unit None: the FRF's own) and ``numbers`` that are known."""
+    for name, unit in arrays.items():
         value = getattr(frf, name)
         if value is not None and not (name == "hit_times_s" and len(value) == 0):
             ds = group.create_dataset(name, data=np.asarray(value, dtype=np.float64))
             ds.attrs["units"] = frf.units if unit is None else unit
-    for name, unit in _ESTIMATE_NUMBERS.items():
+    for name, unit in numbers.items():
         value = getattr(frf, name)
         if value is not None:
             ds = group.create_dataset(name, data=value)
             ds.attrs["units"] = unit
+
+
+def _write_estimate(group, frf) -> None:
+    """Coherence, noise per line and the estimate's settings beside an estimated FRF's response."""
+    import json
+
+    _write_known(group, frf, _ESTIMATE_ARRAYS, _ESTIMATE_NUMBERS)
     group.attrs["estimator"] = frf.estimator
     group.attrs["window"] = frf.window
     group.attrs["rejected"] = json.dumps(frf.rejected)
 
 
 def _read_estimate(group, frf: FRF, source: str) -> FRF:
-    """An :class:`~modal.estimate.EstimatedFRF` when the group holds an estimate's extras, else ``frf``."""
+    """An :class:`~modal.estimate.EstimatedFRF` when the group holds an estimate's extras, else ``frf`` with
+    its noise per line and window time constant when the group holds them."""
     if "averages" not in group:
-        return frf
+        known = {}
+        try:
+            if "noise_std" in group:
+                known["noise_std"] = np.asarray(group["noise_std"][()], float).reshape(np.shape(frf.response))
+            if "exponential_decay_s" in group:
+                known["exponential_decay_s"] = float(group["exponential_decay_s"][()])
+        except (ValueError, TypeError) as exc:
+            raise FormatError(f"{source}: group {group.name}: the noise per line cannot be read ({exc}); "
+                              "expected an array shaped like 'response'") from None
+        return replace(frf, **known) if known else frf
     import json
 
     from ..estimate import EstimatedFRF

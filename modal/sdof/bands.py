@@ -106,7 +106,7 @@ def line_weight(frf, bands):
     unweighted, those few lines pulled the 1450 and 2600 Hz poles of a hammer test to 1500 and 2500 Hz.
     A line claimed quieter than 1e-3 σ_ref counts as 1e-3 σ_ref (no line weighs more than 1000).
     """
-    line_noise = getattr(frf, "noise_std", None)
+    line_noise = frf.noise_std
     if line_noise is None:
         return None
     keep, _ = regions(bands, frf.frequency_hz)

@@ -17,7 +17,6 @@ from __future__ import annotations
 import numpy as np
 
 from ..assemble import ModeEstimate, assemble_modes, driving_points
-from ..errors import IdentificationError
 from ..flags import BIAS_LIMIT, model_inadequate
 from ..frf import KIND_POWER, line_spacing
 from ..peaks import channel_sample
@@ -59,16 +58,11 @@ def identify_bands(frf, method: str, bands, *, raw_noise: np.ndarray, noise_std=
     n_ch = frf.n_channels
     estimated_noise = raw_noise
     # an FRF estimated from time data carries its own calibrated noise per line (modal.estimate_frf)
-    line_noise = getattr(frf, "noise_std", None)
+    line_noise = frf.noise_std
     known_noise = noise_std is None and line_noise is not None
     if known_noise:
         estimated_noise = band_noise(frf, bands, line_noise)
-    if noise_std is None:
-        noise = estimated_noise
-    else:
-        noise = np.broadcast_to(np.asarray(noise_std, float), (n_ch,)).copy()
-        if not np.all(np.isfinite(noise)) or np.any(noise < 0):
-            raise IdentificationError(f"noise_std must be finite and >= 0, got {noise_std!r}")
+    noise = estimated_noise if noise_std is None else np.broadcast_to(np.asarray(noise_std, float), (n_ch,)).copy()
     if method in ("halfpower", "circle"):
         estimates, missing_mode = _single_mode_fits(frf, bands, power, method, noise, estimated_noise, known_noise,
                                                     rescale=noise_std is None and not known_noise)
@@ -84,7 +78,7 @@ def identify_bands(frf, method: str, bands, *, raw_noise: np.ndarray, noise_std=
     driving, assumed = driving_points(frf, driving_point)
     modes = assemble_modes(estimates, method=method, source=frf.source, single=frf.response.ndim == 1,
                            driving=driving, driving_assumed=assumed,
-                           window_decay_s=getattr(frf, "exponential_decay_s", None))
+                           window_decay_s=frf.exponential_decay_s)
     return IdentificationResult(modes, method, frf.kind, n_ch, noise_std=estimated_noise)
 
 

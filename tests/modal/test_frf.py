@@ -125,3 +125,56 @@ def test_bad_synthetic_parameters():
         modal_frf([1, 2], [1.0], [-0.1], [1.0])
     with pytest.raises(ParameterError, match="positive definite"):
         matrix_frf([1, 2], -np.eye(2), np.zeros((2, 2)), np.eye(2))
+
+
+# ---- what identification needs, carried as fields: the noise per line and the window's time constant
+
+def test_noise_and_window_fields_are_checked_and_name_the_field():
+    f = np.linspace(1, 10, 5)
+    with pytest.raises(FRFValidationError, match="field 'noise_std'"):
+        FRF(f, np.ones(5), noise_std=np.ones(4), source="a.h5")  # not shaped like the response
+    with pytest.raises(FRFValidationError, match="a.h5: field 'noise_std'"):
+        FRF(f, np.ones(5), noise_std=-np.ones(5), source="a.h5")
+    for decay in (0.0, -1.0, float("nan"), "long"):
+        with pytest.raises(FRFValidationError, match="field 'exponential_decay_s'"):
+            FRF(f, np.ones(5), exponential_decay_s=decay)
+    plain = FRF(f, np.ones(5))
+    assert plain.noise_std is None and plain.exponential_decay_s is None
+
+
+def test_noise_per_line_follows_sorting_cropping_channels_and_kind():
+    f = np.array([3.0, 1.0, 2.0, 4.0])
+    noise = np.array([[0.3, 0.1, 0.2, 0.4], [3.0, 1.0, 2.0, 4.0]])
+    with pytest.warns(ModalWarning, match="sorted"):
+        frf = FRF(f, np.ones((2, 4)), kind="receptance", noise_std=noise, exponential_decay_s=0.5)
+    assert frf.noise_std.tolist() == [[0.1, 0.2, 0.3, 0.4], [1.0, 2.0, 3.0, 4.0]]  # moved with its lines
+    assert frf.cropped(2.0, 3.0).noise_std.tolist() == [[0.2, 0.3], [2.0, 3.0]]
+    one = frf.channel(1)
+    assert one.noise_std.tolist() == [1.0, 2.0, 3.0, 4.0] and one.exponential_decay_s == 0.5
+    # a receptance's error times |iω|² is the accelerance's error, line by line (exact but for one rounding)
+    converted = frf.as_kind("accelerance")
+    omega = 2 * np.pi * frf.frequency_hz
+    assert np.allclose(converted.noise_std, frf.noise_std * omega**2, rtol=1e-15, atol=0)
+
+
+def test_identify_takes_the_noise_and_the_window_from_the_fields():
+    from modal import identify
+
+    # a mode seen through an exponential window exp(-t/τ): its pole moved left by 1/τ (exact)
+    fn, zeta, tau = 50.0, 0.01, 0.5
+    wn = 2 * np.pi * fn
+    sigma = zeta * wn + 1 / tau
+    wd = wn * np.sqrt(1 - zeta**2)
+    wn_m = np.hypot(wd, sigma)
+    f = np.linspace(40.0, 60.0, 801)
+    seen = modal_frf(f, [wn_m / (2 * np.pi)], [sigma / wn_m], [1.0])
+    level = 1e-3 * np.abs(seen.response).max()
+    frf = FRF(f, add_noise(seen, 1e-3, seed=1).response, noise_std=np.full(f.size, level), exponential_decay_s=tau)
+    result = identify(frf, "nls", bands_hz=[(44.0, 56.0)])
+    mode = result[0]
+    # the window's damping (σ/ωn of the seen pole, less ζ: 0.0064) taken back out, to the noise's errors
+    # (0.1 % noise: std of ζ ~1e-5; without the window's τ the fit would report 0.0164)
+    assert abs(mode.damping_ratio - zeta) < 5 * mode.std.damping_ratio
+    assert abs(mode.window_damping_ratio - (sigma / wn_m - zeta)) < 5 * mode.std.damping_ratio
+    # the noise the fit used is the FRF's own per line (its RMS over the band), not one estimated from the data
+    assert result.noise_std == pytest.approx([level], rel=1e-12)

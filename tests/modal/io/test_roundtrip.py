@@ -345,3 +345,14 @@ def test_mat_v73_written_like_matlab_with_default_names(tmp_path):
         fh.write(b"MATLAB 7.3 MAT-file, Platform: GLNXA64".ljust(116) + b"\0" * 8 + b"\0\x02IM")
     got = read_frf(tmp_path / "m.mat", kind="accelerance")
     assert np.array_equal(got.frequency_hz, frf.frequency_hz) and np.array_equal(got.response, frf.response)
+
+
+def test_hdf5_keeps_a_plain_frfs_noise_and_window(tmp_path):
+    want = _frf(2)
+    want = FRF(want.frequency_hz, want.response, kind=want.kind, response_points=want.response_points,
+               reference_points=want.reference_points, noise_std=np.abs(want.response) * 1e-3 + 1e-9,
+               exponential_decay_s=0.25)
+    write_frf(want, tmp_path / "a.h5")
+    got = read_frf(tmp_path / "a.h5")
+    assert type(got) is FRF
+    assert np.array_equal(got.noise_std, want.noise_std) and got.exponential_decay_s == 0.25

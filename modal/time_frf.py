@@ -1,0 +1,88 @@
+"""A time-data file → its FRFs, with the time options of ``modal fit``, ``modal frf`` and ``modal batch``.
+
+The fit service (:mod:`modal.fitting`) and the command line (:mod:`modal.cli`,
+whose options :mod:`modal.cli_time` declares) both call :func:`frf_from_time`, so a
+time file gives the same FRFs either way.
+"""
+from __future__ import annotations
+
+from typing import Callable
+
+from .errors import FormatError
+from .estimate import estimate_frf
+from .frf import FRF_KINDS
+
+__all__ = ["TIME_OPTIONS", "wants_time", "frf_from_time"]
+
+#: the attribute names the time options set (None when not given)
+TIME_OPTIONS = ("excitation", "response", "impact", "estimator", "window", "exponential_decay_s", "segment_length",
+                "overlap")
+_KIND_OF_QUANTITY = {"displacement": "receptance", "velocity": "mobility", "acceleration": "accelerance"}
+
+
+
+def wants_time(args, path) -> bool:
+    """Whether ``path`` is to be read as time data (a time option given, or the file holds time data)."""
+    from .io.timedata import is_time_file
+
+    given = any(getattr(args, name, None) not in (None, False) for name in TIME_OPTIONS if name != "overlap")
+    return given or is_time_file(path)
+
+
+def frf_from_time(path, args, report: Callable[[str], None] | None = None):
+    """Read a time file and estimate its FRFs with the command line's options.
+
+    Parameters
+    ----------
+    path : path-like
+    args : object
+        The time options as attributes (:data:`TIME_OPTIONS`, and ``kind``): an ``argparse``
+        namespace or :meth:`modal.fitting.FitOptions.namespace`.
+    report : callable, optional
+        Called with a one-line note (the excitation channel taken when none was named).
+
+    Returns
+    -------
+    (EstimatedFRF, TimeRecord, list of int, list of int)
+        The estimate, the record, and the excitation and response channel indices.
+    """
+    from .io.timedata import read_time
+
+    record = read_time(path)
+    src = record.source
+    if args.excitation is not None:
+        inputs = [record.channel_index(args.excitation)]
+    else:
+        inputs = record.force_channels()
+        if len(inputs) != 1:
+            listing = ", ".join(f"{k + 1}={n} ({q or 'unknown'})"
+                                for k, (n, q) in enumerate(zip(record.names, record.quantities)))
+            what = "no channel" if not inputs else f"{len(inputs)} channels"
+            raise FormatError(f"{src}: {what} marked as force ({listing}); expected one: name the force channel "
+                              "with --excitation CHANNEL (an FRF needs an excitation)")
+        if report is not None:
+            report(f"{src}: excitation channel {inputs[0] + 1} ({record.names[inputs[0]]})")
+    if args.response:
+        outputs = [record.channel_index(r) for r in args.response]
+    else:
+        outputs = [k for k in range(record.n_channels) if k not in inputs]
+    if not outputs:
+        raise FormatError(f"{src}: no response channel besides the excitation; expected at least one")
+    quantities = {record.quantities[k] for k in outputs}
+    quantity = quantities.pop() if len(quantities) == 1 else None
+    if len(quantities) > 0:
+        raise FormatError(f"{src}: the response channels measured different quantities; expected one kind "
+                          "(choose them with --response)")
+    kind = getattr(args, "kind", None) or _KIND_OF_QUANTITY.get(quantity or "")
+    if kind is None:
+        raise FormatError(f"{src}: the file does not say what the response channels measured; give --kind "
+                          f"({', '.join(FRF_KINDS)})")
+    window = args.window or ("force" if args.impact else "hann")
+    estimate = estimate_frf(
+        record.signals[inputs], record.signals[outputs], record.sample_rate_hz,
+        estimator=args.estimator or "H1", kind=kind, segment_length=args.segment_length,
+        overlap=0.5 if args.overlap is None else args.overlap, window=window,
+        exponential_decay_s=args.exponential_decay_s, impact=args.impact,
+        response_quantity=quantity, excitation_points=[record.names[k] for k in inputs],
+        response_points=[record.names[k] for k in outputs], source=src)
+    return estimate, record, inputs, outputs

@@ -1,0 +1,69 @@
+"""Argument checks of ``modal``, in one place: each returns the checked value or raises a one-line error
+that names the argument, the value given and what was expected.
+
+:class:`~modal.errors.ParameterError` by default; a caller passes its own error class
+(:class:`~modal.errors.FRFValidationError`, :class:`~modal.errors.IdentificationError`)
+and ``source`` (the file) where the message should start with it.
+"""
+from __future__ import annotations
+
+from typing import Sequence
+
+import numpy as np
+
+from .errors import ParameterError
+
+__all__ = ["positive", "non_negative", "positive_number", "one_of", "finite_samples"]
+
+
+def _where(source: str | None) -> str:
+    return "" if source is None else f"{source}: "
+
+
+def positive(name: str, value, error: type[Exception] = ParameterError) -> np.ndarray:
+    """``value`` as a float array (at least 1-D) whose every entry is finite and > 0."""
+    arr = np.atleast_1d(np.asarray(value, dtype=float))
+    if not np.all(np.isfinite(arr)) or np.any(arr <= 0):
+        raise error(f"'{name}' must be finite and > 0, got {value!r}")
+    return arr
+
+
+def non_negative(name: str, value, error: type[Exception] = ParameterError) -> np.ndarray:
+    """``value`` as a float array (at least 1-D) whose every entry is finite and >= 0."""
+    arr = np.atleast_1d(np.asarray(value, dtype=float))
+    if not np.all(np.isfinite(arr)) or np.any(arr < 0):
+        raise error(f"'{name}' must be finite and >= 0, got {value!r}")
+    return arr
+
+
+def positive_number(name: str, value, expected: str, error: type[Exception] = ParameterError,
+                    source: str | None = None) -> float:
+    """``value`` as a float, finite and > 0; ``expected`` says what it is (``"time in s"``)."""
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        number = float("nan")
+    if not (np.isfinite(number) and number > 0):
+        raise error(f"{_where(source)}field '{name}' is {value!r}; expected a positive {expected}")
+    return number
+
+
+def one_of(name: str, value, choices: Sequence, error: type[Exception] = ParameterError):
+    """``value``, which must be one of ``choices``."""
+    if value not in choices:
+        raise error(f"field '{name}' is {value!r}; expected one of {', '.join(map(str, choices))}")
+    return value
+
+
+def finite_samples(signal, name: str, source: str, block: int = 2**22) -> None:
+    """Every sample of ``signal`` (channels × samples; an array, memmap or h5py dataset, read in blocks) is finite."""
+    n = signal.shape[1]
+    for first in range(0, n, block):
+        part = np.asarray(signal[:, first:first + block], dtype=float)
+        bad = ~np.isfinite(part)
+        if bad.any():
+            ch, i = (int(v) for v in np.argwhere(bad)[0])
+            raise ParameterError(
+                f"{source}: field {name!r} has a non-finite sample at channel {ch + 1}, sample {first + i}; "
+                "expected finite numbers"
+            )
