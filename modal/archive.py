@@ -179,7 +179,12 @@ def write_node(parent: h5py.Group, name: str, obj: Any, unit: str | None = None)
 
 #: classes that moved: the ``@__class__`` an older archive names -> where the class lives now.
 #: Archives keep loading after a class moves; add a line here when one does.
-RENAMED_CLASSES: dict[str, str] = {}
+RENAMED_CLASSES: dict[str, str] = {
+    # the band-wise algorithms moved into the modal.sdof package
+    "modal.halfpower:HalfPowerEstimate": "modal.sdof.halfpower:HalfPowerEstimate",
+    "modal.circlefit:CircleEstimate": "modal.sdof.circlefit:CircleEstimate",
+    "modal.checks:MissingMode": "modal.sdof.checks:MissingMode",
+}
 
 
 def _class_from(path: str):

@@ -96,3 +96,40 @@ def test_failed_write_leaves_previous_archive(tmp_path, result):
         write_archive(path, {"identify": result, "bad": object()})
     assert path.read_bytes() == before
     assert list(tmp_path.glob("*.tmp")) == []
+
+
+def test_an_archive_written_before_classes_moved_still_loads():
+    # written by the toolkit before the band-wise algorithms moved into modal/sdof (main at 473933f:
+    # circle_fit_curve, half_power_curve and identify(..., "circle") of one mode at 50 Hz, zeta 0.02, mobility,
+    # 81 lines 40-60 Hz, add_noise(1e-3, seed=1); a MissingMode(51.5, 0.01, 0, 40.0, 25.0, (0,))): its
+    # @__class__ attributes name modal.circlefit, modal.halfpower and modal.checks
+    import warnings
+    from pathlib import Path
+
+    from modal.archive import RENAMED_CLASSES
+    from modal.sdof.checks import MissingMode
+    from modal.sdof.circlefit import CircleEstimate, circle_fit_curve
+    from modal.sdof.halfpower import HalfPowerEstimate, half_power_curve
+
+    path = Path(__file__).parent / "data" / "archive_before_sdof.h5"
+    with h5py.File(path, "r") as f:
+        assert {f[name].attrs["__class__"] for name in ("circle", "halfpower", "missing")} <= set(RENAMED_CLASSES)
+    back = read_archive(path)
+    frf = add_noise(modal_frf(np.linspace(40.0, 60.0, 81), [50.0], [0.02], [1.0], kind="mobility"), 1e-3, seed=1)
+    omega, h = frf.omega_rad_s, frf.response
+    # the classes load from their new homes, and today's code computes the same numbers, bit for bit
+    assert type(back["circle"]) is CircleEstimate and _equal(back["circle"], circle_fit_curve(omega, h, 1e-3))
+    assert type(back["halfpower"]) is HalfPowerEstimate and _equal(back["halfpower"], half_power_curve(omega, h, 1, 1e-3))
+    assert back["missing"] == MissingMode(51.5, 0.01, 0, 40.0, 25.0, (0,))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # whatever the flags say, they are the same flags
+        again = identify(frf, "circle")
+    assert _equal(back["identify"], again)
+
+
+@pytest.mark.parametrize("old", sorted(__import__("modal.archive", fromlist=["RENAMED_CLASSES"]).RENAMED_CLASSES))
+def test_every_renamed_class_has_a_home(old):
+    from modal.archive import RENAMED_CLASSES, _class_from
+
+    cls = _class_from(old)
+    assert f"{cls.__module__}:{cls.__qualname__}" == RENAMED_CLASSES[old]
