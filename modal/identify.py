@@ -14,7 +14,7 @@ from .frf import FRF
 from .peaks import _indicator_and_peak, bands_from_hz, estimate_noise_std, find_modes
 from .results import IdentificationResult
 from .sdof import BANDWISE_METHODS, identify_bands
-from .validate import non_negative, one_of
+from .validate import one_of, per_channel
 
 __all__ = ["identify", "choose_method", "METHODS", "BANDWISE_METHODS"]
 
@@ -115,8 +115,7 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
         raise TypeError(f"identify() got options {', '.join(sorted(global_options))} that only method='global' takes")
     one_of("method", method, METHODS + ("auto",), IdentificationError)
     if noise_std is not None:
-        noise_std = np.broadcast_to(non_negative("noise_std", noise_std, IdentificationError),
-                                    (frf.n_channels,)).copy()
+        noise_std = per_channel("noise_std", noise_std, frf.n_channels, IdentificationError)
     from .scaling import scale_exponent, scaled_frf, unscale_result
 
     # |H| once: the mode indicator and each channel's max |H|, and (but for the global method, which measures

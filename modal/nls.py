@@ -341,7 +341,7 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
                 break
             # a pole the step would push to ζ ≤ 0 (a mode below the noise sliding onto a
             # spike) moves to a tenth of its value instead; rejecting the whole step drove λ
-            # up until every other mode stalled where it started (stress finding 12). Poles
+            # up until every other mode stalled where it started. Poles
             # kept inside a box (ωn within a factor 2 of the lines, ζ ≤ ZETA_MAX) move halfway
             # to the bound, so an unidentifiable mode cannot run off to overflow
             x_r, zeta_t = trial[0::2], trial[1::2]
@@ -458,8 +458,8 @@ def truncation_shift(omega: np.ndarray, response: np.ndarray, power: int, region
     which is exact only to zeroth order: a mode above the bands still adds
     ``−2iζ ω/ωs`` (its damping) and ``(ω/ωs)²`` of itself across the band.
     Where the noise is far below that misfit (near-exact data), the fitted
-    poles are biased by many of their white-noise errors (finding 26 of
-    docs/stress.md: 2.5e-7 relative, 5.5 errors, on exact data). Refitting
+    poles are biased by many of their white-noise errors (2.5e-7 relative, 5.5
+    errors, on exact data with a mode far above the bands). Refitting
     with the background ``c0 + c1 t + c2 t²`` per region (t the position in the
     region, scaled to [−1, 1]) takes
     the first- and second-order terms out; the change of each estimate is the

@@ -13,7 +13,7 @@ import numpy as np
 
 from .errors import ParameterError
 
-__all__ = ["positive", "non_negative", "positive_number", "one_of", "finite_samples"]
+__all__ = ["positive", "non_negative", "per_channel", "positive_number", "one_of", "finite_samples"]
 
 
 def _where(source: str | None) -> str:
@@ -34,6 +34,14 @@ def non_negative(name: str, value, error: type[Exception] = ParameterError) -> n
     if not np.all(np.isfinite(arr)) or np.any(arr < 0):
         raise error(f"'{name}' must be finite and >= 0, got {value!r}")
     return arr
+
+
+def per_channel(name: str, value, n_channels: int, error: type[Exception] = ParameterError) -> np.ndarray:
+    """``value`` (finite, >= 0: one for every channel, or one per channel) as a float array of ``n_channels``."""
+    arr = non_negative(name, value, error)
+    if arr.size not in (1, n_channels):
+        raise error(f"'{name}' has {arr.size} values; expected one, or one per channel ({n_channels})")
+    return np.broadcast_to(arr, (n_channels,)).copy()
 
 
 def positive_number(name: str, value, expected: str, error: type[Exception] = ParameterError,

@@ -97,7 +97,7 @@ def _load_v5_here(p, src: str) -> dict[str, Any]:
             # list the variables first: loadmat can crash the process (SIGSEGV) on a damaged
             # variable of a class we never use (e.g. a char array whose class byte says sparse)
             # and a damaged size: a 1.8 kB file whose cell claimed 268 million elements kept loadmat
-            # allocating for 9 s before it failed (stress finding 31)
+            # allocating for 9 s before it failed
             size = os.path.getsize(p)
             for name, shape, cls in scipy.io.whosmat(os.fspath(p), appendmat=False):
                 if cls not in _V5_CLASSES:

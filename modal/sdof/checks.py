@@ -4,7 +4,8 @@ Peak detection misses a weak mode on the shoulder of a strong one (it needs a
 peak standing out by a prominence and 10× above the noise). The fit then
 bends the strong mode towards the hidden one, its estimates move by many of
 their standard errors, and the residual variance grows only a little (χ² ≈ 3
-for finding 11 of docs/stress.md), so ``model_inadequate`` rarely fires.
+for a mode at 115 Hz hidden beside one at 154 Hz), so ``model_inadequate``
+rarely fires.
 
 The check here asks the question directly. Where the residual, smoothed over a
 mode's width, is largest, it adds one mode and refits. It then keeps the added
@@ -179,7 +180,7 @@ def residual_noise_std(omega: np.ndarray, response: np.ndarray, power: int, regi
 
     The raw-data estimate (:func:`modal.peaks.estimate_noise_std`) takes in the
     resonances' curvature where the lines are coarse: 3.7σ at 16 lines across
-    a band of ±5 half-power widths (finding 17 of docs/stress.md). The same
+    a band of ±5 half-power widths. The same
     neighbour-misfit estimate on the residual of the fitted modes has that
     curvature removed, and a misfit that is smooth on the lines does not enter
     it either (1.02σ there). The result is the smaller of the two, and at least
@@ -409,8 +410,8 @@ def find_missing_mode(omega: np.ndarray, response: np.ndarray, power: int, regio
     ratio_limit = float(special.chdtri(q, SIGNIFICANCE))
     if f_stat > f_limit and ratio > ratio_limit:
         # a fitted mode that moves by more than 3 of its errors once the hidden one is in the
-        # model was biased by it as well, wherever its band (stress finding 28: a neighbour
-        # absorbed a mode lost below the noise and its ζ was 17 errors off, unflagged)
+        # model was biased by it as well, wherever its band (a neighbour that absorbed a
+        # mode lost below the noise had its ζ 17 errors off, unflagged)
         with np.errstate(all="ignore"):
             std = np.sqrt(np.abs(fit.mode_cov[:-1, 0][:, [0, 1], [0, 1]]))  # (n_modes, 2)
             shift = np.abs(np.column_stack([fit.omega_n[:-1] - omega_n, fit.damping_ratio[:-1] - zeta]))

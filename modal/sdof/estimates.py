@@ -166,7 +166,7 @@ def without_neighbours(frf, bands, power, noise, poles):
 
     The magnitude of a mode's band carries its neighbours' tails (an offset and a
     slope across the band), which bend the −3 dB crossings: at 1 % noise a neighbour
-    at 2.5× the frequency biased ωn by −0.4 of its error (SD of z 1.25, issue 21). The
+    at 2.5× the frequency biased ωn by −0.4 of its error (SD of z 1.25). The
     other modes, with the first pass's poles and their constants solved with all the
     poles, are subtracted on every line and each mode is estimated again.
     """

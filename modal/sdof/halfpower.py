@@ -177,7 +177,7 @@ def _fitted_crossing(omega, db, level_db, guess, offset, chooser=None, window_db
         return None
     # under heavy noise the lines near the level scatter over the whole side, and a root
     # half their span from the guess can fall past the peak or below zero (a negative ω2 at
-    # 18 % noise, stress finding 27): a crossing of this side lies within its lines
+    # 18 % noise): a crossing of this side lies within its lines
     if not omega[0] <= crossing <= omega[-1]:
         return None
     return ("fit", near + offset, which)
@@ -384,7 +384,7 @@ def half_power_curve(omega: np.ndarray, h: np.ndarray, power: int, noise_std: fl
         # peak (|ω − ωn| ≤ ζωn/2), and the crossing fits on the lines within ±1 dB of −3 dB on
         # that model, not chosen by the noisy lines themselves: the highest line is selected
         # for being high, which lifts the level and narrows the band (ζ −0.2 to −0.3 of its
-        # error low at 1 % noise, −20 errors at 5 % noise and 300 lines per band; issue 21)
+        # error low at 1 % noise, −20 errors at 5 % noise and 300 lines per band)
         if plan.left is None or plan.right is None:
             break
         with np.errstate(all="ignore"):

@@ -35,7 +35,7 @@ def refinement_check(frf, bands, power, poles, consts, noise, estimated_noise, k
 
     # the refinement starts from the method's poles; a pole the method could not give (ζ ≤ 0
     # or non-finite: half-power under heavy noise) starts from its band instead, so that it
-    # does not take the check away from the other modes (stress finding 25)
+    # does not take the check away from the other modes
     peak = np.array([TWO_PI * b.peak_hz for b in bands])
     width = np.array([b.half_power_width_hz / (2 * b.peak_hz) if b.peak_hz > 0 else np.nan for b in bands])
     span = np.array([(b.high_hz - b.low_hz) / (12 * b.peak_hz) if b.peak_hz > 0 else np.nan for b in bands])
@@ -61,7 +61,7 @@ def refinement_check(frf, bands, power, poles, consts, noise, estimated_noise, k
     omega_n, damping_ratio = fit.omega_n[order], fit.damping_ratio[order]
     std_ref = np.sqrt(np.abs(fit.mode_cov[order][:, 0, [0, 1], [0, 1]]))  # (n_modes, 2)
     shift = truncation(frf, bands, power, fit, strongest)
-    if shift is not None:  # the refinement's own truncation bias (finding 26) widens its errors
+    if shift is not None:  # the refinement's own truncation bias widens its errors
         std_ref = np.hypot(std_ref, shift[0][order])
     # an unconverged refinement still serves: a mode below the noise crawling along a flat
     # valley keeps LM from stopping while the other poles are long settled; the check only
@@ -102,7 +102,7 @@ def constant_distance(difference: np.ndarray, cov: np.ndarray, floor: np.ndarray
 
     k, c, m depend on |A|, and a half-power or circle constant's covariance is often long across
     A and short along it: the difference divided by the total error sqrt(var Re + var Im) let a
-    bias 10 of its errors along |A| pass as 1.9 (docs/stress.md, finding 33). Where the covariance
+    bias 10 of its errors along |A| pass as 1.9. Where the covariance
     is singular, that total error is used.
     """
     a, b, c = cov[:, 0, 0] + floor**2, cov[:, 0, 1], cov[:, 1, 1] + floor**2

@@ -79,9 +79,8 @@ def fit_bands(frf, bands, power, omega_n0, damping_ratio0, channels=None, data=N
 
     A weak mode whose start lies on a noise spike can collapse there inside the
     joint fit (ζ shrinking to the spike's width, its error larger than a tenth
-    of it) while its neighbour absorbs the real mode: finding 29 of
-    docs/stress.md, a neighbour 5.4 errors off, unflagged, with the collapsed
-    mode formally still in the model. Such a mode (relative error of ζ above
+    of it) while its neighbour absorbs the real mode: a neighbour 5.4 errors
+    off, unflagged, with the collapsed mode formally still in the model. Such a mode (relative error of ζ above
     ``REL_STD_LIMIT``, or ζ ≥ 1) restarts where the residual of the other
     modes peaks in its band (:func:`modal.sdof.checks.restart_pole`), and the joint
     fit runs again. The restart is kept only when its residual is lower: the

@@ -64,7 +64,7 @@ def test_units_attributes(tmp_path, result):
         assert mode["stiffness_n_per_m"].attrs["units"] == "N/m"
         assert mode["damping_n_s_per_m"].attrs["units"] == "N s/m"
         assert mode["mass_kg"].attrs["units"] == "kg"
-    assert units_of("rotor_x_m") == "m" and units_of("time_s") == "s" and units_of("damping_ratio") == "1"  # dimensionless (issue 20)
+    assert units_of("rotor_x_m") == "m" and units_of("time_s") == "s" and units_of("damping_ratio") == "1"  # dimensionless
 
 
 def test_unknown_major_version_is_refused(tmp_path, result):

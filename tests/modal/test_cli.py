@@ -109,5 +109,5 @@ def test_real_beam_files_and_time_data_refused():
     assert abs(rows[0]["natural_frequency_hz"] / 51.5 - 1) < 1e-3  # LSCF value, 0.1 %
     time_file = real / "pyuff_MPSTD_Set001_2024_10_08_10_27_07.uff"
     refused = run("fit", time_file)
-    # time data (issue 16) without a force channel: refused with what it holds and how to name the force
+    # time data without a force channel: refused with what it holds and how to name the force
     assert refused.returncode == 1 and "no channel marked as force" in refused.stderr and "--excitation" in refused.stderr

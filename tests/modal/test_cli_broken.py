@@ -1,4 +1,4 @@
-"""The `fit` command on broken files: exit 1 and one line on stderr naming the file (issue 3).
+"""The `fit` command on broken files: exit 1 and one line on stderr naming the file.
 
 `modal.cli.main` is called in-process (the console script and `python -m modal` call
 the same function); `test_cli.py` covers the real subprocess.

@@ -1,4 +1,4 @@
-"""Figures drawn cheaply (issue 19 goal 4): fixed margins instead of a layout engine, log labels without
+"""Figures drawn cheaply: fixed margins instead of a layout engine, log labels without
 mathtext; nothing may overlap or fall off the figure because of it."""
 from __future__ import annotations
 

@@ -24,7 +24,7 @@ def test_noise_estimate_matches_the_added_noise():
 
 def test_noise_estimate_ignores_a_trend_on_a_jittered_axis():
     # a line through its neighbours cancels any straight trend whatever the spacing; the plain
-    # second difference kept slope × (change of spacing) and called it noise (finding 17)
+    # second difference kept slope × (change of spacing) and called it noise
     from modal import FRF
 
     rng = np.random.default_rng(3)

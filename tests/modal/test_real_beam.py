@@ -31,7 +31,7 @@ def test_nls_finds_the_five_modes(beam):
     found = np.array([m.natural_frequency_hz for m in result])
     for f_ref in LSCF_HZ:
         nearest = found[np.argmin(np.abs(found - f_ref))]
-        # the LSCF values are printed to 0.1 Hz; the issue asks for 0.1 %
+        # the LSCF values are printed to 0.1 Hz; the target is 0.1 %
         assert abs(nearest / f_ref - 1) < 1e-3, (f_ref, found)
     for mode in result:
         assert np.isfinite(mode.natural_frequency_hz) and np.isfinite(mode.damping_ratio)

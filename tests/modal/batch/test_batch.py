@@ -1,4 +1,4 @@
-"""`python -m modal batch` and `modal.batch` (issue 18): many FRF files on Dask, one archive and one table,
+"""`python -m modal batch` and `modal.batch`: many FRF files on Dask, one archive and one table,
 per-file failures as data, resumable after a crash or a lost worker.
 
 A real Dask scheduler and two workers are started from the installed `dask` command on 127.0.0.1

@@ -23,7 +23,7 @@ def _fit(frf, **kwargs):
 def hammer_test():
     """Three modes, three hits of a 4 ms hammer (its band ends near 375 Hz), force noise, exponential window.
 
-    The noisy 8192-line H1 estimate of issue 16/19 (noise above the hammer's band) that made identify
+    A noisy 8192-line H1 estimate (noise above the hammer's band) that once made identify
     run for more than 10 minutes: 219 noise peaks went into one joint fit.
     """
     plant = DigitalModes(np.array([120.0, 310.0, 560.0]), np.array([0.01, 0.015, 0.01]),
@@ -69,7 +69,7 @@ def test_exponential_window_damping_is_removed(hammer_test):
         wn = 2 * np.pi * fn
         added = 1 / (0.5 * wn)  # 1/(τωn): the window's first-order damping
         assert mode.window_damping_ratio == pytest.approx(added, rel=0.02)
-        if fn < 375:  # inside the hammer's band: the issue's 3 % on damping
+        if fn < 375:  # inside the hammer's band: the 3 % asked of damping
             assert mode.damping_ratio == pytest.approx(zeta, rel=0.03)
             assert abs(mode.damping_ratio - zeta) < 4 * mode.std.damping_ratio
     plain = _fit(modal.FRF(est.frequency_hz, est.response, kind="receptance"))
@@ -98,7 +98,7 @@ def test_random_excitation_modes_and_no_spurious_ones():
 
 
 def test_a_hundred_thousand_noisy_lines_identify_in_bounded_time():
-    # issue 16/19: any FRF up to 100 000 lines, however noisy, well under a minute. Noise rising above
+    # any FRF up to 100 000 lines, however noisy, well under a minute. Noise rising above
     # 3 kHz to 30 % of the peak (a hammer's band edge): the local noise test keeps its peaks out
     rng = np.random.default_rng(0)
     f = np.linspace(1, 5000, 100_000)

@@ -63,7 +63,7 @@ def test_every_mode_in_band_found_with_calibrated_errors(multi_reference):
     matched = []
     for k in in_band:
         j = int(np.argmin(np.abs(found - fn[k])))
-        assert abs(found[j] / fn[k] - 1) < 3e-3, (fn[k], found)  # the issue's 0.3 %
+        assert abs(found[j] / fn[k] - 1) < 3e-3, (fn[k], found)  # the 0.3 % asked
         matched.append(j)
     assert len(set(matched)) == in_band.size  # the close pair at 200/202 Hz is two modes
     modes = [result[j] for j in matched]
@@ -88,7 +88,7 @@ def test_synthesis_reproduces_the_noise_free_frf(multi_reference):
     synth = result.synthesize(clean.frequency_hz)
     assert synth.kind == "accelerance" and synth.channels.shape == clean.channels.shape
     error = np.abs(synth.channels - clean.channels) / np.abs(clean.channels)
-    assert np.median(error) < 0.01  # the issue's 1 %
+    assert np.median(error) < 0.01  # the 1 % asked
     # the synthesis is the model identify fitted: its residual on the noisy data is the noise (0.2 % of peak)
     residual = noisy.channels - synth.channels
     noise = 0.002 * np.abs(clean.channels).max(axis=1)
@@ -132,7 +132,7 @@ def test_mpc_of_real_and_complex_vectors():
 
 
 def test_errors_are_calibrated_over_noise_seeds():
-    """2σ intervals hold the truth about 95 % of the time (the issue), over 120 noise seeds × 3 modes."""
+    """2σ intervals hold the truth about 95 % of the time (as asked), over 120 noise seeds × 3 modes."""
     fn, zeta = np.array([40.0, 65.0, 90.0]), np.array([0.02, 0.015, 0.01])
     const = np.array([[1.0, 0.6, 0.5], [0.6, -0.9, 0.4], [0.5, 0.4, -0.8], [0.3, 0.8, 0.7]])
     f = np.arange(20, 120.001, 0.2)
@@ -147,7 +147,7 @@ def test_errors_are_calibrated_over_noise_seeds():
                       (m.damping_ratio - zeta[k]) / m.std.damping_ratio])
     z = np.array(z)
     # 360 z-scores per quantity: the standard deviation of a standard normal sample of 360 is 1 ± 0.037;
-    # ±15 % (the issue's bound for calibration) is four of those
+    # ±15 % (the bound asked for calibration) is four of those
     assert np.all(np.abs(z.std(axis=0) - 1) < 0.15), z.std(axis=0)
     coverage = np.mean(np.abs(z) < 2, axis=0)
     # 95.4 % expected, binomial SE 1.1 %: 4 of them either side
@@ -164,7 +164,7 @@ def test_real_beam_modes_and_synthesis():
     found = np.array([m.natural_frequency_hz for m in result])
     for f_ref in BEAM_HZ:
         nearest = found[np.argmin(np.abs(found - f_ref))]
-        # the reference values are printed to 0.1 Hz: 0.05 % (the issue) is 0.03-0.3 Hz here
+        # the reference values are printed to 0.1 Hz: 0.05 % (as asked) is 0.03-0.3 Hz here
         assert abs(nearest / f_ref - 1) < 5e-4, (f_ref, found)
     below = [m for m in result if m.natural_frequency_hz < BEAM_HZ[0] * 0.95]
     assert all(not m.ok for m in below)  # nothing unflagged below the first flexible mode
@@ -175,7 +175,7 @@ def test_real_beam_modes_and_synthesis():
     f = frf.frequency_hz
     band = (f >= 20) & (f <= 990)
     error = np.abs(result.synthesize(f[band]).channels - frf.channels[:, band]) / np.abs(frf.channels[:, band])
-    assert np.median(error) < 0.06 and np.percentile(error, 90) < 0.35  # the issue's 6 % and 35 %
+    assert np.median(error) < 0.06 and np.percentile(error, 90) < 0.35  # the 6 % and 35 % asked
 
 
 def test_cli_global_on_the_real_beam_with_a_stabilisation_plot(tmp_path):

@@ -401,7 +401,7 @@ def test_mat_truncated(tmp_path):
 
 
 def test_mat_size_beyond_what_the_file_can_hold(tmp_path):
-    # stress finding 31: a bit flip in a cell's dimensions (1x1 → 1x268435457) in a 1.8 kB file
+    # a bit flip in a cell's dimensions (1x1 → 1x268435457) in a 1.8 kB file
     # kept loadmat allocating for 9 s before it failed. The sizes listed by whosmat are checked
     # against the file's size first (zlib compresses at most about 1032:1)
     path = tmp_path / "m.mat"

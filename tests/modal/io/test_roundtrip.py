@@ -1,4 +1,4 @@
-"""Write-then-read round trips of every FRF file format (issue 3)."""
+"""Write-then-read round trips of every FRF file format."""
 from __future__ import annotations
 
 import os
