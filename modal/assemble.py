@@ -41,8 +41,9 @@ class ModeEstimate:
     omega_n : float
         Natural frequency, rad/s (as measured: an exponential window's damping still in it).
     damping_ratio : float
-    modal_constant : ndarray of complex, shape (n_channels,)
-        Receptance modal constant per channel, 1/kg (NaN where the method gives none).
+    modal_constant : ndarray of complex, shape (n_channels,), or None
+        Receptance modal constant per channel, 1/kg (NaN where the method gives none); None: the
+        method scales no constants (an output-only method's shapes go in ``mode_shape``).
     covariance : ndarray, shape (n_channels, 4, 4), or None
         Covariance of (ωn [rad/s], ζ, Re A, Im A [1/kg]) per channel; None: not known (NaN).
     std_omega_n, std_damping_ratio : float
@@ -69,7 +70,7 @@ class ModeEstimate:
 
     omega_n: float
     damping_ratio: float
-    modal_constant: np.ndarray
+    modal_constant: np.ndarray | None
     covariance: np.ndarray | None
     std_omega_n: float
     std_damping_ratio: float
@@ -138,7 +139,7 @@ def physical_with_flags(wn, zeta, const, cov, driving, flags: set[str], referenc
 
 
 def assemble_modes(estimates: Sequence[ModeEstimate], *, method: str, source: str, single: bool,
-                   driving: np.ndarray, driving_assumed: bool = False, window_decay_s: float | None = None,
+                   driving: np.ndarray | None, driving_assumed: bool = False, window_decay_s: float | None = None,
                    phase_check: bool = True) -> tuple[ModeResult, ...]:
     """The :class:`~modal.results.ModeResult` of every mode, with the flags every method shares, and a
     warning per flagged mode.
@@ -153,8 +154,9 @@ def assemble_modes(estimates: Sequence[ModeEstimate], *, method: str, source: st
         The FRF's source (file name), for the warnings.
     single : bool
         One channel: the per-channel fields are scalars.
-    driving : ndarray of bool, shape (n_channels,)
-        Driving-point channels (k, c, m defined); see :func:`driving_points`.
+    driving : ndarray of bool, shape (n_channels,), or None
+        Driving-point channels (k, c, m defined); see :func:`driving_points`. None: no channel has
+        an input (output-only data): no k, c, m and no driving-point flags.
     driving_assumed : bool
         A single channel taken as a driving point (flag ``driving_point_assumed``).
     window_decay_s : float, optional
@@ -177,7 +179,11 @@ def assemble_modes(estimates: Sequence[ModeEstimate], *, method: str, source: st
         flags = set(estimate.flags)
         wn, zeta = estimate.omega_n, estimate.damping_ratio
         s_wn, s_z = estimate.std_omega_n, estimate.std_damping_ratio
-        const = np.asarray(estimate.modal_constant, complex)
+        if estimate.modal_constant is None:
+            channels = 1 if estimate.mode_shape is None else np.size(estimate.mode_shape)
+            const = np.full(channels, np.nan, complex)
+        else:
+            const = np.asarray(estimate.modal_constant, complex)
         cov = estimate.covariance
         if cov is None:
             cov = np.full((const.size, 4, 4), np.nan)
@@ -198,8 +204,13 @@ def assemble_modes(estimates: Sequence[ModeEstimate], *, method: str, source: st
                 reference = (reference[0] + wn - wn_measured, reference[1] + zeta - zeta_measured, *reference[2:])
             if not valid:
                 flags.add("window_damping_dominates")
-        (k, c, m), (sk, sc, sm), cov_kcm = physical_with_flags(wn, zeta, const, cov, driving, flags, reference,
-                                                               phase_check)
+        if driving is None:  # output-only: nothing scales the shapes to k, c, m
+            k = c = m = sk = sc = sm = np.full(const.shape, np.nan)
+            cov_kcm, inputs = None, np.zeros(const.shape, bool)
+        else:
+            (k, c, m), (sk, sc, sm), cov_kcm = physical_with_flags(wn, zeta, const, cov, driving, flags, reference,
+                                                                   phase_check)
+            inputs = driving
         s_const = np.sqrt(np.maximum(cov[:, 2, 2] + cov[:, 3, 3], 0))
         sq = (lambda a: a.reshape(-1)[0].item()) if single else (lambda a: np.asarray(a))
         std = ModeStd(s_wn / TWO_PI, s_z, sq(s_const), sq(sk), sq(sc), sq(sm))
@@ -208,10 +219,10 @@ def assemble_modes(estimates: Sequence[ModeEstimate], *, method: str, source: st
             natural_frequency_hz=float(wn / TWO_PI), damping_ratio=float(zeta), modal_constant=sq(const),
             stiffness_n_per_m=sq(k), damping_n_s_per_m=sq(c), mass_kg=sq(m), std=std, flags=flags_t,
             method=method, band_hz=estimate.band_hz, n_lines=int(estimate.n_lines),
-            lines_per_bandwidth=float(estimate.lines_per_bandwidth), chi2=estimate.chi2, driving_point=sq(driving),
+            lines_per_bandwidth=float(estimate.lines_per_bandwidth), chi2=estimate.chi2, driving_point=sq(inputs),
             quality=estimate.quality, window_damping_ratio=window_zeta,
             mode_shape=estimate.mode_shape, participation=estimate.participation, mpc=estimate.mpc,
-            kcm_correlation=correlation_of(cov_kcm[0] if single else cov_kcm)))
+            kcm_correlation=None if cov_kcm is None else correlation_of(cov_kcm[0] if single else cov_kcm)))
         serious = set(flags_t) - INFORMATIONAL
         if serious:
             category = ResolutionWarning if serious & RESOLUTION_FLAGS else QualityWarning

@@ -108,3 +108,17 @@ def test_driving_points_from_the_point_ids_or_the_caller():
     assert driving.tolist() == [True, False] and not assumed
     driving, assumed = driving_points(two, [False, True])
     assert driving.tolist() == [False, True] and not assumed
+
+
+def test_an_output_only_method_hands_over_shapes_and_gets_the_shared_rules_without_k_c_m():
+    # no input measured: shapes instead of scaled constants, no driving point; the pole's rules still apply
+    shape = np.array([1.0, -0.5 + 0.01j, 0.25])
+    modes = [ModeEstimate(TWO_PI * 20.0, 0.02, None, None, 0.01, 1.01 * REL_STD_LIMIT * 0.02,
+                          (15.0, 25.0), 200, 20.0, mode_shape=shape),
+             ModeEstimate(TWO_PI * 40.0, 0.01, None, None, 0.01, 1e-5, (35.0, 45.0), 200, 20.0, mode_shape=shape)]
+    with pytest.warns(QualityWarning, match="high_uncertainty"):
+        first, second = assemble_modes(modes, method="oma", source="run.h5", single=False, driving=None)
+    assert first.flags == ("high_uncertainty",) and second.flags == ()
+    assert np.all(np.isnan(first.mass_kg)) and np.all(np.isnan(first.modal_constant))
+    assert first.driving_point.tolist() == [False] * 3 and first.kcm_correlation is None
+    assert np.array_equal(first.mode_shape, shape) and first.natural_frequency_hz == pytest.approx(20.0, rel=1e-15)
