@@ -14,7 +14,7 @@ import numpy as np
 
 from .errors import FRFValidationError, ModalWarning, warn
 from .units import TWO_PI
-from .validate import positive_number
+from .validate import one_of, per_line, positive_number
 
 __all__ = ["FRF", "FRF_KINDS", "KIND_POWER", "DEFAULT_UNITS", "kind_factor"]
 
@@ -117,10 +117,7 @@ class FRF:
 
     def __post_init__(self) -> None:
         src = self.source
-        if self.kind not in FRF_KINDS:
-            raise FRFValidationError(
-                f"{src}: field 'kind' is {self.kind!r}, expected one of {', '.join(FRF_KINDS)}"
-            )
+        one_of("kind", self.kind, FRF_KINDS, FRFValidationError, src)
         try:
             freq = np.array(self.frequency_hz, dtype=float)
         except (TypeError, ValueError) as exc:
@@ -187,10 +184,7 @@ class FRF:
         if self.units is None:
             object.__setattr__(self, "units", DEFAULT_UNITS[self.kind])
         if self.noise_std is not None:
-            noise = np.array(self.noise_std, dtype=float)
-            shape = resp[0].shape if single else resp.shape
-            if noise.shape != shape or not np.all(np.isfinite(noise)) or np.any(noise < 0):
-                raise FRFValidationError(f"{src}: field 'noise_std' must be finite, >= 0 and shaped like 'response' {shape}")
+            noise = per_line("noise_std", self.noise_std, resp[0].shape if single else resp.shape, FRFValidationError, src)
             if order is not None:
                 noise = noise[..., order]
             noise.setflags(write=False)
@@ -247,8 +241,7 @@ class FRF:
         Converting a line at 0 Hz to a lower kind (for example accelerance to
         receptance) divides by zero and is refused.
         """
-        if kind not in FRF_KINDS:
-            raise FRFValidationError(f"kind must be one of {', '.join(FRF_KINDS)}, got {kind!r}")
+        one_of("kind", kind, FRF_KINDS, FRFValidationError, self.source)
         delta = KIND_POWER[kind] - KIND_POWER[self.kind]
         if delta == 0:
             return self

@@ -13,7 +13,7 @@ import numpy as np
 
 from .errors import ParameterError
 
-__all__ = ["positive", "non_negative", "per_channel", "positive_number", "one_of", "finite_samples"]
+__all__ = ["positive", "non_negative", "per_channel", "per_line", "positive_number", "one_of", "finite_samples"]
 
 
 def _where(source: str | None) -> str:
@@ -44,6 +44,18 @@ def per_channel(name: str, value, n_channels: int, error: type[Exception] = Para
     return np.broadcast_to(arr, (n_channels,)).copy()
 
 
+def per_line(name: str, value, shape: tuple, error: type[Exception] = ParameterError,
+             source: str | None = None) -> np.ndarray:
+    """``value`` as a float array shaped like an FRF's response (``shape``), every entry finite and >= 0."""
+    try:
+        arr = np.array(value, dtype=float)
+    except (TypeError, ValueError):
+        arr = np.full(1, np.nan)
+    if arr.shape != shape or not np.all(np.isfinite(arr)) or np.any(arr < 0):
+        raise error(f"{_where(source)}field '{name}' must be finite, >= 0 and shaped like 'response' {shape}")
+    return arr
+
+
 def positive_number(name: str, value, expected: str, error: type[Exception] = ParameterError,
                     source: str | None = None) -> float:
     """``value`` as a float, finite and > 0; ``expected`` says what it is (``"time in s"``)."""
@@ -56,10 +68,10 @@ def positive_number(name: str, value, expected: str, error: type[Exception] = Pa
     return number
 
 
-def one_of(name: str, value, choices: Sequence, error: type[Exception] = ParameterError):
+def one_of(name: str, value, choices: Sequence, error: type[Exception] = ParameterError, source: str | None = None):
     """``value``, which must be one of ``choices``."""
     if value not in choices:
-        raise error(f"field '{name}' is {value!r}; expected one of {', '.join(map(str, choices))}")
+        raise error(f"{_where(source)}field '{name}' is {value!r}; expected one of {', '.join(map(str, choices))}")
     return value
 
 

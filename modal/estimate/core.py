@@ -21,7 +21,7 @@ import numpy as np
 
 from ..errors import FRFValidationError, ParameterError
 from ..frf import FRF, FRF_KINDS, KIND_POWER
-from ..validate import finite_samples, one_of, positive_number
+from ..validate import finite_samples, one_of, per_line, positive_number
 from . import spectra
 from .hits import find_hits
 from .windows import WINDOWS, exponential_window, force_window, segment_window
@@ -83,13 +83,8 @@ class EstimatedFRF(FRF):
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        shape = np.shape(self.response)
         if self.coherence is not None:
-            arr = np.array(self.coherence, dtype=float)
-            if arr.shape != shape or not np.all(np.isfinite(arr)) or np.any(arr < 0):
-                raise FRFValidationError(
-                    f"{self.source}: field 'coherence' must be finite, >= 0 and shaped like 'response' {shape}"
-                )
+            arr = per_line("coherence", self.coherence, np.shape(self.response), FRFValidationError, self.source)
             arr.setflags(write=False)
             object.__setattr__(self, "coherence", arr)
         if self.multiple_coherence is not None:

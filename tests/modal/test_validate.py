@@ -4,7 +4,7 @@ import pytest
 
 from modal import FRFValidationError, IdentificationError, ParameterError, identify
 from modal.synthetic import modal_frf
-from modal.validate import finite_samples, non_negative, one_of, per_channel, positive, positive_number
+from modal.validate import finite_samples, non_negative, one_of, per_channel, per_line, positive, positive_number
 
 
 def test_checked_values_come_back_as_numbers():
@@ -14,6 +14,7 @@ def test_checked_values_come_back_as_numbers():
     assert one_of("window", "hann", ("rect", "hann")) == "hann"
     assert per_channel("noise_std", 0.5, 3).tolist() == [0.5, 0.5, 0.5]
     assert per_channel("noise_std", [0.5, 0.0], 2).tolist() == [0.5, 0.0]
+    assert per_line("coherence", [[0.5, 1.0]], (1, 2)).tolist() == [[0.5, 1.0]]
 
 
 @pytest.mark.parametrize("check, args, message", [
@@ -24,6 +25,8 @@ def test_checked_values_come_back_as_numbers():
     (positive_number, ("sample_rate_hz", 0, "rate in Hz"), r"^field 'sample_rate_hz' is 0; expected a positive rate in Hz$"),
     (positive_number, ("exponential_decay_s", "long", "time in s"), r"^field 'exponential_decay_s' is 'long'; expected"),
     (per_channel, ("noise_std", [1.0, 2.0], 3), r"^'noise_std' has 2 values; expected one, or one per channel \(3\)$"),
+    (per_line, ("coherence", [0.5, 1.0], (1, 2)), r"^field 'coherence' must be finite, >= 0 and shaped like 'response' \(1, 2\)$"),
+    (per_line, ("coherence", [[0.5, -1.0]], (1, 2)), r"^field 'coherence' must be finite, >= 0"),
     (one_of, ("window", "hamming", ("rect", "hann")), r"^field 'window' is 'hamming'; expected one of rect, hann$"),
 ])
 def test_bad_values_give_one_line_naming_the_argument(check, args, message):
