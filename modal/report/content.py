@@ -17,10 +17,10 @@ from typing import Any
 import numpy as np
 
 from ..errors import ArchiveError, ModalError
-from ..flags import FLAG_ACTION
+from ..estimate.core import EstimatedFRF
+from ..flags import FLAG_ACTION, FLAG_TEXT
 from ..frf import FRF
 from ..geometry import Geometry
-from ..results import FLAG_TEXT
 from ..shapes import ModeShapes, mean_phase_deviation_deg, mode_shapes, mpc
 
 __all__ = ["Section", "ReportContent", "report_content", "mode_rows", "SCENE_SECTIONS"]
@@ -105,7 +105,7 @@ def _glance(path: str, archive, frf: FRF | None, results, geometry_note: str) ->
         rows.append(("channels", f"{frf.n_channels} (response/reference point{points})" if points
                      else f"{frf.n_channels} (no point ids)"))
         rows.append(("lines", f"{frf.n_freq}, {frf.frequency_hz[0]:g}–{frf.frequency_hz[-1]:g} Hz"))
-        if getattr(frf, "averages", None) is not None:
+        if isinstance(frf, EstimatedFRF):
             rows.append(("estimate", f"{frf.estimator} from time data, {frf.averages} average(s), window {frf.window}"))
     for result in results:
         settings = getattr(result, "settings", {}) or {}

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..estimate.core import EstimatedFRF
 from ..frf import FRF
 from ..geometry import Geometry
 from ..shapes import ModeShapes, mean_phase_deviation_deg, mpc, normalise
@@ -111,7 +112,7 @@ def frf_payload(frf: FRF, results) -> dict:
             continue
         models.append((result.method, synth))
     channels = drawn_channels(frf.n_channels)
-    coherence = getattr(frf, "coherence", None)
+    coherence = frf.coherence if isinstance(frf, EstimatedFRF) else None
     if coherence is not None:
         coherence = np.atleast_2d(np.asarray(coherence, float))
     entries = []
