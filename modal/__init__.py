@@ -21,13 +21,16 @@ from .io import read_frf, write_frf  # noqa: E402
 from .estimate import EstimatedFRF, estimate_frf  # noqa: E402
 from .flags import FLAG_TEXT  # noqa: E402
 from .results import IdentificationResult, ModeResult, ModeStd, physical_parameters  # noqa: E402
-from .synthetic import add_noise, matrix_frf, modal_frf, sdof_frf  # noqa: E402
+from .synthetic import (  # noqa: E402
+    DigitalModes, add_noise, impact_record, matrix_frf, modal_frf, random_record, sdof_frf,
+)
 from .geometry import Geometry, line_geometry  # noqa: E402
 from .io.geometry import read_geometry  # noqa: E402
 
 __all__ = [
     "FRF", "FRF_KINDS", "identify", "estimate_frf", "EstimatedFRF", "read_frf", "write_frf", "METHODS", "IdentificationResult", "ModeResult", "ModeStd",
     "FLAG_TEXT", "physical_parameters", "Geometry", "line_geometry", "read_geometry", "modal_frf", "matrix_frf", "sdof_frf", "add_noise",
+    "DigitalModes", "impact_record", "random_record",
     "errors", "units", "ModalError", "FRFValidationError", "FormatError", "IdentificationError",
     "ParameterError", "ModalWarning", "ResolutionWarning", "QualityWarning",
 ]

@@ -179,3 +179,11 @@ def add_noise(frf: FRF, level: float, seed: int | np.random.Generator | None = 0
     from dataclasses import replace
 
     return replace(frf, response=noisy[0] if frf.n_channels == 1 and frf.response.ndim == 1 else noisy)
+
+
+# ------------------------------------------------------------ time records (impact and random excitation)
+from .synthetic_time import (  # noqa: E402
+    DigitalModes, SyntheticRecord, hammer_force, impact_record, random_record,
+)
+
+__all__ += ["DigitalModes", "SyntheticRecord", "hammer_force", "impact_record", "random_record"]

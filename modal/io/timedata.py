@@ -59,6 +59,9 @@ class TimeRecord:
     units : tuple of str or None
         Each channel's unit after conversion to SI (None when unknown).
     source : str
+    full_scale : tuple of float or None, or None
+        Each channel's declared converter full scale in the channel's unit (SI where
+        converted), None where the file does not say; None for no channel at all.
     """
 
     signals: np.ndarray
@@ -67,6 +70,7 @@ class TimeRecord:
     quantities: tuple[str | None, ...]
     units: tuple[str | None, ...]
     source: str = "<array>"
+    full_scale: tuple[float | None, ...] | None = None
 
     @property
     def n_channels(self) -> int:
