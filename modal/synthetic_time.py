@@ -17,7 +17,7 @@ width varying between hits, rebounds, noise, clipping at a full scale);
 :func:`random_record` makes stationary random-excitation records. Both return a
 :class:`SyntheticRecord` whose ``record`` is a :class:`~modal.io.timedata.TimeRecord`
 (force first, in N; responses in SI), ready for :func:`modal.estimate_frf` or
-:func:`modal.io.timedata.write_time`.
+:func:`modal.io.timewrite.write_time`.
 
 Modal constants follow :func:`modal.synthetic.modal_frf`: the receptance of mode r
 at output o is A/((s − p)(s − p̄)) for a real A (proportional damping). A complex A

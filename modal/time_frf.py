@@ -60,22 +60,21 @@ def frf_from_time(path, args, report: Callable[[str], None] | None = None):
             what = "no channel" if not inputs else f"{len(inputs)} channels"
             raise FormatError(f"{src}: {what} marked as force ({listing}); expected one: name the force channel "
                               "with --excitation CHANNEL (an FRF needs an excitation)")
-        if report is not None:
-            report(f"{src}: excitation channel {inputs[0] + 1} ({record.names[inputs[0]]})")
     if args.response:
         outputs = [record.channel_index(r) for r in args.response]
     else:
         outputs = [k for k in range(record.n_channels) if k not in inputs]
     if not outputs:
-        raise FormatError(f"{src}: no response channel besides the excitation; expected at least one")
-    quantities = {record.quantities[k] for k in outputs}
-    quantity = quantities.pop() if len(quantities) == 1 else None
-    if len(quantities) > 0:
-        raise FormatError(f"{src}: the response channels measured different quantities; expected one kind "
-                          "(choose them with --response)")
+        listing = ", ".join(record.describe(k) for k in range(record.n_channels))
+        raise FormatError(f"{src}: holds {record.n_channels} channel(s) ({listing}) and no response besides the "
+                          "excitation; expected at least one response channel (is the file cut short?)")
+    quantity = record.check_roles(inputs, outputs)
+    if args.excitation is None and report is not None:
+        report(f"{src}: excitation channel {inputs[0] + 1} ({record.names[inputs[0]]})")
     kind = getattr(args, "kind", None) or _KIND_OF_QUANTITY.get(quantity or "")
     if kind is None:
-        raise FormatError(f"{src}: the file does not say what the response channels measured; give --kind "
+        listing = ", ".join(record.describe(k) for k in outputs)
+        raise FormatError(f"{src}: the file does not say what the responses measured ({listing}); give --kind "
                           f"({', '.join(FRF_KINDS)})")
     window = args.window or ("force" if args.impact else "hann")
     estimate = estimate_frf(

@@ -1,19 +1,29 @@
 """Reading time records (force and responses) for FRF estimation.
 
 :func:`read_time` returns a :class:`TimeRecord`: channels × samples on one
-uniform time axis, with each channel's name (point id), what it measured and
-its unit when the file says. Formats, picked from the file's bytes:
+uniform time axis, with each channel's name (point id), what it measured, its
+unit and its converter full scale when the file says. Formats, picked from the
+file's bytes (docs/estimate.md has the full specification):
 
 * UFF 58/58b with function type 1 (time response); record 8's ordinate
   specific data type gives the quantity (13 force, 8/11/12 displacement,
   velocity, acceleration); the point id is the response node and direction;
+  the time step is record 7's increment, or an explicit abscissa (spacing 0)
+  when it is uniform;
 * CSV: a time column (header ``time``, ``t`` or ``time_s``, in s) and one
   column per channel; a header ``name [unit]`` gives the unit, from which the
   quantity follows (N → force, m → displacement, m/s → velocity, m/s^2 or g →
-  acceleration);
-* MAT (v5/v7 or v7.3) and HDF5: ``signals`` (channels × samples), and either
-  ``sample_rate_hz`` (or ``fs``) or a ``time`` vector; optional ``names``,
-  ``quantities`` and ``units`` (string arrays, or HDF5 attributes of ``signals``).
+  acceleration); ``#`` lines are comments, ``# full_scale: v1, v2, ...`` declares
+  each channel's full scale in its unit;
+* MAT (v5/v7 or v7.3) and HDF5: ``signals`` (channels × samples, or a cell of
+  equal-length channels), and either ``sample_rate_hz`` (or ``fs``) or a ``time``
+  vector; optional ``names``, ``quantities``, ``units`` (strings, or HDF5
+  attributes of ``signals``) and ``full_scale`` (NaN where unknown).
+
+A damaged or hostile file (cut short, a zero or uneven time step, channels of
+different lengths, samples that are not finite, sizes beyond what the file can
+hold) ends in one :class:`~modal.errors.FormatError` naming the file, the dataset
+or column, and what is wrong.
 """
 from __future__ import annotations
 
@@ -27,6 +37,7 @@ import numpy as np
 
 from ..errors import FormatError
 from ._common import check_file, source_name
+from .mat import _MAX_ELEMENTS_PER_BYTE
 
 __all__ = ["TimeRecord", "read_time", "QUANTITY_FROM_DATA_TYPE"]
 
@@ -95,6 +106,64 @@ class TimeRecord:
         """Indices of the channels that measured force."""
         return [k for k, q in enumerate(self.quantities) if q == "force"]
 
+    def describe(self, index: int) -> str:
+        """``channel 2 (1+Z, acceleration in m/s^2)``: a channel as messages name it."""
+        quantity = self.quantities[index]
+        unit = self.units[index]
+        what = (f"{quantity} in {unit}" if quantity and unit else quantity or
+                (f"unknown quantity in {unit}" if unit else "unknown quantity"))
+        return f"channel {index + 1} ({self.names[index]}, {what})"
+
+    def check_roles(self, inputs, outputs) -> str | None:
+        """Check that the excitation channels measured force and the responses motion.
+
+        Parameters
+        ----------
+        inputs, outputs : sequence of int
+            0-based indices of the excitation and response channels.
+
+        Returns
+        -------
+        str or None
+            What every response measured (``"displacement"``, ``"velocity"`` or
+            ``"acceleration"``), None when the file does not say.
+
+        Raises
+        ------
+        FormatError
+            An excitation whose quantity or unit says it is not a force, a response that
+            measured force, a channel in both roles, responses of different quantities.
+
+        Warns
+        -----
+        ModalWarning
+            An excitation channel of unknown quantity (accepted as the force).
+        """
+        from ..errors import ModalWarning, warn
+
+        both = sorted(set(inputs) & set(outputs))
+        if both:
+            raise FormatError(f"{self.source}: {self.describe(both[0])} is both the excitation and a response; "
+                              "expected separate force and response channels")
+        for k in inputs:
+            if self.quantities[k] is None:
+                warn(f"{self.source}: {self.describe(k)} is taken as the excitation, but the file does not say "
+                     "it measured force; check that it is the hammer's or shaker's force in N", ModalWarning)
+            elif self.quantities[k] != "force":
+                raise FormatError(f"{self.source}: {self.describe(k)} is named as the excitation but measured "
+                                  f"{self.quantities[k]}; expected a force channel (N) as the excitation")
+        for k in outputs:
+            if self.quantities[k] == "force":
+                raise FormatError(f"{self.source}: {self.describe(k)} is a response but measured force; expected "
+                                  "responses of displacement, velocity or acceleration")
+        known = {self.quantities[k] for k in outputs if self.quantities[k] is not None}
+        unknown = [k for k in outputs if self.quantities[k] is None]
+        if len(known) > 1 or (known and unknown):
+            listing = ", ".join(self.describe(k) for k in outputs)
+            raise FormatError(f"{self.source}: the responses measured different quantities ({listing}); expected "
+                              "one kind (choose them with --response)")
+        return known.pop() if known else None
+
 
 def _normalise_unit(unit: str | None) -> str | None:
     if unit is None:
@@ -116,15 +185,34 @@ def _channel(values, unit: str | None, quantity: str | None):
     return np.asarray(values, float), (unit.strip() if u else _SI_UNIT.get(quantity or "")), quantity
 
 
+#: no measurement reaches this magnitude in any unit; writers put the largest double (1.8e308) for ±Inf,
+#: and squaring such a sample overflows the spectra
+LARGEST_SAMPLE = 1e100
+
+
+def _check_samples(values: np.ndarray, src: str, where: str) -> None:
+    """Every sample finite and of a magnitude a measurement can have; the message names the first bad one."""
+    values = np.asarray(values)
+    if values.dtype.kind not in "fiu":
+        raise FormatError(f"{src}: {where}: samples of type {values.dtype}; expected real numbers")
+    with np.errstate(invalid="ignore"):
+        bad = ~(np.abs(values) < LARGEST_SAMPLE)
+    if bad.any():
+        i = np.unravel_index(int(np.argmax(bad)), values.shape)
+        ch, sample = (int(i[0]) + 1, int(i[1])) if values.ndim == 2 else (None, int(i[0]))
+        value = values[i]
+        what = "not a number" if np.isnan(value) else ("infinite" if np.isinf(value) else
+                                                        f"{value:.4g} (a writer's stand-in for infinity?)")
+        at = f"channel {ch}, sample {sample + 1}" if ch is not None else f"sample {sample + 1}"
+        raise FormatError(f"{src}: {where}, {at}: {what}; expected finite samples (|value| < {LARGEST_SAMPLE:g})")
+
+
 def _check(signals: np.ndarray, rate: float, src: str) -> None:
     if signals.ndim != 2 or signals.shape[1] < 2:
         raise FormatError(f"{src}: field 'signals' has shape {signals.shape}; expected (channels, samples >= 2)")
     if not (np.isfinite(rate) and rate > 0):
         raise FormatError(f"{src}: sample rate {rate!r}; expected a positive number of samples per second")
-    bad = ~np.isfinite(signals)
-    if bad.any():
-        ch, i = (int(v) for v in np.argwhere(bad)[0])
-        raise FormatError(f"{src}: channel {ch + 1}, sample {i}: not a finite number; expected finite samples")
+    _check_samples(signals, src, "field 'signals'")
 
 
 def _rate_from_time(time: np.ndarray, src: str, field: str = "time") -> float:
@@ -139,47 +227,90 @@ def _rate_from_time(time: np.ndarray, src: str, field: str = "time") -> float:
     return 1.0 / mean
 
 
+def _uff_time_step(block, d: dict, src: str) -> float:
+    """The time step of one dataset 58 of time data, s: record 7's increment, or its explicit abscissa."""
+    if int(d.get("abscissa_spacing", 1)) == 1:
+        step = float(d.get("abscissa_inc", float("nan")))
+        if not (np.isfinite(step) and step > 0):
+            raise FormatError(f"{src}: {block.where(7, 'abscissa_inc')}: time step {step!r} s; expected a positive "
+                              "step between samples")
+        return step
+    # spacing 0: the abscissa is stored with every sample (pyuff writes it so when given x): accept it when uniform
+    x = np.asarray(d.get("x", ()), dtype=float)
+    # ASCII keeps each abscissa to 6 significant digits (E13.5): 5e-6 of |x|; binary stores them as written
+    binary = block.raw.split(b"\n", 2)[1:2] and block.raw.split(b"\n", 2)[1][6:7].lower() == b"b"
+    rounding = 1e-12 if binary else 5e-6
+    where = f"{block.where()} (record 7 abscissa_spacing 0: an abscissa for every sample)"
+    if x.size < 2 or not np.all(np.isfinite(x)):
+        raise FormatError(f"{src}: {where}: {x.size} abscissa values or non-finite ones; expected a time axis in s")
+    step = (x[-1] - x[0]) / (x.size - 1)
+    offset = np.abs(x - (x[0] + step * np.arange(x.size)))
+    # each value off by its own rounding, and the axis through the end points by theirs
+    bad = offset > rounding * (np.abs(x) + abs(x[0]) + abs(x[-1])) + 1e-9 * abs(step)
+    if not step > 0 or bad.any():
+        steps = np.diff(x)
+        usual = float(np.median(steps))
+        jumps = np.flatnonzero(np.abs(steps - usual) > 2 * rounding * (np.abs(x[1:]) + abs(usual)))
+        if usual > 0 and jumps.size:
+            j = int(jumps[0])
+            what = (f"the step from sample {j + 1} to {j + 2} is {steps[j]:.6g} s against {usual:.6g} s "
+                    "elsewhere")
+        else:
+            what = f"the times run from {x[0]:.6g} to {x[-1]:.6g} s unevenly"
+        raise FormatError(f"{src}: {where}: {what}; expected samples at one rate (resample first)")
+    return float(step)
+
+
 def _read_uff(path, src: str) -> TimeRecord:
-    import pyuff
+    from .uff import FUNCTION_TYPES, check_header, format_point, read_dataset, scan_datasets
 
-    from .uff import format_point
-
-    try:
-        with warnings.catch_warnings(), np.errstate(all="ignore"):
-            warnings.simplefilter("ignore")
-            uff = pyuff.UFF(os.fspath(path))
-            types = [int(t) for t in uff.get_set_types()]
-            sets = [uff.read_sets(k) if t == 58 else None for k, t in enumerate(types)]
-    except Exception as exc:  # pyuff raises bare Exception
-        raise FormatError(f"{src}: cannot be read as UFF ({exc}); expected datasets 58/58b") from None
-    chosen = [(k, d) for k, d in enumerate(sets) if isinstance(d, dict) and int(d.get("func_type", -1)) == 1]
+    uff, blocks = scan_datasets(path, src)
+    uff58 = [b for b in blocks if b.type == 58]
+    if not uff58:
+        kinds = ", ".join(sorted({str(b.type) for b in blocks}))
+        raise FormatError(f"{src}: no dataset 58 (the file holds dataset types {kinds}); expected a time file: "
+                          "datasets 58/58b of function type 1 (time response)")
+    headers = {b.number: read_dataset(uff, b, src, header_only=True) for b in uff58}
+    chosen = [b for b in uff58 if int(headers[b.number].get("func_type", -1)) == 1]
     if not chosen:
-        found = sorted({int(d["func_type"]) for d in sets if isinstance(d, dict) and "func_type" in d})
-        raise FormatError(f"{src}: no dataset 58 of function type 1 (time response) (function types found: "
-                          f"{found or 'none'}); expected time data")
-    k0, first = chosen[0]
-    step = float(first["abscissa_inc"])
-    n = int(first["num_pts"])
+        found = sorted({int(h.get("func_type", -1)) for h in headers.values()})
+        names = ", ".join(f"{t} ({FUNCTION_TYPES.get(t, 'unknown')})" for t in found)
+        frf = " (FRFs: fit them with 'modal fit')" if 4 in found else ""
+        raise FormatError(f"{src}: no time data: its datasets 58 are of function type {names}{frf}; expected a time "
+                          "file: datasets 58/58b of function type 1 (time response)")
     signals, names, quantities, units = [], [], [], []
-    for k, d in chosen:
-        if int(d["num_pts"]) != n or not np.isclose(float(d["abscissa_inc"]), step, rtol=1e-9):
-            raise FormatError(f"{src}: dataset {k + 1}: {d['num_pts']} samples every {d['abscissa_inc']} s; expected "
-                              f"{n} every {step} s like dataset {k0 + 1} (one time axis for every channel)")
-        data = np.asarray(d["data"])
+    b0, n0, step0 = None, 0, 0.0
+    for b in chosen:
+        problem = check_header(b, src)
+        if problem:
+            raise FormatError(problem)
+        d = read_dataset(uff, b, src, header_only=False)
+        data = np.asarray(d.get("data", ()))
+        n_pts = int(d.get("num_pts", -1))
+        if data.size != n_pts:
+            raise FormatError(f"{src}: {b.where(7, 'num_pts')}: says {n_pts} samples but its data hold {data.size}: "
+                              "the dataset ends early; expected a complete dataset (truncated or damaged file?)")
         if np.iscomplexobj(data):
-            raise FormatError(f"{src}: dataset {k + 1}: complex ordinates; expected real time samples")
+            raise FormatError(f"{src}: {b.where(7, 'ord_data_type')}: complex ordinates; expected real time samples")
+        step = _uff_time_step(b, d, src)
+        if b0 is None:
+            b0, n0, step0 = b, n_pts, step
+        elif n_pts != n0 or not np.isclose(step, step0, rtol=1e-9):
+            raise FormatError(f"{src}: {b.where(7)}: {n_pts} samples every {step:.9g} s; expected {n0} every "
+                              f"{step0:.9g} s like dataset {b0.number} (one time axis for every channel)")
+        _check_samples(data, src, b.where())
         quantity = QUANTITY_FROM_DATA_TYPE.get(int(d.get("ordinate_spec_data_type", 0)))
         unit = d.get("ordinate_axis_units_lab")
         unit = None if unit in (None, "NONE", "") else str(unit)
         values, si, quantity = _channel(data, unit, quantity)
         signals.append(values)
-        names.append(format_point(int(d.get("rsp_node", k + 1)), int(d.get("rsp_dir", 0))))
+        names.append(format_point(int(d.get("rsp_node", b.number)), int(d.get("rsp_dir", 0))))
         quantities.append(quantity)
         units.append(si)
     if len(set(names)) < len(names):  # repeated point ids (a roving test stored twice): number them
         names = [f"{n}#{k + 1}" for k, n in enumerate(names)]
     signals = np.array(signals)
-    rate = 1.0 / step
+    rate = 1.0 / step0
     # UFF keeps the time step to 6 significant digits (E13.5): 1/1024 s comes back as 9.76562e-4 s. A rate
     # within that rounding (5e-6 relative) of a whole number of samples per second is taken as that number
     if abs(rate - round(rate)) <= 5e-6 * rate:
@@ -196,29 +327,72 @@ def _split_header(text: str) -> tuple[str, str | None]:
     return text.strip(), None
 
 
+_TIME_CSV = "expected a time file: a 'time' column (s) followed by one column per channel, 'name [unit]'"
+
+
+def _csv_full_scale(comments: list[tuple[int, str]], n_channels: int, src: str) -> list[float | None] | None:
+    """The ``# full_scale: v1, v2, ...`` comment line (one level per channel, in its unit; nan when unknown)."""
+    for line_no, text in comments:
+        key, _, value = text.lstrip("#").partition(":")
+        if key.strip().lower() != "full_scale":
+            continue
+        parts = [v.strip() for v in value.replace(";", ",").split(",")]
+        try:
+            levels = [float(v) if v else float("nan") for v in parts]
+        except ValueError:
+            raise FormatError(f"{src}: line {line_no}, full_scale: {value.strip()!r}; expected one number per "
+                              "channel (nan where unknown)") from None
+        if len(levels) != n_channels or any(v <= 0 for v in levels):
+            raise FormatError(f"{src}: line {line_no}, full_scale: {len(levels)} value(s) {value.strip()!r}; "
+                              f"expected {n_channels} positive levels, one per channel (nan where unknown)")
+        return [v if np.isfinite(v) else None for v in levels]
+    return None
+
+
 def _read_csv(path, src: str) -> TimeRecord:
     with open(path, newline="", encoding="utf-8-sig") as fh:
-        sample = fh.read(4096)
-        fh.seek(0)
-        try:
-            dialect = _csv.Sniffer().sniff(sample, delimiters=",;\t ")
-        except _csv.Error:
-            dialect = _csv.excel
-        rows = [r for r in _csv.reader(fh, dialect) if any(c.strip() for c in r)]
-    if len(rows) < 3:
-        raise FormatError(f"{src}: {len(rows)} rows; expected a header and at least 2 rows of samples")
-    header = [c.strip() for c in rows[0]]
-    if header[0].lower() not in _TIME_NAMES:
-        raise FormatError(f"{src}: line 1, column 1 is {header[0]!r}; expected a time column named 'time' (s) "
-                          "followed by one column per channel")
+        text = fh.read()
+    lines = text.splitlines()
+    comments = [(k + 1, ln) for k, ln in enumerate(lines) if ln.lstrip().startswith("#")]
+    body = [(k + 1, ln) for k, ln in enumerate(lines) if ln.strip() and not ln.lstrip().startswith("#")]
+    if any("modalbal-frf-csv" in ln for _, ln in comments[:1]):
+        raise FormatError(f"{src}: line 1: an FRF file (modalbal-frf-csv), not a time record; {_TIME_CSV} "
+                          "(fit FRF files with 'modal fit')")
     try:
-        table = np.array([[float(c) for c in r] for r in rows[1:]])
-    except ValueError as exc:
-        raise FormatError(f"{src}: a sample is not a number ({exc}); expected numbers below the header") from None
-    if table.ndim != 2 or table.shape[1] != len(header) or table.shape[1] < 2:
-        raise FormatError(f"{src}: rows have differing numbers of columns; expected {len(header)} in every row")
+        dialect = _csv.Sniffer().sniff("\n".join(ln for _, ln in body[:50]), delimiters=",;\t ")
+    except _csv.Error:
+        dialect = _csv.excel
+    parsed = _csv.reader([ln for _, ln in body], dialect)
+    rows = [(k, [c.strip() for c in row]) for (k, _), row in zip(body, parsed)]
+    if len(rows) < 3:
+        raise FormatError(f"{src}: {len(rows)} rows; {_TIME_CSV}, and at least 2 rows of samples")
+    header_line, header = rows[0]
+    if header[0].lower() not in _TIME_NAMES:
+        frf = header[0].lower().startswith(("freq", "f [", "f_hz", "f (", "omega"))
+        what = "a frequency column: an FRF, not a time record" if frf else "not a time column"
+        raise FormatError(f"{src}: line {header_line}, column 1 is {header[0]!r} ({what}); {_TIME_CSV}"
+                          + (" (fit FRF files with 'modal fit')" if frf else ""))
+    if len(header) < 2:
+        raise FormatError(f"{src}: line {header_line}: only the time column; {_TIME_CSV}")
+    for line_no, row in rows[1:]:
+        if len(row) != len(header):
+            raise FormatError(f"{src}: line {line_no}: {len(row)} columns; expected {len(header)} like the header "
+                              f"(line {header_line}) in every row")
+    try:
+        table = np.array([row for _, row in rows[1:]], dtype=float)
+    except ValueError:
+        for line_no, row in rows[1:]:  # find the cell
+            for j, cell in enumerate(row):
+                try:
+                    float(cell)
+                except ValueError:
+                    column = header[j] or f"column {j + 1}"
+                    raise FormatError(f"{src}: line {line_no}, column {column!r}: {cell!r} is not a number; "
+                                      "expected numbers below the header") from None
+        raise
     rate = _rate_from_time(table[:, 0], src)
-    signals, names, quantities, units = [], [], [], []
+    scale = _csv_full_scale(comments, len(header) - 1, src)
+    signals, names, quantities, units, scales = [], [], [], [], []
     for j, text in enumerate(header[1:], start=1):
         name, unit = _split_header(text)
         values, si, quantity = _channel(table[:, j], unit, None)
@@ -226,81 +400,146 @@ def _read_csv(path, src: str) -> TimeRecord:
         names.append(name or str(j))
         quantities.append(quantity)
         units.append(si)
+        level = None if scale is None else scale[j - 1]
+        scales.append(None if level is None else level * _SI_FACTOR.get(_normalise_unit(unit) or "", 1.0))
     signals = np.array(signals)
     _check(signals, rate, src)
-    return TimeRecord(signals, rate, tuple(names), tuple(quantities), tuple(units), src)
+    declared = tuple(scales) if any(v is not None for v in scales) else None
+    return TimeRecord(signals, rate, tuple(names), tuple(quantities), tuple(units), src, declared)
 
 
-def _strings(value) -> list[str] | None:
+def _strings(value, field: str, src: str) -> list[str] | None:
+    """A list of strings from a char array, cellstr or HDF5 string attribute (None when absent)."""
     if value is None:
         return None
-    arr = np.atleast_1d(np.asarray(value))
+    if isinstance(value, str):
+        return [value.strip()]
     out = []
-    for v in arr.ravel():
+    for v in (value if isinstance(value, list) else np.atleast_1d(np.asarray(value)).ravel()):
         if isinstance(v, bytes):
-            v = v.decode()
+            v = v.decode("utf-8", "replace")
+        if isinstance(v, np.ndarray) and v.dtype.kind in "US" and v.size <= 1:
+            v = "".join(str(c) for c in v.ravel())
+        if not isinstance(v, (str, np.str_)):
+            raise FormatError(f"{src}: field {field!r} holds {type(v).__name__} values; expected text, one per channel")
         out.append(str(v).strip())
     return out
+
+
+def _signals(value, src: str) -> np.ndarray:
+    """The ``signals`` variable as a float array (channels, samples); a cell of channels is stacked."""
+    if isinstance(value, (list, tuple)) or (isinstance(value, np.ndarray) and value.dtype.kind == "O"):
+        channels = [np.asarray(v).squeeze() for v in (value if isinstance(value, (list, tuple)) else value.ravel())]
+        for k, ch in enumerate(channels):
+            if ch.ndim != 1 or ch.dtype.kind not in "fiub":
+                raise FormatError(f"{src}: field 'signals', channel {k + 1}: {ch.dtype} of shape {ch.shape}; "
+                                  "expected a vector of numbers")
+            if ch.size != channels[0].size:
+                raise FormatError(f"{src}: field 'signals', channel {k + 1}: {ch.size} samples, channel 1 has "
+                                  f"{channels[0].size}; expected one length for every channel")
+        if not channels:
+            raise FormatError(f"{src}: field 'signals' is empty; expected (channels, samples)")
+        return np.array(channels, dtype=float)
+    arr = np.asarray(value)
+    if arr.dtype.kind not in "fiub":
+        what = "complex numbers" if arr.dtype.kind == "c" else f"values of type {arr.dtype}"
+        raise FormatError(f"{src}: field 'signals' holds {what}; expected real samples (channels x samples)")
+    if arr.ndim > 2:
+        raise FormatError(f"{src}: field 'signals' has shape {arr.shape}; expected (channels, samples)")
+    return np.atleast_2d(arr.astype(float))
+
+
+def _number(value, field: str, src: str) -> float | None:
+    if value is None:
+        return None
+    arr = np.asarray(value)
+    if arr.dtype.kind not in "fiu" or arr.size != 1:
+        raise FormatError(f"{src}: field {field!r} holds {arr.size} value(s) of type {arr.dtype}; expected one number")
+    return float(arr.ravel()[0])
 
 
 def _from_mapping(get, src: str) -> TimeRecord:
     signals = get("signals")
     if signals is None:
-        raise FormatError(f"{src}: no variable 'signals'; expected 'signals' (channels x samples) and "
+        raise FormatError(f"{src}: no variable 'signals'; expected a time file: 'signals' (channels x samples) and "
                           "'sample_rate_hz' or 'time'")
-    signals = np.atleast_2d(np.asarray(signals, float))
-    rate = get("sample_rate_hz")
+    signals = _signals(signals, src)
+    rate = _number(get("sample_rate_hz"), "sample_rate_hz", src)
     if rate is None:
-        rate = get("fs")
-    if rate is not None:
-        rate = float(np.asarray(rate, float).ravel()[0])
-    else:
+        rate = _number(get("fs"), "fs", src)
+    if rate is None:
         time = get("time")
         if time is None:
             raise FormatError(f"{src}: neither 'sample_rate_hz' nor 'time'; expected one of them beside 'signals'")
         time = np.asarray(time, float).ravel()
         if signals.shape[1] != time.size and signals.shape[0] == time.size:
             signals = signals.T
+        if signals.shape[1] != time.size:
+            raise FormatError(f"{src}: field 'time' has {time.size} values and 'signals' {signals.shape[1]} samples "
+                              "per channel; expected one time per sample")
         rate = _rate_from_time(time, src)
-    names = _strings(get("names")) or [str(k + 1) for k in range(signals.shape[0])]
-    quantities = _strings(get("quantities")) or [None] * signals.shape[0]
-    stored_units = _strings(get("units")) or [None] * signals.shape[0]
-    for field, values in (("names", names), ("quantities", quantities), ("units", stored_units)):
-        if len(values) != signals.shape[0]:
-            raise FormatError(f"{src}: field {field!r} has {len(values)} entries; expected one per channel "
-                              f"({signals.shape[0]})")
-    out, si_units, quants = [], [], []
-    for k in range(signals.shape[0]):
-        q = quantities[k] if quantities[k] in ("force", "displacement", "velocity", "acceleration") else None
+    n_ch = signals.shape[0]
+    names = _strings(get("names"), "names", src) or [str(k + 1) for k in range(n_ch)]
+    quantities = _strings(get("quantities"), "quantities", src) or [""] * n_ch
+    stored_units = _strings(get("units"), "units", src) or [None] * n_ch
+    scale = get("full_scale")
+    full_scale = None if scale is None else np.atleast_1d(np.asarray(scale, dtype=float)).ravel()
+    for field, values in (("names", names), ("quantities", quantities), ("units", stored_units),
+                          ("full_scale", full_scale)):
+        if values is not None and len(values) != n_ch:
+            raise FormatError(f"{src}: field {field!r} has {len(values)} entries; expected one per channel ({n_ch})")
+    if full_scale is not None and np.any(full_scale <= 0):
+        k = int(np.flatnonzero(full_scale <= 0)[0])
+        raise FormatError(f"{src}: field 'full_scale', channel {k + 1}: {full_scale[k]:g}; expected a positive level "
+                          "(NaN where unknown)")
+    out, si_units, quants, scales = [], [], [], []
+    for k in range(n_ch):
+        q = quantities[k].lower() if quantities[k] else None
+        if q is not None and q not in _SI_UNIT:
+            raise FormatError(f"{src}: field 'quantities', channel {k + 1}: {quantities[k]!r}; expected one of "
+                              f"{', '.join(_SI_UNIT)} (or empty when unknown)")
         values, si, q = _channel(signals[k], stored_units[k], q)
         out.append(values)
         si_units.append(si)
         quants.append(q)
+        level = None if full_scale is None or not np.isfinite(full_scale[k]) else float(full_scale[k])
+        factor = _SI_FACTOR.get(_normalise_unit(stored_units[k]) or "", 1.0)
+        scales.append(None if level is None else level * factor)
     signals = np.array(out)
     _check(signals, rate, src)
-    return TimeRecord(signals, rate, tuple(names), tuple(quants), tuple(si_units), src)
+    declared = tuple(scales) if any(v is not None for v in scales) else None
+    return TimeRecord(signals, rate, tuple(names), tuple(quants), tuple(si_units), src, declared)
 
 
 def _read_mat(path, src: str) -> TimeRecord:
-    from scipy.io import loadmat
+    """MAT v4/v5/v7 through the FRF reader's guarded loader (class and size checks, in a child process)."""
+    from .mat import _load_v5, _load_v73, _HDF5_SIGNATURE
 
-    try:
-        data = loadmat(os.fspath(path), squeeze_me=True)
-    except NotImplementedError:  # v7.3: HDF5
-        return _read_hdf5(path, src)
-    except Exception as exc:
-        raise FormatError(f"{src}: cannot be read as a MAT file ({exc})") from None
-    return _from_mapping(data.get, src)
+    with open(path, "rb") as fh:
+        head = fh.read(520)
+    if head[512:520] == _HDF5_SIGNATURE:
+        variables = _load_v73(path, src)  # arrays back in MATLAB's shape, cells as lists
+    else:
+        variables = _load_v5(path, src)
+    return _from_mapping(variables.get, src)
 
 
 def _read_hdf5(path, src: str) -> TimeRecord:
     import h5py
 
+    size = os.path.getsize(path)
     try:
         with h5py.File(path, "r") as fh:
             def get(name):
                 if name in fh:
-                    return fh[name][()]
+                    obj = fh[name]
+                    if not isinstance(obj, h5py.Dataset):
+                        raise FormatError(f"{src}: {obj.name} is a group; expected a dataset {name!r}")
+                    # a damaged header can claim any shape: no dataset holds more than zlib's best ratio allows
+                    if obj.size > _MAX_ELEMENTS_PER_BYTE * size:
+                        raise FormatError(f"{src}: dataset {obj.name} claims shape {obj.shape}, more than a "
+                                          f"{size}-byte file can hold; expected an undamaged file")
+                    return obj[()]
                 if "signals" in fh and name in fh["signals"].attrs:
                     return fh["signals"].attrs[name]
                 return fh.attrs.get(name)

@@ -147,6 +147,53 @@ class _Block:
         return text
 
 
+def scan_datasets(path: str | os.PathLike, src: str) -> tuple[Any, list[_Block]]:
+    """Open a UFF file with pyuff and list its datasets, refusing a file that ends inside one.
+
+    Returns
+    -------
+    (pyuff.UFF, list of _Block)
+        Each block has its 1-based ``number``, first ``line``, ``raw`` bytes and dataset ``type``.
+
+    Raises
+    ------
+    FormatError
+        No complete dataset, a last dataset without its closing ``-1`` line (the file
+        ends early), or datasets pyuff does not see as we do.
+    """
+    import pyuff
+
+    p = check_file(path)
+    data = p.read_bytes()
+    tags = _tag_offsets(data)
+    if len(tags) < 2:
+        raise FormatError(f"{src}: line 1: no complete dataset (found {len(tags)} '    -1' delimiter line); "
+                          "expected datasets between pairs of '    -1' lines (truncated file?)")
+    if len(tags) % 2:
+        last = data.count(b"\n", 0, tags[-1]) + 1
+        raise FormatError(f"{src}: line {last}: dataset {len(tags) // 2 + 1} has no closing '    -1' line: the file "
+                          "ends early (truncated?); expected every dataset to end with one")
+    blocks, line, pos = [], 1, 0
+    for k in range(len(tags) // 2):  # line numbers counted incrementally (large files)
+        line += data.count(b"\n", pos, tags[2 * k])
+        pos = tags[2 * k]
+        blocks.append(_Block(k + 1, line, data[tags[2 * k]:tags[2 * k + 1]]))
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            uff = pyuff.UFF(os.fspath(p))
+            types = [int(t) for t in uff.get_set_types()]
+    except Exception as exc:  # pyuff raises bare Exception
+        raise FormatError(f"{src}: cannot be scanned as UFF ({exc}); "
+                          "expected datasets between '    -1' lines") from None
+    if len(types) != len(blocks):
+        raise FormatError(f"{src}: {len(blocks)} datasets found but pyuff sees {len(types)}; "
+                          "expected a well-formed UFF file")
+    for b, t in zip(blocks, types):
+        b.type = t
+    return uff, blocks
+
+
 def read_frf_uff(path: str | os.PathLike, **hints: Any) -> FRF:
     """Read the FRF datasets (58/58b, function type 4) of a UFF file.
 
@@ -166,55 +213,27 @@ def read_frf_uff(path: str | os.PathLike, **hints: Any) -> FRF:
         No FRF dataset (e.g. time data: names its function type), damaged or
         truncated datasets, unknown kind, datasets on different axes.
     """
-    import pyuff
-
     src = source_name(path)
-    p = check_file(path)
-    data = p.read_bytes()
-    tags = _tag_offsets(data)
-    if len(tags) < 2:
-        raise FormatError(f"{src}: line 1: no complete dataset (found {len(tags)} '    -1' delimiter line); "
-                          "expected datasets between pairs of '    -1' lines (truncated file?)")
-    if len(tags) % 2:
-        last = data.count(b"\n", 0, tags[-1]) + 1
-        raise FormatError(f"{src}: line {last}: dataset {len(tags) // 2 + 1} has no closing '    -1' line; "
-                          "expected every dataset to end with one (truncated file?)")
-    blocks, line, pos = [], 1, 0
-    for k in range(len(tags) // 2):  # line numbers counted incrementally (large files)
-        line += data.count(b"\n", pos, tags[2 * k])
-        pos = tags[2 * k]
-        blocks.append(_Block(k + 1, line, data[tags[2 * k]:tags[2 * k + 1]]))
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            uff = pyuff.UFF(os.fspath(p))
-            types = [int(t) for t in uff.get_set_types()]
-    except Exception as exc:  # pyuff raises bare Exception
-        raise FormatError(f"{src}: cannot be scanned as UFF ({exc}); "
-                          "expected datasets between '    -1' lines") from None
-    if len(types) != len(blocks):
-        raise FormatError(f"{src}: {len(blocks)} datasets found but pyuff sees {len(types)}; "
-                          "expected a well-formed UFF file")
-    for b, t in zip(blocks, types):
-        b.type = t
+    uff, blocks = scan_datasets(path, src)
     uff58 = [b for b in blocks if b.type == 58]
     if not uff58:
         kinds = ", ".join(sorted({str(b.type) for b in blocks}))
         raise FormatError(f"{src}: no dataset 58 (the file holds dataset types {kinds}); "
                           "expected dataset 58 or 58b with FRFs")
-    headers = {b.number: _read_set(uff, b, src, header_only=True) for b in uff58}
+    headers = {b.number: read_dataset(uff, b, src, header_only=True) for b in uff58}
     chosen = _choose(hints.get("dataset"), blocks, headers, src)
     frfs = []
     for b in chosen:
-        problem = _check_header(b, src)
+        problem = check_header(b, src)
         if problem:
             raise FormatError(problem)
-        dset = _read_set(uff, b, src, header_only=False)
+        dset = read_dataset(uff, b, src, header_only=False)
         frfs.append(_to_arrays(b, dset, src, hints))
     return _assemble(chosen, frfs, src, hints)
 
 
-def _read_set(uff, block: _Block, src: str, header_only: bool) -> dict:
+def read_dataset(uff, block: _Block, src: str, header_only: bool) -> dict:
+    """One dataset 58 as pyuff's dict; a dataset pyuff cannot parse gets a message naming its bad record."""
     try:
         with warnings.catch_warnings(), np.errstate(all="ignore"):
             warnings.simplefilter("ignore")
@@ -344,7 +363,7 @@ _REQUIRED = {"func_type", "rsp_node", "rsp_dir", "ref_node", "ref_dir", "ord_dat
              "abscissa_spacing"}
 
 
-def _check_header(block: _Block, src: str) -> str | None:
+def check_header(block: _Block, src: str) -> str | None:
     """A message for the first bad field of records 6–11 (pyuff reads some as 0 silently), or None."""
     lines = block.raw.split(b"\n", 14)
     if len(lines) < 14:
@@ -372,7 +391,7 @@ def _check_header(block: _Block, src: str) -> str | None:
 
 def _diagnose(block: _Block, src: str) -> str:
     """A message naming the first bad record or value of a dataset pyuff could not parse."""
-    problem = _check_header(block, src)
+    problem = check_header(block, src)
     if problem:
         return problem
     lines = block.raw.split(b"\n")

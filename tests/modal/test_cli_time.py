@@ -179,3 +179,49 @@ def test_read_time_from_mat_and_hdf5(tmp_path, fmt):
     assert record.sample_rate_hz == pytest.approx(FS, rel=1e-9)
     np.testing.assert_allclose(record.signals[1], resp[0] * 1e-3, rtol=1e-12)  # mm -> m at the edge
     assert record.units == ("N", "m", "m")
+
+
+def test_an_accelerometer_named_as_the_excitation_is_refused():
+    out = run("fit", REAL / "pyuff_MPSTD_Set001_2024_10_08_10_27_07.uff", "--excitation", 1)
+    assert out.returncode == 1 and out.stderr.count("\n") == 1, out.stderr
+    assert "channel 1 (1+Z#1, acceleration in m/s^2) is named as the excitation but measured acceleration" \
+        in out.stderr and "expected a force channel" in out.stderr
+
+
+def test_roles_on_a_hammer_csv_match_what_its_header_says(tmp_path):
+    from dataclasses import replace
+
+    from modal.io.timewrite import write_time
+    from modal.synthetic import impact_record
+
+    record = impact_record(PLANT, [0.5, 2.5, 4.5], 6.0, names=["hammer", "a1", "a2"], seed=1).record
+    path = tmp_path / "hammer.csv"
+    write_time(record, path)
+    wrong = run("frf", path, "--excitation", 2, "--out", tmp_path / "x.h5")
+    assert wrong.returncode == 1 and wrong.stderr.count("\n") == 1
+    assert "channel 2 (a1, acceleration in m/s^2) is named as the excitation" in wrong.stderr
+    assert "does not say" not in wrong.stderr  # the header says [m/s^2] and [N]
+    # a force column without a unit: accepted as the excitation, with a warning that says so
+    unknown = tmp_path / "unknown.csv"
+    write_time(replace(record, quantities=(None, "acceleration", "acceleration"), units=(None, "m/s^2", "m/s^2")),
+               unknown)
+    out = run("frf", unknown, "--excitation", 1, "--impact", "--out", tmp_path / "y.h5")
+    assert out.returncode == 0, out.stderr
+    assert "warning: " in out.stderr and "channel 1 (hammer, unknown quantity) is taken as the excitation" in out.stderr
+
+
+def test_time_commands_on_files_that_are_not_whole_time_records(tmp_path):
+    # a two-channel 58b cut in half ends exactly after the force dataset: nothing says it was cut, but the
+    # message lists what the file holds
+    force, resp = _records(n=4096)
+    path = tmp_path / "half.uff"
+    write_uff_time(path, force, resp[:1])
+    data = path.read_bytes()
+    path.write_bytes(data[:len(data) // 2])
+    out = run("frf", path, "--out", tmp_path / "x.h5")
+    assert out.returncode == 1 and out.stderr.count("\n") == 1
+    assert "holds 1 channel(s) (channel 1 (1+Z, force in N))" in out.stderr and "cut short" in out.stderr
+    frf_file = ROOT / "data" / "synthetic" / "demo_frf.csv"
+    out = run("frf", frf_file, "--out", tmp_path / "y.h5")
+    assert out.returncode == 1 and out.stderr.count("\n") == 1
+    assert "an FRF file" in out.stderr and "expected a time file" in out.stderr
