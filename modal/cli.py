@@ -197,7 +197,9 @@ def _report_estimate(frf) -> None:
           + (f", exponential decay {frf.exponential_decay_s:g} s (its damping is removed)"
              if frf.exponential_decay_s else ""), file=sys.stderr)
     for item in frf.rejected:
-        print(f"{frf.source}: hit {item['hit']} at {item['time_s']:.4g} s rejected: {item['reason']}", file=sys.stderr)
+        detail = f" ({item['detail']})" if item.get("detail") else ""
+        print(f"{frf.source}: hit {item['hit']} at {item['time_s']:.4g} s rejected: {item['reason']}{detail}",
+              file=sys.stderr)
 
 
 def _frf(args) -> int:

@@ -83,5 +83,6 @@ def frf_from_time(path, args, report: Callable[[str], None] | None = None):
         overlap=0.5 if args.overlap is None else args.overlap, window=window,
         exponential_decay_s=args.exponential_decay_s, impact=args.impact,
         response_quantity=quantity, excitation_points=[record.names[k] for k in inputs],
-        response_points=[record.names[k] for k in outputs], source=src)
+        response_points=[record.names[k] for k in outputs], source=src,
+        full_scale=None if record.full_scale is None else [record.full_scale[k] for k in inputs + outputs])
     return estimate, record, inputs, outputs

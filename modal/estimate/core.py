@@ -19,11 +19,12 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..errors import FRFValidationError, ParameterError
+from ..errors import FRFValidationError, ParameterError, QualityWarning, warn
 from ..frf import FRF, FRF_KINDS, KIND_POWER
 from ..validate import finite_samples, one_of, per_line, positive_number
 from . import spectra
 from .hits import find_hits
+from .overload import find_overloads
 from .windows import WINDOWS, exponential_window, force_window, segment_window
 
 __all__ = ["EstimatedFRF", "estimate_frf", "RESPONSE_QUANTITIES"]
@@ -67,6 +68,11 @@ class EstimatedFRF(FRF):
         Excitation channels.
     hit_times_s : tuple of float
         Trigger time of each accepted hit, s (impact records; empty otherwise).
+    overloads : list of dict
+        Channels clipped (flat tops at the recorder's extreme) or overloaded (at a declared
+        full scale) anywhere in the record: ``channel``, ``how`` (``"flat tops"`` or
+        ``"full scale"``), ``level`` (in the channel's unit), ``samples``, ``longest_run``.
+        Impact records reject the hits they touch; continuous records warn.
     """
 
     coherence: np.ndarray | None = None
@@ -80,6 +86,7 @@ class EstimatedFRF(FRF):
     overlap: float = 0.0
     n_inputs: int = 1
     hit_times_s: tuple = ()
+    overloads: list = field(default_factory=list)
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -148,7 +155,7 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
                  response_quantity: str | None = None, excitation_points=None, response_points=None,
                  threshold: float | None = None, pretrigger_s: float | None = None,
                  double_hit_window_s: float = 0.05, decay_fraction: float = 0.05,
-                 full_scale: float | None = None, source: str = "<array>") -> EstimatedFRF:
+                 full_scale=None, source: str = "<array>") -> EstimatedFRF:
     """Estimate FRFs, coherence and per-line noise from excitation and response records.
 
     Parameters
@@ -185,8 +192,14 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
         Find the hits in a continuous record and average one record per accepted hit.
     excitation_points, response_points : sequence of str, optional
         Point ids of the inputs and outputs (a pair with equal ids is a driving point).
-    threshold, pretrigger_s, double_hit_window_s, decay_fraction, full_scale
+    threshold, pretrigger_s, double_hit_window_s, decay_fraction
         Hit detection settings, see :func:`modal.estimate.hits.find_hits`.
+    full_scale : float or sequence of (float or None), optional
+        The recorder's full scale: one value for every channel or one per channel
+        (inputs first, then outputs), in the channels' units. Samples at or beyond
+        99.9 % of it, and flat tops at a channel's extreme (clipping), are overloads:
+        impact records reject the hits they touch, continuous records warn
+        (:class:`~modal.errors.QualityWarning`); both list them in ``overloads``.
     source : str
         Name used in messages (the file).
 
@@ -213,6 +226,24 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
     finite_samples(x, "excitation", source)
     finite_samples(y, "response", source)
 
+    def ids(points, count, name):
+        if points is None:
+            return None
+        points = [points] if isinstance(points, (str, int)) else list(points)
+        if len(points) != count:
+            raise ParameterError(f"{source}: field {name!r} has {len(points)} ids, expected {count}")
+        return [str(p) for p in points]
+
+    ins = ids(excitation_points, x.shape[0], "excitation_points")
+    outs = ids(response_points, y.shape[0], "response_points")
+    labels = ([f"force {p}" for p in ins] if ins else
+              ["force"] if x.shape[0] == 1 else [f"force {i + 1}" for i in range(x.shape[0])])
+    labels += [f"response {p}" for p in outs] if outs else [f"response {o + 1}" for o in range(y.shape[0])]
+    n_channels = x.shape[0] + y.shape[0]
+    if full_scale is not None and np.ndim(full_scale) and len(full_scale) != n_channels:
+        raise ParameterError(f"{source}: field 'full_scale' has {len(full_scale)} values; expected one or one per "
+                             f"channel ({n_channels}, inputs first)")
+
     rejected: list[dict] = []
     hit_times: tuple = ()
     if impact:
@@ -227,7 +258,7 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
         pre = None if pretrigger_s is None else pretrigger_s
         probe = find_hits(force, np.asarray(y, dtype=float), fs, threshold=threshold, pretrigger_s=pre,
                           record_length=segment_length, double_hit_window_s=double_hit_window_s,
-                          decay_fraction=decay_fraction, full_scale=full_scale)
+                          decay_fraction=decay_fraction, full_scale=full_scale, channel_names=labels)
         length = probe.record_length
         pre_samples = int(probe.trigger_index[0] - probe.record_start[0])
         decay = (None if exponential_decay_s is None
@@ -235,8 +266,9 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
         hits = probe if decay is None else find_hits(
             force, np.asarray(y, dtype=float), fs, threshold=threshold, pretrigger_s=pre, record_length=length,
             double_hit_window_s=double_hit_window_s, decay_fraction=decay_fraction, decay_window=decay,
-            full_scale=full_scale)
+            full_scale=full_scale, channel_names=labels)
         rejected = hits.rejected
+        overloads = hits.overloads
         hit_times = tuple(float(t) / fs for t in hits.trigger_index[hits.accepted])
         starts = hits.record_start[hits.accepted]
         if starts.size == 0:
@@ -263,6 +295,11 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
         starts = np.arange(0, n - length + 1, step)
         in_w = out_w = segment_window(window, length)
         decay = None
+        overloads = find_overloads([x[i] for i in range(x.shape[0])] + [y[o] for o in range(y.shape[0])],
+                                   full_scale)
+        for item in overloads:
+            warn(f"{source}: {item.describe(labels[item.channel])}: the spectra are distorted where it clipped; "
+                 "lower the gain or the excitation level", QualityWarning)
 
     sums = spectra.accumulate(x, y, starts, length, in_w, out_w)
     estimate = {"H1": spectra.h1, "H2": spectra.h2, "Hv": spectra.hv}[estimator]
@@ -288,16 +325,6 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
             if noise is not None:
                 noise = noise[:, keep] * np.abs(scale)
 
-    def ids(points, count, name):
-        if points is None:
-            return None
-        points = [points] if isinstance(points, (str, int)) else list(points)
-        if len(points) != count:
-            raise ParameterError(f"{source}: field {name!r} has {len(points)} ids, expected {count}")
-        return [str(p) for p in points]
-
-    ins = ids(excitation_points, n_in, "excitation_points")
-    outs = ids(response_points, n_out, "response_points")
     single = n_out * n_in == 1
     return EstimatedFRF(
         frequency_hz=frequency,
@@ -319,4 +346,6 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
         overlap=0.0 if impact else float(overlap),
         n_inputs=n_in,
         hit_times_s=hit_times,
+        overloads=[{"channel": labels[o.channel], "how": o.how, "level": o.level, "samples": o.samples,
+                    "longest_run": o.longest_run} for o in overloads],
     )

@@ -1,16 +1,24 @@
 """Hit detection in a continuous impact-hammer record.
 
-A *hit* is one impact event: the force rises above a threshold and the pulses
-that follow it within ``double_hit_window_s`` belong to the same event (a
-bounce of the hammer, i.e. a double hit). Hits are numbered from 1 in time
-order. Each hit is accepted or rejected with a reason a user can act on:
+A *hit* is one impact event: the force rises above a threshold, and every pulse
+that follows while the hit is not over belongs to it: a pulse within
+``double_hit_window_s`` of the previous one (a bounce of the hammer), or a pulse
+that arrives while the hit's response is still ringing (above ``decay_fraction``
+of its peak and above its noise floor: a rebound, or a second hit given too
+soon). Hits are numbered from 1 in time order. Each hit is accepted or rejected
+with a reason a user can act on (and a ``detail`` saying what was seen):
 
-* ``"double hit"``: a second force pulse follows within the double-hit window;
-* ``"overload (clipped)"``: the force or a response sits at a flat maximum (the
-  converter clipped) for several samples;
-* ``"response not decayed before the next hit"``: the (windowed) response at
-  the end of the hit's record is still above ``decay_fraction`` of its peak, so
-  the record is truncated (leakage) and the next hit's record starts with it;
+* ``"double hit"``: more than one force pulse in the hit;
+* ``"overload (clipped)"``: the force or a response reached the recorder's rail
+  (flat tops at its extreme) or 99.9 % of a declared full scale within the hit's
+  record (:mod:`modal.estimate.overload`);
+* ``"response of an earlier hit still ringing"``: the hit began before the
+  previous response had decayed relative to this hit's own peak (a weak hit after
+  a strong one), so its record would start inside another hit's response;
+* ``"response not decayed within the record"``: the (windowed) response in the
+  last 1/16 of the record is still above ``decay_fraction`` of its peak and above
+  the noise (leakage);
+* ``"next hit within the record"``: the record is longer than the gap to the next hit;
 * ``"record cut by the start or end of the data"``.
 """
 from __future__ import annotations
@@ -20,8 +28,15 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ParameterError
+from .overload import find_overloads
 
-__all__ = ["Hits", "find_hits"]
+__all__ = ["Hits", "find_hits", "DECAY_LOOK_S", "NOISE_FACTOR"]
+
+#: how far back the response is looked at before a pulse to judge whether it has decayed, s
+#: (a whole period of any mode above 10 Hz; half the gap to the previous pulse when that is shorter)
+DECAY_LOOK_S = 0.1
+#: a response within this many times its noise floor (RMS of its quietest parts) counts as decayed
+NOISE_FACTOR = 6.0
 
 
 @dataclass(frozen=True)
@@ -45,6 +60,8 @@ class Hits:
         in the record, s) and ``reason``.
     threshold : float
         Force level used for detection, in the force channel's unit.
+    overloads : list of ChannelOverload
+        Channels clipped or overloaded anywhere in the record (channel 0 is the force).
     """
 
     trigger_index: np.ndarray
@@ -54,6 +71,7 @@ class Hits:
     pulse_samples: int
     threshold: float
     rejected: list = field(default_factory=list)
+    overloads: list = field(default_factory=list)
 
 
 def _pulses(above: np.ndarray, merge_gap: int) -> list[tuple[int, int]]:
@@ -70,21 +88,36 @@ def _pulses(above: np.ndarray, merge_gap: int) -> list[tuple[int, int]]:
     return pulses
 
 
-def _clipped(signal: np.ndarray, min_run: int = 3) -> bool:
-    """True when the signal holds its largest |value| for ``min_run`` or more consecutive samples."""
-    peak = np.max(np.abs(signal))
-    if peak == 0:
-        return False
-    at_peak = np.abs(signal) >= peak * (1 - 1e-12)
-    run = np.convolve(at_peak.astype(np.int32), np.ones(min_run, np.int32), mode="valid")
-    return bool(np.any(run >= min_run))
+def _noise_floor(centred: np.ndarray) -> np.ndarray:
+    """Per channel, the RMS of the quiet parts: the 10th percentile of the RMS of 64-sample blocks."""
+    block = 64
+    m = centred.shape[1] // block
+    if m < 10:
+        return 1.4826 * np.median(np.abs(centred), axis=1)
+    blocks = centred[:, :m * block].reshape(centred.shape[0], m, block)
+    return np.percentile(np.sqrt(np.mean(blocks**2, axis=2)), 10, axis=1)
+
+
+def _names(channel_names, n_outputs: int) -> list[str]:
+    if channel_names is None:
+        return ["force"] + [f"response {k + 1}" for k in range(n_outputs)]
+    names = [str(v) for v in channel_names]
+    if len(names) != n_outputs + 1:
+        raise ParameterError(f"field 'channel_names' has {len(names)} names; expected {n_outputs + 1} (force first)")
+    return names
 
 
 def find_hits(force, response, sample_rate_hz: float, *, threshold: float | None = None,
               pretrigger_s: float | None = None, record_length: int | None = None,
               double_hit_window_s: float = 0.05, decay_fraction: float = 0.05,
-              decay_window: np.ndarray | None = None, full_scale: float | None = None) -> Hits:
+              decay_window: np.ndarray | None = None, full_scale=None, channel_names=None,
+              channel_units=None) -> Hits:
     """Find, cut and screen the hits of a continuous impact record.
+
+    A pulse belongs to the hit before it when it starts within ``double_hit_window_s``
+    of that hit's last pulse (a bounce) or while the hit's response is still ringing
+    (above ``decay_fraction`` of its peak and above the noise): such a hit is rejected
+    as a double hit, so that no record ever starts inside another hit's response.
 
     Parameters
     ----------
@@ -106,18 +139,24 @@ def find_hits(force, response, sample_rate_hz: float, *, threshold: float | None
     double_hit_window_s : float
         A pulse starting this soon after the previous pulse's end makes a double hit, s.
     decay_fraction : float
-        Largest |response| allowed in the last 1/16 of a record, as a fraction of the
-        record's peak, after ``decay_window`` (the leakage the record can tolerate).
+        A response is decayed when its |value| is below this fraction of its peak
+        (or at its noise floor): in the last 1/16 of a record, after ``decay_window``
+        (the leakage the record can tolerate), and when the next pulse arrives.
     decay_window : ndarray, optional
         Window applied to the response record before the decay check (the exponential window).
-    full_scale : float, optional
-        The converter's full scale in the force's and responses' units: |values| at
-        or above 99.9 % of it count as overloads as well.
+    full_scale : float or sequence of (float or None), optional
+        The converter's full scale: one value for every channel, or one per channel
+        (force first, then the responses), in the channels' units; |values| at or above
+        99.9 % of it are overloads, as are flat tops (:mod:`modal.estimate.overload`).
+    channel_names, channel_units : sequence of str, optional
+        Force first, then the responses: how the reasons name the channels.
     """
     force = np.asarray(force, dtype=float)
     response = np.atleast_2d(np.asarray(response, dtype=float))
     n = force.size
     fs = float(sample_rate_hz)
+    names = _names(channel_names, response.shape[0])
+    units = [None] * len(names) if channel_units is None else list(channel_units)
     peak = float(np.max(np.abs(force))) if n else 0.0
     if peak == 0:
         raise ParameterError("field 'excitation' is zero everywhere: no hit to find (is it the force channel?)")
@@ -130,13 +169,44 @@ def find_hits(force, response, sample_rate_hz: float, *, threshold: float | None
     pulses = _pulses(above, merge_gap)
     if not pulses:
         raise ParameterError(f"field 'excitation': no sample exceeds the trigger threshold {threshold:g}")
+    centred = response - np.median(response, axis=1, keepdims=True)
+    floor = NOISE_FACTOR * _noise_floor(centred)
     bounce = max(1, int(round(double_hit_window_s * fs)))
+    look = max(2, int(round(DECAY_LOOK_S * fs)))
+
+    def ringing(first: int, stop: int, gap_start: int, reference: np.ndarray):
+        """(channel, level / reference) of the most undecayed response just before the pulse at ``stop``, or None.
+
+        The look ends ``merge_gap`` samples before the trigger: the force rises below the threshold first, and
+        an acceleration answers it at once."""
+        stop = max(first, stop - merge_gap)
+        span = max(1, min(look, (stop - gap_start) // 2 if stop > gap_start else look))
+        level = np.max(np.abs(centred[:, max(first, stop - span):stop]), axis=1) if stop > first else 0 * reference
+        undecayed = level > np.maximum(decay_fraction * reference, floor)
+        if not undecayed.any():
+            return None
+        ratio = np.where(undecayed, level / np.maximum(reference, np.finfo(float).tiny), 0.0)
+        j = int(np.argmax(ratio))
+        return j, float(ratio[j])
+
     events: list[list[tuple[int, int]]] = []
+    details: list[str | None] = []
     for p in pulses:
-        if events and p[0] - events[-1][-1][1] <= bounce:
-            events[-1].append(p)
-        else:
-            events.append([p])
+        if events:
+            first, last_end = events[-1][0][0], events[-1][-1][1]
+            after_ms = 1e3 * (p[0] - first) / fs
+            if p[0] - last_end <= bounce:
+                events[-1].append(p)
+                details[-1] = details[-1] or f"a second pulse {after_ms:.0f} ms after the first"
+                continue
+            still = ringing(first, p[0], last_end, np.max(np.abs(centred[:, first:p[0]]), axis=1))
+            if still is not None:
+                events[-1].append(p)
+                details[-1] = details[-1] or (f"a second pulse {after_ms:.0f} ms after the first, while "
+                                              f"{names[still[0] + 1]} was at {100 * still[1]:.0f} % of its peak")
+                continue
+        events.append([p])
+        details.append(None)
     trigger = np.array([ev[0][0] for ev in events], dtype=np.int64)
     if record_length is None:
         spacing = np.diff(np.append(trigger, n))
@@ -148,36 +218,49 @@ def find_hits(force, response, sample_rate_hz: float, *, threshold: float | None
     pre = max(2, record_length // 64) if pretrigger_s is None else int(round(pretrigger_s * fs))
     start = trigger - pre
     tail = max(1, record_length // 16)
+    window = np.ones(record_length) if decay_window is None else np.asarray(decay_window, float)
+    overloads = find_overloads(np.vstack([force[None, :], response]), full_scale)
     accepted = np.ones(trigger.size, bool)
     rejected: list[dict] = []
     pulse_len = 1
     for k, ev in enumerate(events):
-        reason = None
+        reason, detail = None, None
         s = int(start[k])
+        t = int(trigger[k])
+        nxt = int(trigger[k + 1]) if k + 1 < trigger.size else n
         if s < 0 or s + record_length > n:
             reason = "record cut by the start or end of the data"
         elif len(ev) > 1:
-            reason = "double hit"
+            reason, detail = "double hit", details[k]
+        elif any(o.mask[s:s + record_length].any() for o in overloads):
+            reason = "overload (clipped)"
+            detail = "; ".join(o.describe(names[o.channel], units[o.channel]) for o in overloads
+                               if o.mask[s:s + record_length].any())
         else:
-            seg_f = force[s:s + record_length]
-            seg_y = response[:, s:s + record_length]
-            over = _clipped(seg_f) or any(_clipped(ch) for ch in seg_y)
-            if full_scale is not None:
-                over = over or bool(np.any(np.abs(seg_f) >= 0.999 * full_scale)
-                                    or np.any(np.abs(seg_y) >= 0.999 * full_scale))
-            if over:
-                reason = "overload (clipped)"
-            else:
-                weighted = seg_y * (1.0 if decay_window is None else decay_window)
-                top = np.max(np.abs(weighted), axis=1)
-                end = np.max(np.abs(weighted[:, -tail:]), axis=1)
-                if np.any(end > decay_fraction * np.maximum(top, np.finfo(float).tiny)):
-                    reason = "response not decayed before the next hit"
-                elif k + 1 < trigger.size and trigger[k + 1] - pre < s + record_length:
-                    reason = "response not decayed before the next hit"
+            previous_end = events[k - 1][-1][1] if k else 0
+            own_peak = np.max(np.abs(centred[:, t:min(nxt, s + record_length)]), axis=1)
+            before = ringing(previous_end, t, previous_end, own_peak)
+            weighted = centred[:, s:s + record_length] * window
+            top = np.max(np.abs(weighted), axis=1)
+            end = np.max(np.abs(weighted[:, -tail:]), axis=1)
+            end_floor = floor * np.max(np.abs(window[-tail:]))
+            if before is not None:
+                reason = "response of an earlier hit still ringing"
+                detail = (f"{names[before[0] + 1]} at {100 * before[1]:.0f} % of this hit's peak when it started")
+            elif np.any(end > np.maximum(decay_fraction * np.maximum(top, np.finfo(float).tiny), end_floor)):
+                j = int(np.argmax(end / np.maximum(top, np.finfo(float).tiny)))
+                reason = "response not decayed within the record"
+                detail = (f"{names[j + 1]} at {100 * end[j] / top[j]:.0f} % of its peak at the end of the "
+                          f"{record_length}-sample record")
+            elif k + 1 < trigger.size and nxt - pre < s + record_length:
+                reason = "next hit within the record"
+                detail = f"the next hit starts {1e3 * (nxt - t) / fs:.0f} ms after this one"
         if reason is not None:
             accepted[k] = False
-            rejected.append({"hit": k + 1, "time_s": float(trigger[k] / fs), "reason": reason})
+            item = {"hit": k + 1, "time_s": float(trigger[k] / fs), "reason": reason}
+            if detail:
+                item["detail"] = detail
+            rejected.append(item)
         else:
             pulse_len = max(pulse_len, ev[0][1] - ev[0][0] + 1)
-    return Hits(trigger, accepted, start, record_length, int(pulse_len), threshold, rejected)
+    return Hits(trigger, accepted, start, record_length, int(pulse_len), threshold, rejected, overloads)

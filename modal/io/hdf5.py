@@ -125,6 +125,7 @@ def _write_estimate(group, frf) -> None:
     group.attrs["estimator"] = frf.estimator
     group.attrs["window"] = frf.window
     group.attrs["rejected"] = json.dumps(frf.rejected)
+    group.attrs["overloads"] = json.dumps(frf.overloads)
 
 
 def _read_estimate(group, frf: FRF, source: str) -> FRF:
@@ -161,6 +162,7 @@ def _read_estimate(group, frf: FRF, source: str) -> FRF:
         extras["estimator"] = _str_attr(group.attrs.get("estimator", "H1"))
         extras["window"] = _str_attr(group.attrs.get("window", "rect"))
         extras["rejected"] = json.loads(_str_attr(group.attrs.get("rejected", "[]")))
+        extras["overloads"] = json.loads(_str_attr(group.attrs.get("overloads", "[]")))
     except (ValueError, TypeError) as exc:
         raise FormatError(f"{source}: group {group.name}: the estimate's coherence or noise cannot be read ({exc}); "
                           "expected arrays shaped like 'response'") from None

@@ -225,3 +225,30 @@ def test_time_commands_on_files_that_are_not_whole_time_records(tmp_path):
     out = run("frf", frf_file, "--out", tmp_path / "y.h5")
     assert out.returncode == 1 and out.stderr.count("\n") == 1
     assert "an FRF file" in out.stderr and "expected a time file" in out.stderr
+
+
+def test_clipping_is_reported_on_the_command_line(tmp_path):
+    from modal.io.timewrite import write_time
+    from modal.synthetic import DigitalModes, impact_record, random_record
+
+    plant = DigitalModes([40.0, 95.0], [0.03, 0.02], [[1.0, 0.5], [0.6, -0.8]], 2048.0)
+    # hits clipped at 100 N (flat tops) and the full scale declared in the file: those hits are named and dropped
+    hammer = impact_record(plant, 0.5 + 2.0 * np.arange(6), 12.0, pulse_width_s=0.003, amplitude_variation=0.2,
+                           full_scale=[100.0, None, None], force_noise=0.002, response_noise=0.002,
+                           names=["hammer", "a1", "a2"], seed=1)
+    path = tmp_path / "hammer.csv"
+    write_time(hammer.record, path)
+    out = run("frf", path, "--impact", "--out", tmp_path / "h.h5", "--json")
+    assert out.returncode == 0, out.stderr
+    lines = [ln for ln in out.stderr.splitlines() if "rejected: overload (clipped)" in ln]
+    assert len(lines) == 5 and all("force hammer at or beyond 99.9 % of its full scale 100" in ln for ln in lines)
+    assert json.loads(out.stdout)["averages"] == 1
+    # a shaker record whose response clipped: estimated, with a warning naming the channel
+    shaker = random_record(plant, 32.0, full_scale=[None, 3.0, None], declare_full_scale=False, seed=2,
+                           names=["force", "a1", "a2"])
+    assert shaker.clipped_samples[1] > 0
+    path = tmp_path / "shaker.csv"
+    write_time(shaker.record, path)
+    out = run("frf", path, "--out", tmp_path / "s.h5")
+    assert out.returncode == 0, out.stderr
+    assert "warning: " in out.stderr and "response a1 clipped at 3 (flat tops" in out.stderr

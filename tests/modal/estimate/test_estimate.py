@@ -146,7 +146,8 @@ def test_impact_double_hit_is_rejected_and_named(plant):
     force = hammer_force(n, FS, hits)
     y = plant.respond(force)
     est = modal.estimate_frf(force, y, FS, impact=True, window="force", segment_length=1024)
-    assert est.rejected == [{"hit": 2, "time_s": pytest.approx(2.5, abs=1.5 / FS), "reason": "double hit"}]
+    assert est.rejected == [{"hit": 2, "time_s": pytest.approx(2.5, abs=1.5 / FS), "reason": "double hit",
+                             "detail": "a second pulse 10 ms after the first"}]
     assert est.averages == 3
     truth = plant.frf(est.frequency_hz)
     band = (est.frequency_hz > 10) & (est.frequency_hz < 250)  # within the 2 ms hammer's band
@@ -175,14 +176,15 @@ def test_exponential_window_shifts_every_pole_by_one_over_tau(plant):
 
 
 def test_undecayed_response_is_rejected():
+    # ζ = 0.001 at 60 Hz decays with 2.65 s: a 2 s record ends with 47 % of the peak left (the hits are 12 s
+    # apart, so each starts in silence)
     light = DigitalModes(np.array([60.0]), np.array([0.001]), np.array([[1.0]]), FS)
-    n = int(6 * FS)
-    force = hammer_force(n, FS, [0.5, 3.5])
-    est_reasons = None
+    n = int(26 * FS)
+    force = hammer_force(n, FS, [0.5, 12.5])
     with pytest.raises(ParameterError, match="every hit was rejected") as info:
         modal.estimate_frf(force, light.respond(force), FS, impact=True, window="force", segment_length=2048)
-    est_reasons = str(info.value)
-    assert "hit 1" in est_reasons and "response not decayed" in est_reasons
+    reasons = str(info.value)
+    assert "hit 1" in reasons and "hit 2" in reasons and "response not decayed within the record" in reasons
 
 
 def test_clipped_force_is_rejected():

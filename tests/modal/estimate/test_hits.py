@@ -1,0 +1,113 @@
+"""Hits of an impact record (modal.estimate.hits): rebounds, hits inside another's response, overloads."""
+from __future__ import annotations
+
+import collections
+
+import numpy as np
+import pytest
+
+import modal
+from modal.estimate.hits import find_hits
+from modal.synthetic import DigitalModes, hammer_force, impact_record
+
+FS = 2048.0
+#: decay times 1/(ζωn): 0.13 s (40 Hz) and 0.084 s (95 Hz)
+PLANT = DigitalModes([40.0, 95.0], [0.03, 0.02], [[1.0, 0.5], [0.6, -0.8]], FS)
+
+
+def _estimate(record, **kwargs):
+    return modal.estimate_frf(record.signals[0], record.signals[1:], record.sample_rate_hz, impact=True,
+                              window="force", kind="accelerance", response_quantity="acceleration", **kwargs)
+
+
+def test_a_rebound_while_the_response_rings_makes_a_double_hit():
+    # a second pulse of 30 % 60 ms after hit 2, when its response is still at about e^(−0.06/0.13) ≈ 60 %
+    # of its peak: today's bounce window (50 ms) missed it, so the rebound became a hit of its own and hit 2
+    # was rejected as not decayed. It belongs to hit 2: the event is a double hit, and no record starts
+    # at the rebound
+    synthetic = impact_record(PLANT, [0.5, 2.5, 4.5, 6.5], 8.0, rebound_delay_s=[None, 0.06, None, None],
+                              rebound_fraction=0.3, force_noise=0.002, response_noise=0.002, seed=2)
+    est = _estimate(synthetic.record)
+    assert [(r["hit"], r["reason"]) for r in est.rejected] == [(2, "double hit")]
+    assert "60 ms after the first" in est.rejected[0]["detail"] and "% of its peak" in est.rejected[0]["detail"]
+    assert est.averages == 3
+    np.testing.assert_allclose(est.hit_times_s, [0.5, 4.5, 6.5], atol=2 / FS)
+    # no record holds the rebound's force or its response: the estimate is the system's within the noise
+    truth = synthetic.frf(est.frequency_hz)
+    band = (est.frequency_hz > 10) & (est.frequency_hz < 200)
+    error = np.abs(est.response[:, band] - truth[:, band]) / est.noise_std[:, band]
+    assert np.median(error) < 2  # Rayleigh: median √ln 2 ≈ 0.83 when only noise is left
+
+
+def test_a_late_rebound_after_the_response_decayed_is_a_hit_of_its_own():
+    # 1.5 s after hit 1 (over 10 decay times): the response has decayed, so the pulse starts a new hit
+    synthetic = impact_record(PLANT, [0.5, 4.5], 6.0, rebound_delay_s=[1.5, None], force_noise=0.002,
+                              response_noise=0.002, seed=3)
+    hits = find_hits(synthetic.record.signals[0], synthetic.record.signals[1:], FS)
+    np.testing.assert_allclose(hits.trigger_index / FS, [0.5, 2.0, 4.5], atol=2 / FS)
+    assert hits.rejected == []
+
+
+def test_a_weak_hit_in_the_tail_of_a_strong_one_is_rejected():
+    # hit 2 (10 N) comes 0.6 s after hit 1 (100 N): hit 1's response has fallen to about e^(−0.5/0.13) ≈ 2 %
+    # of its peak 0.1 s before (decayed, by its own measure), but that is about 20 % of hit 2's peak: hit 2's
+    # record would start inside hit 1's response
+    n = int(4 * FS)
+    force = hammer_force(n, FS, [0.5, 1.1, 2.95], width_s=0.003, amplitude_n=[100.0, 10.0, 100.0])
+    response = PLANT.respond(force, "acceleration")
+    hits = find_hits(force, response, FS, record_length=1024)
+    assert [(r["hit"], r["reason"]) for r in hits.rejected] == [(2, "response of an earlier hit still ringing")]
+    assert "of this hit's peak when it started" in hits.rejected[0]["detail"]
+    assert hits.accepted.tolist() == [True, False, True]
+
+
+def test_clipped_hits_are_rejected_and_the_others_kept():
+    # the converter saturates at 100 N: hits above it have flat tops (3 ms pulses, 6 samples each), those
+    # below are untouched. Noise on force and response (0.2 % of the peak) never repeats a value exactly
+    synthetic = impact_record(PLANT, 0.5 + 2.0 * np.arange(6), 12.0, pulse_width_s=0.003, amplitude_variation=0.2,
+                              full_scale=[100.0, None, None], declare_full_scale=False, force_noise=0.002,
+                              response_noise=0.002, seed=1)
+    force = synthetic.record.signals[0]
+    on_rail = [force[int(t * FS):int(t * FS) + 8] == 100.0 for t in synthetic.hit_times_s]
+    clipped = [k + 1 for k, rail in enumerate(on_rail) if rail.any()]
+    assert 0 < len(clipped) < 6  # the seed gives both kinds
+    # a flat top (two samples on the rail) shows where the rail is; then a hit with one sample on it is clipped too
+    assert any(np.any(rail[1:] & rail[:-1]) for rail in on_rail)
+    est = _estimate(synthetic.record)
+    assert [r["hit"] for r in est.rejected] == clipped
+    assert {r["reason"] for r in est.rejected} == {"overload (clipped)"}
+    assert all(r["detail"].startswith("force clipped at 100 (flat tops") for r in est.rejected)
+    assert est.averages == 6 - len(clipped)
+    assert est.overloads == [{"channel": "force", "how": "flat tops", "level": 100.0, "samples": int(
+        np.sum(force == 100.0)), "longest_run": est.overloads[0]["longest_run"]}]
+
+
+def test_a_declared_full_scale_rejects_hits_that_reach_it():
+    # one sample at the rail: no flat top to see, but the declared full scale of the response says so
+    synthetic = impact_record(PLANT, [0.5, 2.5, 4.5], 6.0, amplitude_variation=0.3, force_noise=0.002,
+                              response_noise=0.002, seed=4)
+    record = synthetic.record
+    peaks = [np.max(np.abs(record.signals[1, int(t * FS):int((t + 1) * FS)])) for t in synthetic.hit_times_s]
+    level = float(np.sort(peaks)[-1]) * 1.0005  # the largest hit's response peak sits within 0.1 % of it
+    est = _estimate(record, full_scale=[None, level, None])
+    strongest = int(np.argmax(peaks)) + 1
+    assert [(r["hit"], r["reason"]) for r in est.rejected] == [(strongest, "overload (clipped)")]
+    assert "response 1 at or beyond 99.9 % of its full scale" in est.rejected[0]["detail"]
+
+
+def test_no_false_rejection_on_unclipped_noisy_hits():
+    # 300 realistic hits (amplitude and width scatter, noise from 0.1 % to 5 % of the peak, hits 1.2 to 3 s
+    # apart: at least 9 decay times) on a three-mode structure: none may be rejected, for any reason
+    plant = DigitalModes([40.0, 95.0, 310.0], [0.03, 0.02, 0.01], [[1.0, 0.5, 0.3], [0.6, -0.8, 0.2]], FS)
+    reasons: collections.Counter = collections.Counter()
+    for seed in range(50):
+        rng = np.random.default_rng(seed)
+        noise = float(rng.choice([0.001, 0.005, 0.01, 0.03, 0.05]))
+        spacing = float(rng.uniform(1.2, 3.0))
+        times = 0.3 + spacing * np.arange(6)
+        synthetic = impact_record(plant, times, times[-1] + spacing, pulse_width_s=0.003, amplitude_variation=0.25,
+                                  width_variation=0.2, force_noise=noise, response_noise=noise, seed=seed)
+        hits = find_hits(synthetic.record.signals[0], synthetic.record.signals[1:], FS)
+        reasons.update(r["reason"] for r in hits.rejected)
+        assert hits.overloads == []
+    assert reasons == collections.Counter()
