@@ -277,3 +277,17 @@ def test_roles_accept_an_unknown_excitation_with_a_warning_and_refuse_a_force_re
         mixed.check_roles([0], [1, 2])
     with pytest.raises(FormatError, match="both the excitation and a response"):
         base.check_roles([0], [0, 1])
+
+
+def test_the_documented_csv_example_reads_as_documented(tmp_path):
+    from support.paths import ROOT
+
+    doc = (ROOT / "docs" / "estimate.md").read_text()
+    block = doc.split("**CSV.**", 1)[1].split("```", 2)[1]
+    path = tmp_path / "doc.csv"
+    path.write_text(block.lstrip("\n"))
+    record = read_time(path)
+    assert record.names == ("hammer", "p1", "p2") and record.sample_rate_hz == pytest.approx(2000.0)
+    assert record.quantities == ("force", "acceleration", "acceleration")
+    assert record.full_scale == (500.0, None, 50 * 9.80665)  # g → m/s²: the declared level too
+    assert record.signals[2, 1] == pytest.approx(0.012 * 9.80665)
