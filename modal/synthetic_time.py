@@ -164,7 +164,8 @@ class DigitalModes:
         # s^q R/(s − p) = (polynomial in s) + R p^q/(s − p): the proper part's residue, and the direct term
         rc = residue * p[None, :] ** power
         direct = {0: 0.0, 1: 2 * residue.real, 2: 2 * (residue * p[None, :]).real}[power]
-        # T Σ_n g(nT) q^n with g(0) halved (g jumps there): T[Rc/(1 − zp q) + c.c.] − T Re(Rc), plus the direct term
+        # T Σ_n g(nT) q^n with g(0) halved (g jumps there) is T[Rc/(1 − zp q) + c.c.] − T Re(Rc); plus the
+        # direct term
         constant = direct - T * rc.real
         a = np.stack([np.ones_like(zp.real), -2 * zp.real, np.abs(zp) ** 2], axis=-1)
         b = np.zeros(rc.shape + (3,))
@@ -411,7 +412,8 @@ def impact_record(system: DigitalModes, hit_times_s: Sequence[float], duration_s
     n = int(round(duration_s * fs))
     times = np.atleast_1d(np.asarray(hit_times_s, dtype=float))
     if times.size == 0 or not np.all(np.isfinite(times)) or np.any(times < 0) or np.any(times >= duration_s):
-        raise ParameterError(f"'hit_times_s' is {hit_times_s!r}; expected times within the record (0 to {duration_s} s)")
+        raise ParameterError(f"'hit_times_s' is {hit_times_s!r}; expected times within the record "
+                             f"(0 to {duration_s} s)")
     peaks = _varied(rng, amplitude_n, amplitude_variation, times.size, "amplitude_n")
     widths = _varied(rng, pulse_width_s, width_variation, times.size, "pulse_width_s")
     if rebound_delay_s is None:

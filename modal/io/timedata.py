@@ -175,11 +175,16 @@ def _normalise_unit(unit: str | None) -> str | None:
 _SI_UNIT = {"force": "N", "displacement": "m", "velocity": "m/s", "acceleration": "m/s^2"}
 
 
-def _channel(values, unit: str | None, quantity: str | None):
+def _channel(values, unit: str | None, quantity: str | None, src: str = "<array>", where: str = "channel"):
     """(values in SI, unit, quantity): a unit we know is converted to SI and names the quantity when
-    the file does not; any other unit is kept as stored."""
+    the file does not; any other unit is kept as stored. A unit of another quantity than the file
+    states is refused (which of the two is wrong cannot be told)."""
     u = _normalise_unit(unit)
     if u in _QUANTITY_FROM_UNIT:
+        if quantity is not None and quantity != _QUANTITY_FROM_UNIT[u]:
+            raise FormatError(f"{src}: {where}: the unit {unit.strip()!r} is of {_QUANTITY_FROM_UNIT[u]} but the file "
+                              f"says the channel measured {quantity}; expected a unit of {quantity} "
+                              f"({_SI_UNIT[quantity]})")
         quantity = quantity or _QUANTITY_FROM_UNIT[u]
         return np.asarray(values, float) * _SI_FACTOR.get(u, 1.0), _SI_UNIT[quantity], quantity
     return np.asarray(values, float), (unit.strip() if u else _SI_UNIT.get(quantity or "")), quantity
@@ -238,7 +243,8 @@ def _uff_time_step(block, d: dict, src: str) -> float:
     # spacing 0: the abscissa is stored with every sample (pyuff writes it so when given x): accept it when uniform
     x = np.asarray(d.get("x", ()), dtype=float)
     # ASCII keeps each abscissa to 6 significant digits (E13.5): 5e-6 of |x|; binary stores them as written
-    binary = block.raw.split(b"\n", 2)[1:2] and block.raw.split(b"\n", 2)[1][6:7].lower() == b"b"
+    head = block.raw.split(b"\n", 2)
+    binary = len(head) > 1 and head[1][6:7].lower() == b"b"
     rounding = 1e-12 if binary else 5e-6
     where = f"{block.where()} (record 7 abscissa_spacing 0: an abscissa for every sample)"
     if x.size < 2 or not np.all(np.isfinite(x)):
@@ -302,7 +308,7 @@ def _read_uff(path, src: str) -> TimeRecord:
         quantity = QUANTITY_FROM_DATA_TYPE.get(int(d.get("ordinate_spec_data_type", 0)))
         unit = d.get("ordinate_axis_units_lab")
         unit = None if unit in (None, "NONE", "") else str(unit)
-        values, si, quantity = _channel(data, unit, quantity)
+        values, si, quantity = _channel(data, unit, quantity, src, b.where(9, 'ordinate_axis_units_lab'))
         signals.append(values)
         names.append(format_point(int(d.get("rsp_node", b.number)), int(d.get("rsp_dir", 0))))
         quantities.append(quantity)
@@ -498,7 +504,7 @@ def _from_mapping(get, src: str) -> TimeRecord:
         if q is not None and q not in _SI_UNIT:
             raise FormatError(f"{src}: field 'quantities', channel {k + 1}: {quantities[k]!r}; expected one of "
                               f"{', '.join(_SI_UNIT)} (or empty when unknown)")
-        values, si, q = _channel(signals[k], stored_units[k], q)
+        values, si, q = _channel(signals[k], stored_units[k], q, src, f"channel {k + 1} ('units', 'quantities')")
         out.append(values)
         si_units.append(si)
         quants.append(q)

@@ -291,3 +291,13 @@ def test_the_documented_csv_example_reads_as_documented(tmp_path):
     assert record.quantities == ("force", "acceleration", "acceleration")
     assert record.full_scale == (500.0, None, 50 * 9.80665)  # g → m/s²: the declared level too
     assert record.signals[2, 1] == pytest.approx(0.012 * 9.80665)
+
+
+def test_a_unit_that_contradicts_the_data_type_is_refused(tmp_path):
+    # record 9 says excitation force (13) but labels the unit m/s^2: which one is wrong cannot be told
+    channels = _three_channels()
+    channels[0] = (channels[0][0], 13, "m/s^2")
+    path = tmp_path / "contradiction.uff"
+    _uff(path, channels)
+    _fails(path, "dataset 1", "record 9, field ordinate_axis_units_lab", "'m/s^2' is of acceleration",
+           "measured force")
