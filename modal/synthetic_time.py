@@ -31,7 +31,6 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy import signal
 
 from .errors import ParameterError
 from .frf import KIND_POWER
@@ -188,12 +187,14 @@ class DigitalModes:
         -------
         ndarray, shape (n_outputs, n_samples)
         """
+        from scipy.signal import lfilter  # scipy.signal loads scipy's solvers: only when a record is made
+
         power = _QUANTITY_POWER[_quantity(quantity)]
         force = np.asarray(force, dtype=float)
         b, a = self._sections(power)
         out = np.zeros((self.n_outputs, force.size))
         for r in range(a.shape[0]):
-            u = signal.lfilter([1.0], a[r], force)  # the pole part, shared by every output
+            u = lfilter([1.0], a[r], force)  # the pole part, shared by every output
             delayed = np.zeros((3, force.size))
             delayed[0], delayed[1, 1:], delayed[2, 2:] = u, u[:-1], u[:-2]
             out += b[:, r, :] @ delayed
