@@ -368,7 +368,7 @@ def crank_plot(runs: int, plots: list[str]) -> str:
     import matplotlib.pyplot as plt
 
     from benchmarks.bench_crank import MECH, SPEED_RPM
-    from balancer.crank import grid_search_counterweight, max_shaking_force, optimal_counterweight
+    from balancer.compressor.crank import grid_search_counterweight, max_shaking_force, optimal_counterweight
 
     t_exact, opt = time_runs(lambda: optimal_counterweight(MECH, SPEED_RPM), runs)
     rows = [("exact", t_exact, 0.0)]

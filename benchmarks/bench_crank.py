@@ -16,7 +16,7 @@ import time
 
 import numpy as np
 
-from balancer.crank import (
+from balancer.compressor.crank import (
     SliderCrank,
     grid_search_counterweight,
     max_shaking_force,

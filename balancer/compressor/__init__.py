@@ -1,9 +1,8 @@
 """Compressor study: the slider-crank and its counterweight, the body on its mounts.
 
-* :mod:`balancer.compressor.crank`: shaking forces and the optimal counterweight
-  (also importable as ``balancer.crank``);
+* :mod:`balancer.compressor.crank`: shaking forces and the optimal counterweight;
 * :mod:`balancer.compressor.mounts`: the compressor body as a rigid body on
-  elastic mounts, forced by the shaking harmonics (also ``balancer.mounts``);
+  elastic mounts, forced by the shaking harmonics;
 * :mod:`balancer.compressor.crank_plots`: plots of the above (matplotlib; imported
-  on demand; also ``balancer.crank_plots``).
+  on demand).
 """

@@ -18,7 +18,7 @@ gives ``X = (K - Omega^2 M + i Omega C)^-1 Q``; the force into the base is
 ``(diag(k_i) + i Omega diag(c_i)) T_i X``.
 
 A force ``F`` applied at ``p`` loads the CG with ``[F; p x F]``.  For the
-compressor, the crank-plane axes of :mod:`balancer.crank` (x across the stroke,
+compressor, the crank-plane axes of :mod:`balancer.compressor.crank` (x across the stroke,
 y along it, z the crank axis) are taken parallel to the body axes.
 
 Mount stiffness and damping may come from identification: any object with
@@ -534,7 +534,7 @@ def compressor_response(system: MountedBody, mech: SliderCrank, speed_rpm: float
                         points_m=None, max_order: int = 6) -> HarmonicResponse:
     """Response of the mounted compressor to each harmonic of its shaking force and couple.
 
-    The shaking force (:func:`balancer.crank.shaking_harmonics`) acts at the
+    The shaking force (:func:`balancer.compressor.crank.shaking_harmonics`) acts at the
     crank centre; the crank-plane axes are the body axes.
 
     Parameters

@@ -4,9 +4,9 @@
   re-exported here, so ``from balancer.drive import belt_stage`` works as before
   the drive became a package;
 * :mod:`balancer.drive.shaft`: two-bearing shaft statics, sizing, stiffness and the
-  hand-over to a ball-balancer study (also importable as ``balancer.shaft``);
+  hand-over to a ball-balancer study;
 * :mod:`balancer.drive.report`: plain-text report and plots (matplotlib; imported
-  on demand; also ``balancer.drive_report``).
+  on demand).
 """
 from __future__ import annotations
 

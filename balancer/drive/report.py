@@ -101,7 +101,7 @@ def shaft_rows(analysis: ShaftAnalysis) -> tuple[ReportRow, ...]:
     Parameters
     ----------
     analysis : ShaftAnalysis
-        Result of :func:`balancer.shaft.analyse_shaft`.
+        Result of :func:`balancer.drive.shaft.analyse_shaft`.
 
     Returns
     -------
@@ -124,8 +124,8 @@ def sizing_rows(sizing: ShaftSizing) -> tuple[ReportRow, ...]:
     Parameters
     ----------
     sizing : ShaftSizing
-        Result of :func:`balancer.shaft.shaft_diameter_soderberg` or
-        :func:`balancer.shaft.shaft_diameter_asme`.
+        Result of :func:`balancer.drive.shaft.shaft_diameter_soderberg` or
+        :func:`balancer.drive.shaft.shaft_diameter_asme`.
 
     Returns
     -------
@@ -146,7 +146,7 @@ def handover_rows(handover: RotorHandover) -> tuple[ReportRow, ...]:
     Parameters
     ----------
     handover : RotorHandover
-        Result of :func:`balancer.shaft.rotor_handover`.
+        Result of :func:`balancer.drive.shaft.rotor_handover`.
 
     Returns
     -------
@@ -284,7 +284,7 @@ def plot_shear(analysis: ShaftAnalysis, ax: Axes | None = None) -> Figure:
     Parameters
     ----------
     analysis : ShaftAnalysis
-        Result of :func:`balancer.shaft.analyse_shaft`.
+        Result of :func:`balancer.drive.shaft.analyse_shaft`.
     ax : matplotlib.axes.Axes, optional
         Where to draw; a new Figure is built when omitted.
 
@@ -305,7 +305,7 @@ def plot_moment(analysis: ShaftAnalysis, ax: Axes | None = None) -> Figure:
     Parameters
     ----------
     analysis : ShaftAnalysis
-        Result of :func:`balancer.shaft.analyse_shaft`.
+        Result of :func:`balancer.drive.shaft.analyse_shaft`.
     ax : matplotlib.axes.Axes, optional
         Where to draw; a new Figure is built when omitted.
 
@@ -328,7 +328,7 @@ def plot_shaft_diagrams(analysis: ShaftAnalysis, axes: Sequence[Axes] | None = N
     Parameters
     ----------
     analysis : ShaftAnalysis
-        Result of :func:`balancer.shaft.analyse_shaft`.
+        Result of :func:`balancer.drive.shaft.analyse_shaft`.
     axes : pair of matplotlib.axes.Axes, optional
         ``(shear_ax, moment_ax)``; a new two-panel Figure is built when omitted.
 

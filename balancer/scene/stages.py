@@ -55,15 +55,15 @@ class DriveStage:
     """Belt drive and, when a shaft is given, its hand-over to the rotor."""
 
     drive: object  # balancer.drive.BeltDrive
-    handover: object | None  # balancer.shaft.RotorHandover
+    handover: object | None  # balancer.drive.shaft.RotorHandover
 
 
 @dataclass(frozen=True)
 class CompressorStage:
     """Crank counterweight study: mechanism, exact optimum and the chosen counterweight."""
 
-    mechanism: object  # balancer.crank.SliderCrank
-    optimum: object  # balancer.crank.OptimalCounterweight
+    mechanism: object  # balancer.compressor.crank.SliderCrank
+    optimum: object  # balancer.compressor.crank.OptimalCounterweight
     counterweight_mass_kg: float
     counterweight_radius_m: float
     speed_rpm: float
@@ -73,9 +73,9 @@ class CompressorStage:
 class MountsStage:
     """The compressor body on its mounts: modes and base forces before/after balancing."""
 
-    system: object  # balancer.mounts.MountedBody
+    system: object  # balancer.compressor.mounts.MountedBody
     natural_frequencies_hz: np.ndarray
-    comparison: object  # balancer.mounts.BalancingComparison
+    comparison: object  # balancer.compressor.mounts.BalancingComparison
 
 
 #: [frf] keys passed to modal.io.read_frf: the read options of ``python -m modal fit`` under the same names

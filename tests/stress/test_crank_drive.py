@@ -20,7 +20,9 @@ import pytest
 from hypothesis import HealthCheck, given, note, seed, settings
 from hypothesis import strategies as st
 
-from balancer import crank, drive, shaft
+from balancer import drive
+from balancer.compressor import crank
+from balancer.drive import shaft
 from modal.errors import ParameterError
 from modal.units import rpm_to_rad_s
 

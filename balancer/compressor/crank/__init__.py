@@ -36,10 +36,10 @@ Everything is SI inside (m, kg, N, rad, rad/s); rpm appears only in argument
 names ``speed_rpm``.  ``|F|`` is even in ``theta`` for every model here, so
 maxima over a revolution are searched on ``[0, pi]``.
 
-The package has three parts: :mod:`~balancer.crank.model` (the mechanism and its
-kinematics), :mod:`~balancer.crank.forces` (shaking force, harmonics, exact
-maxima) and :mod:`~balancer.crank.counterweight` (evaluation, optimum, grid).
-Everything public is importable from ``balancer.crank``.
+The package has three parts: :mod:`~balancer.compressor.crank.model` (the mechanism and its
+kinematics), :mod:`~balancer.compressor.crank.forces` (shaking force, harmonics, exact
+maxima) and :mod:`~balancer.compressor.crank.counterweight` (evaluation, optimum, grid).
+Everything public is importable from ``balancer.compressor.crank``.
 """
 from __future__ import annotations
 

@@ -1,6 +1,6 @@
 """The slider-crank mechanism: its masses and geometry, the rod's two-mass split and the
 piston-acceleration and rod-couple factors (exact or harmonic series); the model is
-described in :mod:`balancer.crank`."""
+described in :mod:`balancer.compressor.crank`."""
 from __future__ import annotations
 
 import functools

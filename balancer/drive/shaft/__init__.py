@@ -17,11 +17,11 @@ Conventions
   shear ``V(x) = sum of F_j left of x`` (value just right of x at a station).
 * SI inside: m, N, N m, Pa, kg, rad/s.  rpm and degrees only in names that say so.
 
-The package has four parts: :mod:`~balancer.shaft.statics` (inputs, reactions,
-moments), :mod:`~balancer.shaft.sizing` (diameter from strength),
-:mod:`~balancer.shaft.stiffness` (stiffness, critical speed, margin) and
-:mod:`~balancer.shaft.handover` (speed and stiffness for a ball-balancer study).
-Everything public is importable from ``balancer.shaft``.
+The package has four parts: :mod:`~balancer.drive.shaft.statics` (inputs, reactions,
+moments), :mod:`~balancer.drive.shaft.sizing` (diameter from strength),
+:mod:`~balancer.drive.shaft.stiffness` (stiffness, critical speed, margin) and
+:mod:`~balancer.drive.shaft.handover` (speed and stiffness for a ball-balancer study).
+Everything public is importable from ``balancer.drive.shaft``.
 """
 from __future__ import annotations
 

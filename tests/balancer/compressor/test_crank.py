@@ -16,8 +16,8 @@ import pytest
 from hypothesis import given, seed, settings
 from hypothesis import strategies as st
 
-from balancer import crank
-from balancer.crank import (
+from balancer.compressor import crank
+from balancer.compressor.crank import (
     PAPER_RULES,
     SliderCrank,
     balance_fraction,
@@ -476,7 +476,7 @@ def test_plots_draw_the_computed_data_without_pyplot(seed000):
 
     from matplotlib.figure import Figure
 
-    from balancer import crank_plots
+    from balancer.compressor import crank_plots
 
     opt = optimal_counterweight(seed000, SPEED_000_RPM, n_curve_points=5)
     light = counterweight_on_curve(seed000, opt)
@@ -515,7 +515,7 @@ def test_every_public_parameter_is_documented():
     import inspect
     import re
 
-    from balancer import crank_plots, mounts
+    from balancer.compressor import crank_plots, mounts
 
     missing = []
     for module in (crank, mounts, crank_plots):

@@ -12,14 +12,14 @@ import dataclasses
 import numpy as np
 import pytest
 
-from balancer.crank import (
+from balancer.compressor.crank import (
     SliderCrank,
     counterweight_on_curve,
     optimal_counterweight,
     shaking_harmonics,
     slider_crank_from_components,
 )
-from balancer.mounts import (
+from balancer.compressor.mounts import (
     BalancingComparison,
     Mount,
     MountedBody,

@@ -1,4 +1,4 @@
-"""V-belt stages (balancer.drive) and the plain-text report / plots (balancer.drive_report).
+"""V-belt stages (balancer.drive) and the plain-text report / plots (balancer.drive.report).
 
 Reference numbers are the machine-drive report (seed 002) as decoded in
 ``shared/reference/crank_drive.md`` section 4.  Where the report is sound, the
@@ -17,7 +17,9 @@ from matplotlib.figure import Figure
 from support.numpydoc_sections import documented
 from support.paths import ROOT
 
-from balancer import drive, drive_report, shaft
+from balancer import drive
+from balancer.drive import report as drive_report
+from balancer.drive import shaft
 from balancer.drive import (
     ARC_CORRECTION_VV,
     BeltStageSpec,
@@ -30,7 +32,7 @@ from balancer.drive import (
     tension_ratio_from_friction,
     tension_sum_factor_from_ratio,
 )
-from balancer.shaft import PointLoad, ShaftGeometry, analyse_shaft
+from balancer.drive.shaft import PointLoad, ShaftGeometry, analyse_shaft
 from modal.errors import ParameterError
 
 # Stage A of the report: 0.75 kW motor at 930 rpm, pulleys 100 -> 120 mm, C = 300 mm,

@@ -1,4 +1,4 @@
-"""Two-bearing shaft (balancer.shaft): statics, sizing, stiffness, critical speed and
+"""Two-bearing shaft (balancer.drive.shaft): statics, sizing, stiffness, critical speed and
 the hand-over to a ball-balancer study.
 
 Reference numbers: seed 002 as decoded in ``shared/reference/crank_drive.md`` section 4
@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from balancer.drive import belt_stage
-from balancer.shaft import (
+from balancer.drive.shaft import (
     STANDARD_SHAFT_DIAMETERS_M,
     PointLoad,
     ShaftGeometry,
