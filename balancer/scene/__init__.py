@@ -13,7 +13,7 @@ import importlib
 __all__ = ["run_scene", "SceneRun", "plan", "stage_hashes", "load_scene", "parse_scene", "Scene", "STAGES"]
 
 _HOME = {"run_scene": "runner", "SceneRun": "runner", "plan": "runner", "stage_hashes": "runner",
-         "load_scene": "schema", "parse_scene": "schema", "Scene": "schema", "STAGES": "schema"}
+         "load_scene": "schema", "parse_scene": "schema", "Scene": "schema", "STAGES": "registry"}
 
 
 def __getattr__(name: str):

@@ -1,4 +1,8 @@
-"""One figure per stage, saved as PNG (crash-safely) for the scene runner."""
+"""The stages' figures, saved as PNG (crash-safely) for the scene runner.
+
+Each stage names its figures function, the results they read and the modules drawing them
+imports in :data:`.registry.REGISTRY`.
+"""
 from __future__ import annotations
 
 import importlib
@@ -10,10 +14,13 @@ from matplotlib.figure import Figure
 from modal.figures import fixed_figure, png_bytes
 from modal.io._atomic import atomic_path
 
-__all__ = ["stage_figures", "save_stage_plot", "PLOT_MODULES", "preload"]
+from .registry import REGISTRY, load
+
+__all__ = ["stage_figures", "save_stage_plot", "preload", "identify_figures", "stability_figures", "response_figures",
+           "compressor_figures", "mounts_figures", "drive_figures", "balance_figures"]
 
 
-def _identify(results):
+def identify_figures(results):
     from modal.plots import plot_fit
 
     if "frf" not in results:
@@ -21,7 +28,7 @@ def _identify(results):
     return [("fit", plot_fit(results["frf"], results["identify"]))]
 
 
-def _stability(results):
+def stability_figures(results):
     stage = results["adb_stability"]
     wn = stage.intervals.natural_frequency_rad_s
     fig = fixed_figure(7, 4, left=0.75, right=0.2, bottom=0.55, top=0.35)
@@ -36,7 +43,7 @@ def _stability(results):
     return [("stability", fig)]
 
 
-def _response(results):
+def response_figures(results):
     from ..adb.plots import plot_amplitude, plot_ball_angles, plot_orbit, plot_run_up
 
     r = results["adb_response"]
@@ -51,7 +58,7 @@ def _response(results):
     return [("response", fig)]
 
 
-def _compressor(results):
+def compressor_figures(results):
     from ..compressor.crank_plots import plot_force_locus, plot_objective
 
     c = results["compressor"]
@@ -59,7 +66,7 @@ def _compressor(results):
             ("objective", plot_objective(c.mechanism, c.speed_rpm, c.optimum))]
 
 
-def _mounts(results):
+def mounts_figures(results):
     m = results["mounts"]
     fig = fixed_figure(7, 4, left=0.7, right=0.15, bottom=0.5, top=0.15)  # bottom: the rotated tick labels
     ax = fig.add_subplot()
@@ -75,7 +82,7 @@ def _mounts(results):
     return [("base_force", fig)]
 
 
-def _drive(results):
+def drive_figures(results):
     d = results["drive"]
     fig = Figure(figsize=(7, 3), layout="constrained")
     ax = fig.add_subplot()
@@ -86,7 +93,7 @@ def _drive(results):
     return [("speeds", fig)]
 
 
-def _balance(results):
+def balance_figures(results):
     from ..influence.plots import plot_balance
 
     b = results["balance"]
@@ -109,37 +116,25 @@ def _balance(results):
     return figures
 
 
-_FIGURES = {"identify": _identify, "adb_stability": _stability, "adb_response": _response,
-            "compressor": _compressor, "mounts": _mounts, "drive": _drive, "balance": _balance}
-
-
-#: the modules a stage's figures import when drawn from its plot inputs (runner._PLOT_INPUTS) in a plotting
-#: process, which holds only what drawing needs (balancer._plotter): the plotting functions and the classes of
-#: the results unpickled for them (tests/balancer/scene/test_plot_jobs.py checks it). The plotting process imports them
-#: once, before it forks its helper, instead of each drawing process importing them for itself.
-PLOT_MODULES = {
-    "identify": ("modal.plots", "modal.flags"),
-    "adb_stability": ("balancer.scene.stages",),  # the stage results' classes (StabilityStage, ...)
-    "adb_response": ("balancer.adb.plots", "balancer.scene.stages"),
-    "compressor": ("balancer.compressor.crank_plots", "balancer.scene.stages"),
-    "mounts": ("balancer.compressor.mounts", "balancer.scene.stages"),
-    "drive": ("balancer.drive", "balancer.drive.shaft", "balancer.scene.stages"),
-    "balance": ("balancer.influence.plots", "balancer.influence.study", "balancer.scene.stages"),
-}
-
-
 def preload(stages) -> None:
-    """Import what drawing the figures of ``stages`` needs (:data:`PLOT_MODULES`)."""
+    """Import what drawing the figures of ``stages`` needs (their ``plot_modules``), and their figures functions.
+
+    The plotting process does this once, before it forks its helper, instead of each drawing process
+    importing them for itself.
+    """
     for stage in stages:
-        for name in PLOT_MODULES.get(stage, ()):
+        for name in REGISTRY[stage].plot_modules:
             importlib.import_module(name)
+        if REGISTRY[stage].figures:
+            load(REGISTRY[stage].figures)
 
 
 def stage_figures(stage: str, results) -> list[tuple[str, Figure]]:
     """(name, Figure) pairs for a stage; empty for stages without a plot."""
-    if stage not in results or stage not in _FIGURES:
+    figures = REGISTRY[stage].figures
+    if stage not in results or figures is None:
         return []
-    return _FIGURES[stage](results)
+    return load(figures)(results)
 
 
 def save_stage_plot(stage: str, results, folder: Path) -> list[Path]:

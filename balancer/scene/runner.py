@@ -13,8 +13,9 @@ import modal
 from modal.errors import ArchiveError, PlotError, SceneError
 
 from .._plotter import Plotter, plot_error
-from .schema import STAGES, Reference, Scene, dependencies, load_scene, parse_scene
-from .stages import STAGE_FUNCTIONS
+from .registry import REGISTRY, STAGES, load
+from .rules import Reference
+from .schema import Scene, load_scene, parse_scene
 
 if TYPE_CHECKING:
     import h5py
@@ -23,18 +24,6 @@ __all__ = ["SceneRun", "run_scene", "plan", "stage_hashes"]
 
 # h5py (and modal.archive) are imported where an archive is read or written: `python -m balancer run`
 # forks its plotting process before, and what is imported by then is paid before both processes work
-
-#: configuration sections that make up each stage's inputs (besides its dependencies' hashes)
-_STAGE_CONFIG = {
-    "frf": ("frf",), "identify": ("identify",), "drive": ("drive",), "rotor": ("rotor", "adb.m", "adb.n", "adb.R", "adb.D"),
-    "adb_stability": ("adb.stability",), "adb_response": ("adb.response",),
-    "compressor": ("compressor.crank_radius_m", "compressor.rod_length_m", "compressor.rotating_mass_kg",
-                   "compressor.reciprocating_mass_kg", "compressor.speed_rpm", "compressor.harmonics",
-                   "compressor.counterweight_k"),
-    "mounts": ("compressor.body", "compressor.mounts"),
-    "balance": ("balance",),
-}
-
 
 @dataclass(frozen=True)
 class SceneRun:
@@ -79,49 +68,31 @@ def _canonical(value):
 
 
 def stage_hashes(scene: Scene, stages) -> dict[str, str]:
-    """SHA-256 of each stage's inputs: its configuration, its files' bytes and its dependencies' hashes."""
+    """SHA-256 of each stage's inputs: its configuration, its files' bytes and its dependencies' hashes.
+
+    ``stages`` are needed stages of the scene (:attr:`Scene.graph`) with all their upstream stages.
+    """
     hashes: dict[str, str] = {}
     for stage in STAGES:
         if stage not in stages:
             continue
-        config = {key: _canonical(scene.section(key)) for key in _STAGE_CONFIG[stage]}
-        if stage == "frf" and scene.section("frf.file"):
-            path = scene.folder / scene.section("frf.file")
-            try:
-                config["file_sha256"] = hashlib.sha256(path.read_bytes()).hexdigest()
-            except OSError as exc:
-                raise SceneError(f"{scene.source}: key 'frf.file' = {scene.section('frf.file')!r}: cannot read {path} "
-                                 f"({exc.strerror})") from None
-        if stage == "balance" and scene.section("balance.readings"):
-            path = scene.folder / scene.section("balance.readings")
-            try:
-                config["readings_sha256"] = hashlib.sha256(path.read_bytes()).hexdigest()
-            except OSError as exc:
-                raise SceneError(f"{scene.source}: key 'balance.readings' = {scene.section('balance.readings')!r}: "
-                                 f"cannot read {path} ({exc.strerror})") from None
+        config = {key: _canonical(scene.section(key)) for key in REGISTRY[stage].config}
+        for key in REGISTRY[stage].files:
+            if scene.section(key):
+                config[f"{key.rpartition('.')[2]}_sha256"] = _file_sha256(scene, key)
         payload = {"stage": stage, "config": config, "software": modal.__version__,
-                   "deps": {d: hashes[d] for d in dependencies(scene, stage)}}
+                   "deps": {d: hashes[d] for d in scene.graph[stage]}}
         hashes[stage] = hashlib.sha256(json.dumps(payload, sort_keys=True).encode()).hexdigest()
     return hashes
 
 
-def _closure(scene: Scene, wanted) -> set[str]:
-    need, todo = set(), list(wanted)
-    while todo:
-        stage = todo.pop()
-        if stage not in need:
-            need.add(stage)
-            todo.extend(dependencies(scene, stage))
-    return need
-
-
-def _wanted(scene: Scene) -> list[str]:
-    out = scene.section("outputs")
-    wanted = set(out.get("tables", [])) | set(out.get("plots", []))
-    archive = out.get("archive", False)
-    if isinstance(archive, list):
-        wanted |= set(archive)
-    return [s for s in STAGES if s in wanted]
+def _file_sha256(scene: Scene, key: str) -> str:
+    path = scene.folder / scene.section(key)
+    try:
+        return hashlib.sha256(path.read_bytes()).hexdigest()
+    except OSError as exc:
+        raise SceneError(f"{scene.source}: key '{key}' = {scene.section(key)!r}: cannot read {path} "
+                         f"({exc.strerror})") from None
 
 
 def plan(scene: Scene, earlier: h5py.File | None = None) -> tuple[dict[str, str], dict[str, str]]:
@@ -131,7 +102,7 @@ def plan(scene: Scene, earlier: h5py.File | None = None) -> tuple[dict[str, str]
     stage whose inputs hash matches the earlier archive is reused (read back),
     any other needed stage runs, and the rest are skipped.
     """
-    needed = _closure(scene, _wanted(scene))
+    needed = scene.graph
     hashes = stage_hashes(scene, needed)
     status = {s: "skipped" for s in STAGES}
     for stage in needed:
@@ -160,13 +131,6 @@ def _open_earlier(path) -> h5py.File | None:
         f.close()
         raise
     return f
-
-
-#: the results each stage's figures read (balancer.scene.plots; tests/balancer/scene/test_plot_jobs.py checks it): a
-#: plotting process is handed only these, so it unpickles (and imports the classes of) nothing more
-_PLOT_INPUTS = {"identify": ("frf", "identify"), "adb_stability": ("adb_stability",),
-                "adb_response": ("adb_response", "rotor"), "compressor": ("compressor",), "mounts": ("mounts",),
-                "drive": ("drive",), "balance": ("balance",)}
 
 
 def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, plots_dir: str | Path | None = None,
@@ -226,14 +190,17 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, p
         folder = Path(plots_dir) if plots_dir is not None else (
             archive_path.with_name(archive_path.stem + "_plots") if archive_path else Path("out") / f"{_slug(name)}_plots")
     plotter = Plotter(plot_jobs, folder, plotted) if plotted else None
-    pending = list(plotted)  # plot stages not yet handed to the child, in output order
+    # plot stages not yet handed to the child, in output order (a stage without figures draws nothing)
+    pending = [stage for stage in plotted if REGISTRY[stage].figures]
 
     def hand_over() -> None:
         # plots whose stage and upstream results are all there go to the child while the parent runs on
         for stage in list(pending):
-            if stage not in results or not all(status[t] != "ran" or t in results for t in dependencies(scene, stage)):
+            if stage not in results or not all(status[t] != "ran" or t in results for t in scene.graph[stage]):
                 continue
-            given = {s: results[s] for s in _PLOT_INPUTS.get(stage, _closure(scene, [stage])) if s in results}
+            # a plotting process is handed only what the figures read: it unpickles (and imports the classes of)
+            # nothing more
+            given = {s: results[s] for s in REGISTRY[stage].plot_inputs if s in results}
             if plotter.submit(stage, given):
                 pending.remove(stage)
 
@@ -246,8 +213,8 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, p
                 continue
             say(f"{stage}: running")
             t0 = time.perf_counter()
-            kwargs = {dep: results[dep] for dep in dependencies(scene, stage) if dep in results}
-            results[stage] = STAGE_FUNCTIONS[stage](scene, **kwargs)
+            kwargs = {dep: results[dep] for dep in scene.graph[stage] if dep in results}
+            results[stage] = load(REGISTRY[stage].run)(scene, **kwargs)
             timings[stage] = time.perf_counter() - t0
             say(f"{stage}: done in {timings[stage]:.2f} s")
             if plotter is not None and plotter.started and pending:

@@ -1,5 +1,6 @@
 """The scene's stages: each a plain function from its configuration and the
-results of the stages it depends on to a frozen result dataclass.
+results of the stages it depends on to a frozen result dataclass, and the checks
+a stage makes when the scene is read (its ``prepare``; see :mod:`.registry`).
 
 They only wire the library together; a script can call any of them directly.
 """
@@ -19,12 +20,13 @@ from ..adb.parameters import STD_ORDER, identified_correlation
 from ..adb.simulate import SimulationResult, simulate
 from ..adb.speed import LinearRunUp
 from ..adb.stability import SpeedIntervals
-from .schema import DRIVE_FIELDS, IDENTIFIED_FIELDS, Reference, Scene, parse_reference
+from .rules import DRIVE_FIELDS, IDENTIFIED_FIELDS, Reference, parse_reference
+from .schema import Scene
 
 __all__ = [
     "RotorStage", "StabilityStage", "DriveStage", "CompressorStage", "MountsStage",
     "stage_frf", "stage_identify", "stage_drive", "stage_rotor", "stage_adb_stability", "stage_adb_response",
-    "stage_compressor", "stage_mounts", "resolve", "STAGE_FUNCTIONS", "BalanceStage", "stage_balance",
+    "stage_compressor", "stage_mounts", "resolve", "BalanceStage", "stage_balance", "check_frf", "read_balance_job",
 ]
 
 
@@ -142,6 +144,32 @@ def resolve(value, key: str, scene: Scene, identified=None, drive=None) -> float
     if handover is None:
         raise SceneError(f"{scene.source}: key '{key}' = {value.text!r} needs [drive.shaft] for the hand-over")
     return float(getattr(handover, DRIVE_FIELDS[value.field]))
+
+
+# -------------------------------------------------------------------- checks when the scene is read
+def check_frf(scene: Scene) -> None:
+    """[frf] names a file or describes a synthetic FRF: one of them."""
+    cfg = scene.section("frf")
+    if "file" in cfg and "synthetic" in cfg:
+        raise SceneError(f"{scene.source}: key 'frf' has both 'file' and 'synthetic'; expected one of them")
+    if "file" not in cfg and "synthetic" not in cfg:
+        raise SceneError(f"{scene.source}: key 'frf' needs 'file' or a [frf.synthetic] table")
+
+
+def read_balance_job(scene: Scene):
+    """The [balance] readings, parsed and checked (shapes, units, files) before any work; None for a
+    simulated study ([balance.simulate]), whose readings the stage makes."""
+    from modal.errors import ModalError
+
+    from ..influence.job import parse_job
+
+    cfg = scene.section("balance")
+    if "simulate" in cfg:
+        return None
+    try:
+        return parse_job(cfg, scene.source, scene.folder, key_prefix="balance.")
+    except ModalError as exc:
+        raise SceneError(str(exc)) from None
 
 
 # -------------------------------------------------------------------- stages
@@ -289,7 +317,7 @@ def stage_mounts(scene: Scene, compressor: CompressorStage, identify=None) -> Mo
         vectors = {}
         for key in ("stiffness_n_per_m", "damping_n_s_per_m"):
             raw = m.get(key, [0.0, 0.0, 0.0])
-            if isinstance(raw, str):
+            if isinstance(raw, Reference):
                 value = resolve(raw, f"compressor.mounts[{i}].{key}", scene, identify)
                 raw = [value, value, value]
             vectors[key] = raw
@@ -312,7 +340,7 @@ class BalanceStage:
 
 def stage_balance(scene: Scene, rotor: RotorStage | None = None, adb_response=None) -> BalanceStage:
     """Correction, split, predicted residual and ISO verdict; or the simulated study on the [rotor]."""
-    from ..influence.job import balance, parse_job
+    from ..influence.job import balance
     from ..influence.study import field_balancing_study
 
     cfg = scene.section("balance")
@@ -323,9 +351,8 @@ def stage_balance(scene: Scene, rotor: RotorStage | None = None, adb_response=No
                "speed_rpm": iso.get("speed_rpm"), "distances_m": tuple(iso["distances_m"]) if "distances_m" in iso else None}
     method = cfg.get("method", "least_squares")
     sim = cfg.get("simulate")
-    if sim is None:
-        job = parse_job({k: v for k, v in cfg.items() if k not in ("simulate",)}, scene.source, scene.folder, "balance.")
-        return BalanceStage(balance(job, method, **options), None)
+    if sim is None:  # the readings as read when the scene was checked
+        return BalanceStage(balance(scene.inputs["balance"], method, **options), None)
     p = rotor.params
     # the simulated rotor's truth (default: the identified [rotor] itself); alpha_model uses the identified k, c, M
     true_M, true_k, true_c = (sim.get("rotor_mass_kg", p.M), sim.get("stiffness_n_per_m", p.k),
@@ -344,12 +371,4 @@ def stage_balance(scene: Scene, rotor: RotorStage | None = None, adb_response=No
                             radius, sim.get("noise", 0.05), sim.get("seed", 0), cfg["units"], cfg.get("mass_units", "g"))
         report = balance(job, method, **options)
     return BalanceStage(report, study)
-
-
-STAGE_FUNCTIONS = {
-    "frf": stage_frf, "identify": stage_identify, "drive": stage_drive, "rotor": stage_rotor,
-    "adb_stability": stage_adb_stability, "adb_response": stage_adb_response, "compressor": stage_compressor,
-    "mounts": stage_mounts, "balance": stage_balance,
-}
-
 

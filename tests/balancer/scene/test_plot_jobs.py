@@ -61,7 +61,7 @@ def test_a_failing_plot_in_a_child_is_reported(tmp_path):
     out = _run(tmp_path, """
 def broken(results):
     raise ValueError("no figure today")
-plots._FIGURES["identify"] = broken
+plots.identify_figures = broken
 try:
     run_scene(demo, out="c.h5", plots_dir="c", plot_jobs=2)
     out = {"error": None}
@@ -78,7 +78,7 @@ def test_a_failing_stage_leaves_no_plots_drawn_early(tmp_path):
     out = _run(tmp_path, """
 def broken(scene, **kwargs):
     raise SceneError("mounts: broken on purpose")
-stages.STAGE_FUNCTIONS["mounts"] = broken
+stages.stage_mounts = broken
 try:
     run_scene(demo, out="d.h5", plots_dir="d", plot_jobs=2)
     out = {"error": None}
@@ -100,46 +100,50 @@ def test_a_failing_plot_is_reported_with_its_stage(tmp_path, monkeypatch, jobs):
     # with 2 jobs the identify plot is handed to a child as soon as its stage is done (no child is running
     # yet then) when forking is usable (no other thread in the process: a Dask cluster of another test in the
     # same session makes it draw here instead); wherever it is drawn, the failure reaches the caller the same way
-    monkeypatch.setitem(plots._FIGURES, "identify", broken)
+    monkeypatch.setattr(plots, "identify_figures", broken)
     with pytest.raises(RuntimeError, match="plots of identify.*ValueError: no figure today"):
         run_scene(DEMO, out=tmp_path / "c.h5", plots_dir=tmp_path / "c", plot_jobs=jobs)
 
 
 
 def test_every_stage_figure_declares_the_results_it_reads():
-    # a plotting process is handed only runner._PLOT_INPUTS[stage] (the byte-for-byte test above shows the
-    # demo's figures come out the same from that subset); a new figure must say what it reads
-    from balancer.scene import plots, runner
+    # a plotting process is handed only the stage's plot_inputs (the byte-for-byte test above shows the
+    # demo's figures come out the same from that subset); a stage with figures must say what they read
+    from balancer.scene.registry import REGISTRY
 
-    assert set(runner._PLOT_INPUTS) == set(plots._FIGURES)
-    assert all(stage in inputs for stage, inputs in runner._PLOT_INPUTS.items())
+    with_figures = [stage for stage in REGISTRY.values() if stage.figures]
+    assert len(with_figures) == 7
+    assert all(stage.name in stage.plot_inputs and set(stage.plot_inputs) <= set(REGISTRY) for stage in with_figures)
+    assert all(not stage.plot_inputs and not stage.plot_modules for stage in REGISTRY.values() if not stage.figures)
 
 
 def test_every_figure_draws_the_same_in_a_plotting_process_with_only_the_drawing_modules(tmp_path):
     # `python -m balancer run` forks its plotting process before modal is imported, and the process loads
-    # only modal's submodules that drawing needs (balancer._plotter._drawing_modal), then plots.PLOT_MODULES
+    # only modal's submodules that drawing needs (balancer._plotter._drawing_modal), then the plot_modules
     # of its stages once, before it forks its helper. Each stage's plot inputs are pickled by a run here,
     # then drawn in such a process, a child of its own per stage (as a scene that plots only it): the files
     # are byte for byte the ones drawn here, drawing imports no modal/balancer module beyond the preloaded
     # ones (each drawing process would import it again), and the identification toolkit never loads.
     import pickle
 
-    from balancer.scene import plots, run_scene, runner
+    from balancer.scene import plots, run_scene
+    from balancer.scene.registry import REGISTRY
     from support.scenes import DRIVE
 
     scenes = [DEMO, ROOT / "data" / "synthetic" / "balance_scene.toml",
               {"scene": {"name": "drive"}, "drive": DRIVE, "outputs": {"plots": ["drive"]}}]
+    figured = [stage for stage, entry in REGISTRY.items() if entry.figures]
     pickled = {}
     for scene in scenes:
         run = run_scene(scene, out=tmp_path / "x.h5", plots_dir=tmp_path / "p")
-        for stage in plots._FIGURES:
+        for stage in figured:
             if stage in run.results and stage not in pickled:
-                given = {s: run.results[s] for s in runner._PLOT_INPUTS[stage] if s in run.results}
+                given = {s: run.results[s] for s in REGISTRY[stage].plot_inputs if s in run.results}
                 pickled[stage] = str(tmp_path / f"{stage}.pickle")
                 Path(pickled[stage]).write_bytes(pickle.dumps(given))
                 (tmp_path / "serial").mkdir(exist_ok=True)
                 plots.save_stage_plot(stage, given, tmp_path / "serial")
-    assert set(pickled) == set(plots._FIGURES)  # every stage with figures is covered
+    assert set(pickled) == set(figured)  # every stage with figures is covered
     script = f"""
 import json, os, pickle, sys
 from pathlib import Path
@@ -204,7 +208,7 @@ sys.path.insert(0, {str(ROOT)!r})
 from balancer.scene import plots, run_scene
 def broken(results):
     raise ValueError("no figure today")
-plots._FIGURES["identify"] = broken   # before the fork: the plotting process has it too
+plots.identify_figures = broken   # before the fork: the plotting process has it too
 from balancer import _plotter
 out = {{"started": _plotter.start_early()}}
 try:
@@ -260,7 +264,7 @@ def test_a_failed_figure_ends_the_command_line_with_a_one_line_error(tmp_path, m
     def broken(results):
         raise ValueError("no figure today")
 
-    monkeypatch.setitem(plots._FIGURES, "identify", broken)
+    monkeypatch.setattr(plots, "identify_figures", broken)
     code = cli.main(["run", str(DEMO), "--out", str(tmp_path / "e.h5"), "--plots", str(tmp_path / "e")])
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 1
