@@ -9,8 +9,9 @@ if sys.argv[1:2] == ["run"]:
 
     gc.disable()
     # the plotting process is forked before anything else is imported: it imports matplotlib (and only the
-    # parts of modal that drawing needs) while this process imports the identification toolkit (balancer._plotter)
-    from ._plotter import start_early
+    # parts of modal that drawing needs) while this process imports the identification toolkit
+    # (balancer.scene.plotter; importing balancer.scene loads nothing yet)
+    from .scene.plotter import start_early
 
     start_early()
 

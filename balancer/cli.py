@@ -38,7 +38,7 @@ def build_parser(influence: bool = True) -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit code."""
-    from ._plotter import dismiss_early
+    from .scene.plotter import dismiss_early
 
     try:
         return _main(argv)

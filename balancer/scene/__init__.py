@@ -4,7 +4,7 @@
 unchanged stages from an earlier archive, and writes an HDF5 archive and plots.
 
 The names below are loaded on first use: the plotting process of ``python -m balancer run``
-imports ``balancer.scene.plots`` without the runner and its stages (balancer._plotter).
+imports ``balancer.scene.plots`` without the runner and its stages (:mod:`.plotter`).
 """
 from __future__ import annotations
 

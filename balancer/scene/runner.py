@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING, Any, Callable
 import modal
 from modal.errors import ArchiveError, PlotError, SceneError
 
-from .._plotter import Plotter, plot_error
+from .plotter import Plotter, plot_error
 from .registry import REGISTRY, STAGES, load
 from .rules import Reference
 from .schema import Scene, load_scene, parse_scene
@@ -157,7 +157,7 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, p
         them (matplotlib imported once, while this process starts on the stages), each
         stage's plots as soon as the stage is done, while the next stages run
         (``python -m balancer run`` uses 2 on a machine with several CPUs, and its plotting
-        process is started before anything is imported: :mod:`balancer._plotter`).  The files
+        process is started before anything is imported: :mod:`.plotter`).  The files
         are the same as with 1 (default: everything in this process).
     """
     if isinstance(scene, (str, Path)):

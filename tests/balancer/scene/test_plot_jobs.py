@@ -119,7 +119,7 @@ def test_every_stage_figure_declares_the_results_it_reads():
 
 def test_every_figure_draws_the_same_in_a_plotting_process_with_only_the_drawing_modules(tmp_path):
     # `python -m balancer run` forks its plotting process before modal is imported, and the process loads
-    # only modal's submodules that drawing needs (balancer._plotter._drawing_modal), then the plot_modules
+    # only modal's submodules that drawing needs (balancer.scene.plotter._drawing_modal), then the plot_modules
     # of its stages once, before it forks its helper. Each stage's plot inputs are pickled by a run here,
     # then drawn in such a process, a child of its own per stage (as a scene that plots only it): the files
     # are byte for byte the ones drawn here, drawing imports no modal/balancer module beyond the preloaded
@@ -148,8 +148,8 @@ def test_every_figure_draws_the_same_in_a_plotting_process_with_only_the_drawing
 import json, os, pickle, sys
 from pathlib import Path
 sys.path.insert(0, {str(ROOT)!r})
-from balancer import _plotter
-_plotter._drawing_modal()
+from balancer.scene import plotter
+plotter._drawing_modal()
 import matplotlib.figure
 from balancer.scene import plots
 out = {{}}
@@ -209,15 +209,15 @@ from balancer.scene import plots, run_scene
 def broken(results):
     raise ValueError("no figure today")
 plots.identify_figures = broken   # before the fork: the plotting process has it too
-from balancer import _plotter
-out = {{"started": _plotter.start_early()}}
+from balancer.scene import plotter
+out = {{"started": plotter.start_early()}}
 try:
     run_scene({str(DEMO)!r}, out="c.h5", plots_dir="c", plot_jobs=2)
 except RuntimeError as exc:
     out["error"] = str(exc)
-out["taken"] = _plotter._early is None
-out["second"] = _plotter.start_early()
-_plotter.dismiss_early()
+out["taken"] = plotter._early is None
+out["second"] = plotter.start_early()
+plotter.dismiss_early()
 try:
     os.waitpid(-1, os.WNOHANG)
     out["children"] = "left"

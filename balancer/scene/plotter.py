@@ -1,26 +1,34 @@
-"""The processes that draw a scene's plots while the scene runs on (issue 19 goal 4).
+"""The processes that draw a scene's plots while the scene runs on.
 
 A plotting process is forked and imports the drawing modules (matplotlib) while the parent
 computes; it then forks a helper, which inherits them, and both take figures from one queue
 (whichever is free draws the next), so matplotlib is imported once and both CPUs draw once the
-parent is done.  Each plot stage's results (with those of the stages it depends on) are pickled
-to a temporary file as soon as they are complete and announced by a fixed-size record on a pipe
-(the parent never waits on the plotters).  Figures are written atomically, as by
+parent is done.  Each plot stage's results (those its figures read) are pickled to a temporary
+file as soon as they are complete and announced by a fixed-size record on a pipe (the parent
+never waits on the plotters).  Figures are written atomically, as by
 :func:`balancer.scene.plots.save_stage_plot`.
 
 ``python -m balancer run`` starts its plotting process first of all (:func:`start_early`, before
 the parent imports ``modal``), and the process imports only the parts of ``modal`` that drawing
 needs (:func:`_drawing_modal`): both CPUs then work from the start, the parent on the
 identification toolkit's imports and the stages, the plotting process on matplotlib's.
-:class:`Plotter` takes that process over when the run has plots, else forks its own.
+:class:`Plotter` takes that process over when the run has plots, else forks one the same way.
 
-This module imports only the standard library: it is loaded before anything else.
+This module imports only the standard library: it is loaded before anything else.  The drawing
+modules are imported in the plotting process, after the fork, and ``modal`` (whose package import
+loads the whole identification toolkit) only where a failure is reported.
 """
 from __future__ import annotations
 
+import gc
+import importlib.util
 import json
 import os
+import pickle
+import signal
 import sys
+import tempfile
+import threading
 from pathlib import Path
 from typing import Callable
 
@@ -74,8 +82,6 @@ def _read_report(fd: int) -> dict:
 def _fork_quietly() -> int:
     """``os.fork`` with the garbage collector's objects frozen around it, so that the child's collections
     do not write to (and copy) every page of the parent's objects."""
-    import gc
-
     sys.stdout.flush()
     sys.stderr.flush()
     gc.freeze()
@@ -107,13 +113,11 @@ def _report_and_exit(work: Callable[[], dict], report_write: int, helpers: list[
         os._exit(code)
 
 
-def _draw_jobs(jobs_read: int, folder: Path) -> dict:
-    """Take job records from the pipe until it is closed and draw each; {"drawn": {stage: paths}}, with
-    "error" naming the stage and the cause of the first failure (the later jobs are then only discarded)."""
-    import pickle
-
-    from balancer.scene.plots import save_stage_plot
-
+# --------------------------------------------------------------------------- the plotting process
+def _draw_jobs(jobs_read: int, folder: Path, save_stage_plot: Callable) -> dict:
+    """Take job records from the pipe until it is closed and draw each with ``save_stage_plot``;
+    {"drawn": {stage: paths}}, with "error" naming the stage and the cause of the first failure (the later
+    jobs are then only discarded)."""
     drawn: dict[str, list[str]] = {}
     error = None
     while True:
@@ -131,88 +135,54 @@ def _draw_jobs(jobs_read: int, folder: Path) -> dict:
             Path(job["file"]).unlink(missing_ok=True)
 
 
-def _serve(jobs_read: int, folder: Path, stages, helpers: list[int]) -> dict:
-    """The plotting process: import, fork the helper (its pid appended to ``helpers``, to be reaped after
-    the report), draw; the two reports merged."""
-    import gc
+def _drawing_modal() -> None:
+    """In a plotting process forked before ``modal`` was imported: make its submodules importable
+    without running ``modal/__init__``.
 
+    ``import modal`` loads the whole identification toolkit (scipy.special, scipy.linalg: some 0.2 s of a
+    scene run); drawing needs only a few of its submodules (the figures, the result classes it unpickles).
+    The package's module is made from its spec but not executed, so each ``modal.<submodule>`` this process
+    imports is loaded from the same files, and nothing else.  Only this process sees it; a name that
+    ``modal/__init__`` would have provided (``modal.identify``) is missing here, by design.
+    """
+    sys.modules["modal"] = importlib.util.module_from_spec(importlib.util.find_spec("modal"))
+
+
+def _plotting_process(jobs_read: int, helpers: list[int]) -> dict:
+    """The plotting process: imports, the run's setup record (folder and plot stages), then it forks the
+    helper (its pid appended to ``helpers``, to be reaped after the report) and both draw; the two reports
+    merged.  Nothing to do when the pipe closes before a setup (a run without plots, or a failed one)."""
     # a short-lived process that ends with os._exit: cyclic garbage (a drawn figure) need not be
     # collected, and not collecting saves ~7 % of the drawing
     gc.disable()
-    from balancer.scene import plots  # matplotlib, imported while the parent computes
+    if "modal" not in sys.modules:  # forked before the parent imported it (python -m balancer run)
+        _drawing_modal()
+    from . import plots  # matplotlib, imported while the parent computes
 
-    plots.preload(stages)  # and what drawing them imports: once, not in each drawing process
+    setup = _read_record(jobs_read)
+    if setup is None:
+        return {"drawn": {}}
+    folder = Path(setup["folder"])
+    plots.preload(setup["stages"])  # and what drawing them imports: once, not in each drawing process
     read, write = os.pipe()
     helper = _fork_quietly()
     if helper == 0:
         def drawer() -> dict:
             os.close(read)
-            return _draw_jobs(jobs_read, folder)
+            return _draw_jobs(jobs_read, folder, plots.save_stage_plot)
 
         _report_and_exit(drawer, write)
     os.close(write)
     helpers.append(helper)
-    mine = _draw_jobs(jobs_read, folder)
+    mine = _draw_jobs(jobs_read, folder, plots.save_stage_plot)
     theirs = _read_report(read)
     errors = [r["error"] for r in (mine, theirs) if "error" in r]
     return {"drawn": {**mine.get("drawn", {}), **theirs.get("drawn", {})},
             **({"error": "; ".join(errors)} if errors else {})}
 
 
-# --------------------------------------------------------------------------- started first of all
-#: the plotting process :func:`start_early` forked and no run has taken over yet: (pid, jobs pipe, report pipe)
-_early: tuple[int, int, int] | None = None
-
-
-def _drawing_modal() -> None:
-    """In the early plotting process: make ``modal`` importable without running its ``__init__``.
-
-    ``import modal`` loads the whole identification toolkit (scipy.special, scipy.linalg: some 0.2 s of a
-    scene run); drawing needs only a few of its submodules (the figures, the result classes it unpickles).
-    A package object with ``modal``'s path stands in for it, so each ``modal.<submodule>`` this process
-    imports is loaded from the same files, and nothing else.  Only this process sees it; a name that
-    ``modal/__init__`` would have provided (``modal.identify``) is missing here, by design.
-    """
-    import importlib.util
-    import types
-
-    spec = importlib.util.find_spec("modal")
-    package = types.ModuleType("modal", "modal's submodules, for drawing (balancer._plotter)")
-    package.__path__ = list(spec.submodule_search_locations)
-    package.__spec__ = spec
-    package.__file__ = spec.origin
-    sys.modules["modal"] = package
-
-
-def _early_plotter(jobs_read: int, helpers: list[int]) -> dict:
-    """The early plotting process: imports, then the run's setup record (folder and plot stages), then
-    :func:`_serve`; nothing to do when the pipe closes before a setup (a run without plots, or a failed one)."""
-    if "modal" not in sys.modules:  # forked before the parent imported it (python -m balancer run)
-        _drawing_modal()
-    import matplotlib.figure  # noqa: F401 - the bulk of drawing's imports, while the parent imports modal
-
-    setup = _read_record(jobs_read)
-    if setup is None:
-        return {"drawn": {}}
-    return _serve(jobs_read, Path(setup["folder"]), setup["stages"], helpers)
-
-
-def start_early() -> bool:
-    """Fork the plotting process now, before ``modal`` is imported (``python -m balancer run``); a later
-    :class:`Plotter` with more than one job takes it over, and :func:`dismiss_early` ends it if none does.
-    False (nothing started) where ``os.fork`` is missing, a thread is alive, or there is one CPU."""
-    import threading
-
-    global _early
-    if _early is not None or not hasattr(os, "fork") or threading.active_count() != 1 or (os.cpu_count() or 1) < 2:
-        return False
-    _early = _spawn(_early_plotter)
-    return True
-
-
-def _spawn(work: Callable[[int, list[int]], dict]) -> tuple[int, int, int]:
-    """Fork a plotting process that runs ``work(jobs_read, helpers)`` and reports; (pid, the write end of its
-    jobs pipe, the read end of its report pipe)."""
+def _spawn() -> tuple[int, int, int]:
+    """Fork a plotting process; (pid, the write end of its jobs pipe, the read end of its report pipe)."""
     jobs_read, jobs_write = os.pipe()
     report_read, report_write = os.pipe()
     pid = _fork_quietly()
@@ -220,16 +190,35 @@ def _spawn(work: Callable[[int, list[int]], dict]) -> tuple[int, int, int]:
         os.close(jobs_write)
         os.close(report_read)
         helpers: list[int] = []
-        _report_and_exit(lambda: work(jobs_read, helpers), report_write, helpers)
+        _report_and_exit(lambda: _plotting_process(jobs_read, helpers), report_write, helpers)
     os.close(jobs_read)
     os.close(report_write)
     return pid, jobs_write, report_read
 
 
+def _can_fork() -> bool:
+    """Forking is possible and safe: ``os.fork`` exists and no other thread is alive."""
+    return hasattr(os, "fork") and threading.active_count() == 1
+
+
+# --------------------------------------------------------------------------- started first of all
+#: the plotting process :func:`start_early` forked and no run has taken over yet: (pid, jobs pipe, report pipe)
+_early: tuple[int, int, int] | None = None
+
+
+def start_early() -> bool:
+    """Fork the plotting process now, before ``modal`` is imported (``python -m balancer run``); a later
+    :class:`Plotter` with more than one job takes it over, and :func:`dismiss_early` ends it if none does.
+    False (nothing started) where ``os.fork`` is missing, a thread is alive, or there is one CPU."""
+    global _early
+    if _early is not None or not _can_fork() or (os.cpu_count() or 1) < 2:
+        return False
+    _early = _spawn()
+    return True
+
+
 def dismiss_early() -> None:
     """End the early plotting process if no run took it over (it has drawn nothing: it is stopped at once)."""
-    import signal
-
     global _early
     if _early is None:
         return
@@ -263,8 +252,6 @@ class Plotter:
     """
 
     def __init__(self, jobs: int, folder: Path, stages=()):
-        import threading
-
         global _early
         self.folder = folder
         self.stages = list(stages)
@@ -274,14 +261,11 @@ class Plotter:
         if max(1, int(jobs)) < 2:
             return
         self.folder.mkdir(parents=True, exist_ok=True)
+        if _early is None and _can_fork():
+            _early = _spawn()
         if _early is not None:
-            self.pid, self._jobs, self._report = _early
-            _early = None
+            (self.pid, self._jobs, self._report), _early = _early, None
             _write_record(self._jobs, {"folder": str(self.folder), "stages": self.stages})
-        elif hasattr(os, "fork") and threading.active_count() == 1:
-            folder, stages = self.folder, self.stages
-            self.pid, self._jobs, self._report = _spawn(
-                lambda jobs_read, helpers: _serve(jobs_read, folder, stages, helpers))
 
     @property
     def started(self) -> bool:
@@ -289,9 +273,6 @@ class Plotter:
 
     def submit(self, stage: str, results: dict) -> bool:
         """Hand a stage's plot to the plotters; False if it stays with the parent."""
-        import pickle
-        import tempfile
-
         if not self.started:
             return False
         handle, payload = tempfile.mkstemp(prefix="modalbal-plot-", suffix=".pickle")
@@ -320,7 +301,7 @@ class Plotter:
         for paths in done.values():
             self._drawn.extend(paths)
         if "error" in report:
-            from modal.errors import PlotError
+            from modal.errors import PlotError  # here only: `import modal` loads the identification toolkit
 
             raise PlotError(report["error"])
         return done
