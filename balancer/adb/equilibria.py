@@ -26,6 +26,7 @@ import numpy as np
 
 from modal.errors import ParameterError
 
+from .._checks import finite_positive
 from ..solve1d import find_root
 from .equations import rotating_frame_jacobian, rotating_frame_rhs, rotating_state_size
 from .linear import CLASS_NAMES, eigen_analysis
@@ -166,7 +167,7 @@ def unbalanced_states(params: ADBParameters, speed_rad_s: float) -> list[tuple[n
     list of (ndarray, int)
         Rotating-frame state and ``p``, the number of balls on the deflection side.
     """
-    speed = _check_speed(speed_rad_s)
+    speed = finite_positive("speed_rad_s", speed_rad_s, "a finite number > 0 (rad/s)")
     Om = speed / params.natural_frequency_rad_s
     zeta, mu, eps = params.damping_ratio, params.mass_ratio, params.eccentricity_ratio
     P = complex(1.0 - Om**2, 2.0 * zeta * Om)
@@ -190,16 +191,6 @@ def unbalanced_states(params: ADBParameters, speed_rad_s: float) -> list[tuple[n
             state[2:2 + params.n] = np.angle(np.exp(1j * angles))
             found.append((state, p))
     return found
-
-
-def _check_speed(speed_rad_s) -> float:
-    try:
-        speed = float(speed_rad_s)
-    except (TypeError, ValueError) as exc:
-        raise ParameterError(f"speed_rad_s = {speed_rad_s!r}: expected a finite number > 0 (rad/s)") from exc
-    if not (math.isfinite(speed) and speed > 0.0):
-        raise ParameterError(f"speed_rad_s = {speed!r}: expected a finite number > 0 (rad/s)")
-    return speed
 
 
 @dataclass(frozen=True, slots=True)
@@ -272,7 +263,7 @@ def find_equilibria(params: ADBParameters, speed_rad_s: float, *, ball_angles_ra
     tuple of Equilibrium
         The balanced state first (if ``n m R >= M e`` and it exists), then the unbalanced ones.
     """
-    speed = _check_speed(speed_rad_s)
+    speed = finite_positive("speed_rad_s", speed_rad_s, "a finite number > 0 (rad/s)")
     entries: list[tuple[str, np.ndarray, int]] = []
     if params.can_balance and (params.n >= 2 or math.isclose(params.unbalance_ratio, 1.0, rel_tol=1e-12)):
         entries.append(("balanced", balanced_state(params, ball_angles_rad), -1))

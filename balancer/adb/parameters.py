@@ -17,6 +17,8 @@ import numpy as np
 
 from modal.errors import ParameterError
 
+from .._checks import count, parameter
+
 __all__ = [
     "ADBParameters",
     "ParameterStd",
@@ -40,35 +42,8 @@ _FIELD_MEANING = {
 }
 
 
-def _check_scalar(name: str, value: Any, *, positive: bool) -> float:
-    try:
-        number = float(value)
-    except (TypeError, ValueError) as exc:
-        raise ParameterError(
-            f"{name} ({_FIELD_MEANING[name]}) = {value!r}: expected a real number in {_FIELD_UNITS[name]}"
-        ) from exc
-    if not math.isfinite(number):
-        raise ParameterError(f"{name} ({_FIELD_MEANING[name]}) = {number!r}: expected a finite number")
-    if positive and not number > 0.0:
-        raise ParameterError(
-            f"{name} ({_FIELD_MEANING[name]}) = {number!r} {_FIELD_UNITS[name]}: expected > 0"
-        )
-    if not positive and number < 0.0:
-        raise ParameterError(
-            f"{name} ({_FIELD_MEANING[name]}) = {number!r} {_FIELD_UNITS[name]}: expected >= 0"
-        )
-    return number
-
-
-def _check_count(value: Any) -> int:
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
-        if isinstance(value, (float, np.floating)) and float(value).is_integer():
-            value = int(value)
-        else:
-            raise ParameterError(f"n (ball count) = {value!r}: expected an integer >= 1")
-    if int(value) < 1:
-        raise ParameterError(f"n (ball count) = {value!r}: expected an integer >= 1")
-    return int(value)
+#: how an error names each field: ``"k (support stiffness)"``
+_LABELS = {name: f"{name} ({meaning})" for name, meaning in _FIELD_MEANING.items()}
 
 
 @dataclass(frozen=True, slots=True)
@@ -118,10 +93,10 @@ class ADBParameters:
     def __post_init__(self) -> None:
         set_ = object.__setattr__
         for name in ("M", "m", "R", "k"):
-            set_(self, name, _check_scalar(name, getattr(self, name), positive=True))
+            set_(self, name, parameter(_LABELS[name], getattr(self, name), _FIELD_UNITS[name], positive=True))
         for name in ("e", "c", "D"):
-            set_(self, name, _check_scalar(name, getattr(self, name), positive=False))
-        set_(self, "n", _check_count(self.n))
+            set_(self, name, parameter(_LABELS[name], getattr(self, name), _FIELD_UNITS[name], positive=False))
+        set_(self, "n", count(_LABELS["n"], self.n))
 
     # ----------------------------------------------------------------- derived
     @property
@@ -234,8 +209,8 @@ class ADBParameters:
             Scales: rotor mass (kg), race radius (m), stiffness (N/m); the dynamics in
             nondimensional form do not depend on them.
         """
-        n = _check_count(n)
-        mu = _check_scalar("m", mass_ratio, positive=True)
+        n = count(_LABELS["n"], n)
+        mu = parameter(_LABELS["m"], mass_ratio, _FIELD_UNITS["m"], positive=True)
         if not n * mu < 1.0:
             raise ParameterError(f"mass_ratio = {mu!r} with n = {n}: expected n * mass_ratio < 1")
         m = mu * M / (1.0 - n * mu)
@@ -291,7 +266,7 @@ class ADBParameters:
         k = _pick(mode, "stiffness_n_per_m", channel)
         c = _pick(mode, "damping_n_s_per_m", channel)
         mass = _pick(mode, "mass_kg", channel)
-        n = _check_count(n)
+        n = count(_LABELS["n"], n)
         rotor_mass = mass - n * float(m) if mass_includes_balls else mass
         if mass_includes_balls and not rotor_mass > 0.0:
             raise ParameterError(

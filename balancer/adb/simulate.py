@@ -17,6 +17,7 @@ import numpy as np
 
 from modal.errors import ParameterError
 
+from .._checks import finite_positive
 from .analysis import classify_final_state, settling_time
 from .dop853 import dop853
 from .equations import fixed_to_rotating, rotating_to_fixed, scalar_rhs
@@ -132,16 +133,6 @@ class SimulationResult:
     rtol: float
     n_function_evaluations: int
     n_jacobian_evaluations: int
-
-
-def _check_time(t_end_s: float) -> float:
-    try:
-        value = float(t_end_s)
-    except (TypeError, ValueError) as exc:
-        raise ParameterError(f"t_end_s = {t_end_s!r}: expected a finite time > 0 s") from exc
-    if not (math.isfinite(value) and value > 0.0):
-        raise ParameterError(f"t_end_s = {value!r}: expected a finite time > 0 s")
-    return value
 
 
 def _initial_ball_angles(params: ADBParameters, angles) -> np.ndarray:
@@ -263,7 +254,7 @@ def simulate(
     """
     if not isinstance(params, ADBParameters):
         raise ParameterError(f"params: got {type(params).__name__}; expected ADBParameters")
-    t_end = _check_time(t_end_s)
+    t_end = finite_positive("t_end_s", t_end_s, "a finite time > 0 s")
     if not 0.0 < final_window_fraction <= 1.0:
         raise ParameterError(f"final_window_fraction = {final_window_fraction!r}: expected 0 < fraction <= 1")
     if not 0.0 < settle_tolerance < 1.0:
@@ -556,7 +547,7 @@ def simulate_batch(
     members = list(params)
     batch = ParameterBatch.from_parameters(members)
     n = batch.n
-    t_end = _check_time(t_end_s)
+    t_end = finite_positive("t_end_s", t_end_s, "a finite time > 0 s")
     profile = as_speed_profile(speed)
     speeds = check_profile(profile, t_end)
     frame = "rotating" if isinstance(profile, ConstantSpeed) else "fixed"

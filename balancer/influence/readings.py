@@ -25,6 +25,8 @@ import numpy as np
 
 from modal.errors import ParameterError
 
+from .._checks import finite_array
+
 __all__ = [
     "READING_UNITS",
     "MASS_UNITS",
@@ -77,17 +79,6 @@ def reading_unit(units: str, field: str = "units") -> ReadingUnit:
     return READING_UNITS[key]
 
 
-def _finite_array(values, field: str) -> np.ndarray:
-    try:
-        array = np.asarray(values, dtype=float)
-    except (TypeError, ValueError):
-        raise ParameterError(f"{field}: expected numbers, got {values!r}") from None
-    bad = np.flatnonzero(~np.isfinite(array.ravel()))
-    if bad.size:
-        raise ParameterError(f"{field}: entry {int(bad[0])} is {array.ravel()[bad[0]]}; expected a finite number")
-    return array
-
-
 def vibration(amplitude, phase_lag_deg, units: str, field: str = "reading") -> np.ndarray:
     """Readings (amplitude in ``units``, phase lag in degrees) as complex SI values.
 
@@ -108,8 +99,8 @@ def vibration(amplitude, phase_lag_deg, units: str, field: str = "reading") -> n
         ``amplitude * factor * exp(1j * radians(phase_lag_deg))`` in m, m/s or m/s^2.
     """
     unit = reading_unit(units)
-    a = _finite_array(amplitude, f"{field}.amplitude")
-    p = _finite_array(phase_lag_deg, f"{field}.phase_deg")
+    a = finite_array(amplitude, f"{field}.amplitude")
+    p = finite_array(phase_lag_deg, f"{field}.phase_deg")
     if a.shape != p.shape:
         raise ParameterError(f"{field}.amplitude: {a.size} amplitudes but {p.size} phases; expected one phase per amplitude")
     if np.any(a < 0):
@@ -131,9 +122,9 @@ def unbalance_kg_m(mass, radius_m, angle_deg, mass_units: str = "kg", field: str
     """
     if mass_units not in MASS_UNITS:
         raise ParameterError(f"{field}_units = {mass_units!r}: expected one of {', '.join(MASS_UNITS)}")
-    m = _finite_array(mass, f"{field}")
-    r = _finite_array(radius_m, "radius_m")
-    a = _finite_array(angle_deg, f"{field}.angle_deg")
+    m = finite_array(mass, f"{field}")
+    r = finite_array(radius_m, "radius_m")
+    a = finite_array(angle_deg, f"{field}.angle_deg")
     if np.any(r <= 0):
         raise ParameterError("radius_m: expected > 0")
     return m * MASS_UNITS[mass_units] * r * np.exp(1j * np.deg2rad(a))

@@ -10,13 +10,15 @@ come from an earlier stage are written as references:
 * ``"drive:speed"`` (rad/s) and ``"drive:stiffness"`` (N/m): the drive's hand-over to the
   rotor.
 
-This module imports only the standard library: the stage registry is built from it, and
-the plotting processes read that registry.
+This module imports only the standard library and balancer's argument checks: the stage
+registry is built from it, and the plotting processes read that registry.
 """
 from __future__ import annotations
 
 import re
 from dataclasses import dataclass
+
+from .._checks import scene_number
 
 __all__ = ["POS", "NONNEG", "NUM", "INT", "BOOL", "STR", "choice", "list_of", "ref_or", "complex_value",
            "Reference", "parse_reference", "IDENTIFIED_FIELDS", "DRIVE_FIELDS", "REFERENCE_STAGES"]
@@ -31,32 +33,16 @@ REFERENCE_STAGES = {"identified": "identify", "drive": "drive"}
 _REF = re.compile(r"^(identified):mode(\d+)\.(\w+)$|^(drive):(\w+)$")
 
 
-def _num(v, *, positive=False, nonneg=False):
-    if isinstance(v, bool) or not isinstance(v, (int, float)):
-        raise ValueError("a number")
-    try:
-        v = float(v)
-    except OverflowError:  # TOML integers may be arbitrarily long
-        raise ValueError("a finite number") from None
-    if v != v or v in (float("inf"), float("-inf")):
-        raise ValueError("a finite number")
-    if positive and v <= 0:
-        raise ValueError("a number > 0")
-    if nonneg and v < 0:
-        raise ValueError("a number >= 0")
-    return v
-
-
 def POS(v):
-    return _num(v, positive=True)
+    return scene_number(v, positive=True)
 
 
 def NONNEG(v):
-    return _num(v, nonneg=True)
+    return scene_number(v, nonneg=True)
 
 
 def NUM(v):
-    return _num(v)
+    return scene_number(v)
 
 
 def INT(v):
