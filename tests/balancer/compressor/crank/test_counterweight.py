@@ -1,9 +1,9 @@
-"""Slider-crank shaking forces and the exact counterweight optimum (issue 5).
+"""The exact counterweight optimum (balancer.compressor.crank.counterweight): seed 000 and seed 004,
+the curve of equal optima, other objectives, the grid search, results and bad arguments.
 
-Paper numbers come from seed 000 (hermetic compressor, Table 1 and the results
-table) and seed 004 (slider-crank, R = 35 mm, L = 140 mm), as decoded in
-``../shared/reference/crank_drive.md``.  Tolerances are half a unit in the last
-printed digit unless a comment says otherwise.
+Paper numbers come from seed 000 (hermetic compressor, Table 1 and the results table) and seed 004
+(slider-crank, R = 35 mm, L = 140 mm), as decoded in ``../shared/reference/crank_drive.md``.
+Tolerances are half a unit in the last printed digit unless a comment says otherwise.
 """
 from __future__ import annotations
 
@@ -16,12 +16,13 @@ import pytest
 from hypothesis import given, seed, settings
 from hypothesis import strategies as st
 
+from support.crank import mass_written_out, R_000_M, SPEED_000_RPM
+
 from balancer.compressor import crank
 from balancer.compressor.crank import (
+    counterweight_mass,
     PAPER_RULES,
     SliderCrank,
-    balance_fraction,
-    counterweight_mass,
     counterweight_on_curve,
     evaluate_balance_fraction,
     evaluate_counterweight,
@@ -31,171 +32,9 @@ from balancer.compressor.crank import (
     shaking_force,
     shaking_harmonics,
     shaking_objective,
-    slider_crank_from_components,
     two_mass_split,
 )
 from modal.errors import ParameterError
-
-SPEED_000_RPM = 2950.0
-R_000_M = 0.0119
-DEG_GRID = np.deg2rad(np.arange(360.0))  # the paper's 1 deg angle grid
-
-
-@pytest.fixture
-def seed000() -> SliderCrank:
-    # Table 1: m_A = 0.067, m_G = 0.044, m_B = 0.134 kg, a = 16.3 mm, l = 50 mm.
-    return slider_crank_from_components(
-        crank_radius_m=R_000_M, rod_length_m=0.050, rod_mass_kg=0.044,
-        rod_cg_to_crank_pin_m=0.0163, crank_pin_mass_kg=0.067, piston_mass_kg=0.134)
-
-
-@pytest.fixture
-def seed004() -> SliderCrank:
-    return SliderCrank(0.035, 0.140, 0.55, 1.13)
-
-
-def _mass(mech: SliderCrank, k: float) -> float:
-    # written out here rather than calling counterweight_mass, so the table
-    # test does not depend on the function it could be checking
-    return mech.rotating_mass_kg + k * mech.reciprocating_mass_kg
-
-
-def _second_derivative(fun, x, h=1e-3):
-    """Five-point central second difference (error O(h^4))."""
-    return (-fun(x + 2 * h) + 16 * fun(x + h) - 30 * fun(x) + 16 * fun(x - h)
-            - fun(x - 2 * h)) / (12 * h ** 2)
-
-
-# ----------------------------------------------------------------------------- model
-def test_two_mass_split_gives_the_exact_lumped_masses(seed000):
-    # m_rot = m_A + m_G b/l, m_rec = m_B + m_G a/l: exact arithmetic, so only
-    # rounding error (1e-15) separates them from 0.096656 and 0.148344 kg.
-    assert seed000.rotating_mass_kg == pytest.approx(0.096656, abs=1e-12)
-    assert seed000.reciprocating_mass_kg == pytest.approx(0.148344, abs=1e-12)
-    split = two_mass_split(0.140, 0.3, 0.140 / 3, crank_pin_mass_kg=0.35, piston_mass_kg=1.03,
-                           rod_inertia_about_cg_kg_m2=1e-3)
-    # seed 004 eqs. 6-7: m_tq = m2 + 2/3 m3 = 0.55, m_ct = m4 + 1/3 m3 = 1.13 kg.
-    assert split.rotating_mass_kg == pytest.approx(0.55, abs=1e-12)
-    assert split.reciprocating_mass_kg == pytest.approx(1.13, abs=1e-12)
-    assert split.rod_inertia_correction_kg_m2 == pytest.approx(
-        1e-3 - 0.3 * (0.14 / 3) * (0.28 / 3), rel=1e-12)
-
-
-def test_exact_piston_acceleration_matches_finite_differences():
-    # Independent check of the closed form: differentiate the piston position
-    # y = r cos(t) + sqrt(l^2 - r^2 sin^2 t) twice numerically with the 5-point
-    # stencil, h = 1e-3: truncation ~h^4 y^(6)/90 ~ 1e-15 m, rounding
-    # ~16 eps y / (12 h^2) ~ 3e-11 m; times omega^2 ~ 1.1e4 gives < 1e-6 N.
-    mech = SliderCrank(0.035, 0.080, 0.0, 1.0, harmonics="exact")
-    theta = np.linspace(0.1, 6.2, 50)
-
-    def y(t):
-        return 0.035 * np.cos(t) + np.sqrt(0.080 ** 2 - (0.035 * np.sin(t)) ** 2)
-
-    y_dd = _second_derivative(y, theta)
-    omega = 2 * math.pi * 1000 / 60
-    force = shaking_force(mech, 1000.0, theta)
-    # the shaking force of the piston is -m_rec * acceleration = -m_rec * omega^2 * y''
-    np.testing.assert_allclose(force.force_y_n, -omega ** 2 * y_dd, rtol=0, atol=1e-5)
-    np.testing.assert_array_equal(force.force_x_n, 0.0)
-
-
-def test_exact_rod_couple_matches_finite_differences():
-    # M_z = J_AB * rod angular acceleration, phi = asin(lam sin t): same check.
-    j_ab = -2.0487e-5
-    mech = SliderCrank(0.0119, 0.050, 0.1, 0.15, harmonics="exact",
-                       rod_inertia_correction_kg_m2=j_ab)
-    theta = np.linspace(0.05, 6.2, 40)
-
-    def phi(t):
-        return np.arcsin(0.238 * np.sin(t))
-
-    phi_dd = _second_derivative(phi, theta)
-    omega = 2 * math.pi * 2950 / 60
-    couple = shaking_force(mech, 2950.0, theta).couple_z_n_m
-    # rounding of the stencil: ~7e-11 rad/rad^2 times |J_AB| omega^2 ~ 2 -> 1e-9 N m
-    np.testing.assert_allclose(couple, j_ab * omega ** 2 * phi_dd, rtol=1e-8, atol=1e-9)
-
-
-def test_fourier_series_converges_to_the_exact_force():
-    # With the exact Fourier coefficients the only error is the dropped orders,
-    # which decay like lam^h: lam = 0.238, orders up to 14 leave < 0.238^16 ~ 1e-10.
-    exact = SliderCrank(0.0119, 0.050, 0.096656, 0.148344, harmonics="exact")
-    series = SliderCrank(0.0119, 0.050, 0.096656, 0.148344, harmonics=tuple(range(1, 15)),
-                         series="fourier")
-    theta = np.linspace(0, 2 * np.pi, 97)
-    a = shaking_force(exact, 2950.0, theta, 0.15, 0.011)
-    b = shaking_force(series, 2950.0, theta, 0.15, 0.011)
-    scale = 0.148344 * 0.0119 * (2 * math.pi * 2950 / 60) ** 2
-    np.testing.assert_allclose(b.force_y_n, a.force_y_n, atol=1e-9 * scale)
-    np.testing.assert_allclose(b.force_x_n, a.force_x_n, atol=1e-9 * scale)
-
-
-def test_leading_series_coefficients_are_the_leading_terms_of_the_fourier_ones():
-    # 2x coefficient: lam + lam^3/4 + 15 lam^5/128 + O(lam^7) (standard series);
-    # the papers' "leading" series keeps only lam.  lam = 0.1: O(lam^7) = 1e-7.
-    mech = SliderCrank(0.01, 0.1, 0.0, 1.0, harmonics=(2, 4, 6), series="fourier")
-    h = shaking_harmonics(mech, 60.0 / (2 * math.pi))  # omega = 1 rad/s
-    a2, a4, a6 = h.force_n[:, 1].real / 0.01
-    lam = 0.1
-    assert a2 == pytest.approx(lam + lam ** 3 / 4 + 15 * lam ** 5 / 128, abs=1e-7 * 5)
-    assert a4 == pytest.approx(-(lam ** 3 / 4 + 3 * lam ** 5 / 16), abs=1e-7 * 5)
-    assert a6 == pytest.approx(9 * lam ** 5 / 128, abs=1e-7)
-
-
-def test_harmonic_amplitudes_rebuild_the_time_signal(seed000):
-    # f(t) = Re(sum X_h exp(i h t)) must equal the direct evaluation (1x+2x is a
-    # trig polynomial, so the FFT is exact to rounding).
-    mc, rc = _mass(seed000, 0.6218), 0.011583
-    harm = shaking_harmonics(seed000, SPEED_000_RPM, mc, rc)
-    theta = np.linspace(0, 2 * np.pi, 73)
-    direct = shaking_force(seed000, SPEED_000_RPM, theta, mc, rc)
-    rebuilt = np.real(np.exp(1j * np.outer(theta, harm.orders)) @ harm.force_n)
-    np.testing.assert_allclose(rebuilt[:, 0], direct.force_x_n, atol=1e-9)
-    np.testing.assert_allclose(rebuilt[:, 1], direct.force_y_n, atol=1e-9)
-    # reference note section 2: 1x amplitudes 99.0 / 69.4 N, 2x F_y 40.1 N at the optimum
-    assert abs(harm.force_n[0, 0]) == pytest.approx(99.0, abs=0.05)
-    assert abs(harm.force_n[0, 1]) == pytest.approx(69.4, abs=0.05)
-    assert abs(harm.force_n[1, 1]) == pytest.approx(40.1, abs=0.05)
-
-
-# ----------------------------------------------------------------------------- seed 000
-def test_seed000_table_on_the_papers_one_degree_grid(seed000):
-    # The printed table has 4 decimals: agreement to 5e-5 N.
-    assert max_shaking_force(seed000, SPEED_000_RPM, crank_angles_rad=DEG_GRID) == pytest.approx(
-        318.3321, abs=5e-5)
-    assert max_shaking_force(seed000, SPEED_000_RPM, _mass(seed000, 1.0), R_000_M,
-                             crank_angles_rad=DEG_GRID) == pytest.approx(173.1739, abs=5e-5)
-    printed = {11.563: 109.8853, 11.573: 109.7050, 11.583: 109.5247, 11.593: 109.6591,
-               11.603: 109.8005}
-    for radius_mm, force_n in printed.items():
-        got = max_shaking_force(seed000, SPEED_000_RPM, _mass(seed000, 0.6218), radius_mm * 1e-3,
-                                crank_angles_rad=DEG_GRID)
-        assert got == pytest.approx(force_n, abs=5e-5), radius_mm
-
-
-def test_seed000_abstract_ratio_is_a_typo(seed000):
-    # The abstract's r_c/r = 0.9473 with k = 0.6218 gives 115.1 N (reference
-    # note, 1 decimal), 5.6 N above the table's own optimum 109.5247 N at
-    # r_c/r = 11.583/11.9 = 0.97336, so the abstract cannot be the table's point.
-    m_c = counterweight_mass(seed000, 0.6218)
-    abstract = max_shaking_force(seed000, SPEED_000_RPM, m_c, 0.9473 * R_000_M,
-                                 crank_angles_rad=DEG_GRID)
-    assert abstract == pytest.approx(115.1, abs=0.05)
-    assert abstract > 109.5247 + 5.0
-
-
-def test_exact_maximum_is_never_below_a_grid_maximum(seed000):
-    # The exact max over the revolution bounds every sampled max from above;
-    # the unbalanced and k = 1 peaks sit on grid angles (0 and 90 deg), so they agree.
-    for k, rc in ((0.6218, 0.011593), (0.6218, 0.011583), (0.3, 0.006)):
-        exact = max_shaking_force(seed000, SPEED_000_RPM, _mass(seed000, k), rc)
-        grid = max_shaking_force(seed000, SPEED_000_RPM, _mass(seed000, k), rc,
-                                 crank_angles_rad=DEG_GRID)
-        assert exact >= grid - 1e-9
-    assert max_shaking_force(seed000, SPEED_000_RPM) == pytest.approx(318.3321, abs=5e-5)
-    assert max_shaking_force(seed000, SPEED_000_RPM, _mass(seed000, 1.0),
-                             R_000_M) == pytest.approx(173.1739, abs=5e-5)
 
 
 def test_seed000_exact_optimum(seed000):
@@ -278,7 +117,7 @@ def test_naive_equal_at_0_and_90_deg_rule_is_worse(seed000):
 
 def test_exact_kinematics_move_the_answer_more_than_the_grid(seed000):
     exact = dataclasses.replace(seed000, harmonics="exact")
-    paper_point = max_shaking_force(exact, SPEED_000_RPM, _mass(exact, 0.6218), 0.011583)
+    paper_point = max_shaking_force(exact, SPEED_000_RPM, mass_written_out(exact, 0.6218), 0.011583)
     assert paper_point == pytest.approx(109.97, abs=5e-3)  # reference note, 2 decimals
     opt = optimal_counterweight(exact, SPEED_000_RPM)
     assert opt.balance_fraction == pytest.approx(0.5864, abs=5e-5)
@@ -344,13 +183,6 @@ def test_seed004_rules_and_optimum(seed004):
     assert PAPER_RULES == {"rotating": 0.0, "rotating_plus_half_reciprocating": 0.5}
 
 
-def test_balance_fraction_round_trip(seed004):
-    alpha = balance_fraction(seed004, 1.0, 0.035 * 0.9)
-    assert alpha == pytest.approx((0.9 - 0.55) / 1.13, rel=1e-12)
-    evaluation = evaluate_counterweight(seed004, 1000.0, 1.0, 0.035 * 0.9)
-    assert evaluation.balance_fraction == pytest.approx(alpha, rel=1e-12)
-
-
 # ----------------------------------------------------------------------------- grid search
 def test_grid_search_never_beats_the_exact_optimum(seed000):
     opt = optimal_counterweight(seed000, SPEED_000_RPM)
@@ -411,26 +243,6 @@ def test_results_are_frozen_and_archivable(seed000):
             result.speed_rpm = 1.0  # type: ignore[misc]
 
 
-# ----------------------------------------------------------------------------- bad input
-@pytest.mark.parametrize("kwargs, match", [
-    (dict(rotating_mass_kg=-0.1), "rotating_mass_kg = -0.1"),
-    (dict(reciprocating_mass_kg=-1), "reciprocating_mass_kg = -1"),
-    (dict(rod_length_m=0.01), "rod must be longer than the crank"),
-    (dict(crank_radius_m=0.0), "crank_radius_m = 0.0"),
-    (dict(crank_radius_m=float("nan")), "crank_radius_m = nan"),
-    (dict(harmonics=(1, 8)), "harmonics"),
-    (dict(harmonics="exactly"), "harmonics = 'exactly'"),
-    (dict(harmonics=(1.5,)), "harmonics"),
-    (dict(series="taylor"), "series = 'taylor'"),
-])
-def test_bad_mechanism_raises(kwargs, match):
-    args = dict(crank_radius_m=0.0119, rod_length_m=0.05, rotating_mass_kg=0.1,
-                reciprocating_mass_kg=0.15)
-    args.update(kwargs)
-    with pytest.raises(ParameterError, match=match):
-        SliderCrank(**args)
-
-
 def test_bad_call_arguments_raise(seed000):
     with pytest.raises(ParameterError, match=r"counterweight_radius_m = 0\.02.*r_c <= crank_radius_m"):
         max_shaking_force(seed000, 2950.0, 0.2, 0.02)
@@ -468,73 +280,3 @@ def test_bad_call_arguments_raise(seed000):
     with pytest.raises(ParameterError, match="rod_cg_to_crank_pin_m = 0.06"):
         two_mass_split(0.05, 0.044, 0.06)
     assert crank.OBJECTIVES == ("max", "rms", "max_x", "max_y")
-
-
-# ----------------------------------------------------------------------------- plots
-def test_plots_draw_the_computed_data_without_pyplot(seed000):
-    import inspect
-
-    from matplotlib.figure import Figure
-
-    from balancer.compressor import crank_plots
-
-    opt = optimal_counterweight(seed000, SPEED_000_RPM, n_curve_points=5)
-    light = counterweight_on_curve(seed000, opt)
-    fig = crank_plots.plot_force_vs_angle(seed000, SPEED_000_RPM, light.mass_kg, light.radius_m)
-    assert isinstance(fig, Figure)
-    resultant = fig.axes[0].lines[2].get_ydata()
-    # the drawn |F| never exceeds the exact peak, and reaches it at 0 deg
-    assert resultant.max() <= opt.max_force_n * (1 + 1e-12)
-    assert resultant[0] == pytest.approx(opt.max_force_n, rel=1e-9)
-
-    fig = crank_plots.plot_force_locus(seed000, SPEED_000_RPM, light.mass_kg, light.radius_m)
-    before, after = fig.axes[0].lines[:2]
-    assert np.hypot(before.get_xdata(), before.get_ydata()).max() == pytest.approx(
-        318.3321, abs=5e-5)
-    assert np.hypot(after.get_xdata(), after.get_ydata()).max() <= opt.max_force_n * (1 + 1e-12)
-
-    fig = crank_plots.plot_objective(seed000, SPEED_000_RPM, opt)
-    marker = fig.axes[0].lines[1]
-    assert marker.get_xdata()[0] == opt.balance_fraction
-    assert fig.axes[0].lines[0].get_ydata().min() >= opt.max_force_n
-
-    fig = crank_plots.plot_optimal_curve(opt)
-    np.testing.assert_allclose(fig.axes[0].lines[0].get_ydata(),
-                               opt.curve.counterweight_radius_m * 1e3)
-    # drawing on a caller's axes returns that axes' figure
-    own = Figure()
-    axes = own.add_subplot()
-    assert crank_plots.plot_optimal_curve(opt, ax=axes) is own
-    # the module never touches pyplot state
-    source = inspect.getsource(crank_plots)
-    assert "import matplotlib.pyplot" not in source and "plt." not in source
-
-
-def test_every_public_parameter_is_documented():
-    # numpydoc discipline (style guide 1.7 item 8), without a numpydoc dependency
-    import inspect
-    import re
-
-    from balancer.compressor import crank_plots, mounts
-
-    missing = []
-    for module in (crank, mounts, crank_plots):
-        for name in module.__all__:
-            obj = getattr(module, name)
-            if not callable(obj):
-                continue
-            doc = inspect.getdoc(obj) or ""
-            missing += [f"{module.__name__}.{name}({p})" for p in inspect.signature(obj).parameters
-                        if not re.search(rf"\b{p}\b", doc)]
-    assert missing == []
-
-
-@pytest.mark.parametrize("series", [None, "leading"])
-def test_objective_of_many_fractions_is_each_fractions_own(seed000, series):
-    # shaking_objective searches every fraction's peaks at once (one numpy call per zoom pass); the same
-    # grid and passes as one fraction at a time (the scalar path), so the same numbers to the last bit
-    mech = seed000 if series is None else dataclasses.replace(seed000, series=series)
-    alphas = np.linspace(-0.5, 1.0, 31)
-    together = shaking_objective(mech, SPEED_000_RPM, alphas)
-    alone = [shaking_objective(mech, SPEED_000_RPM, [a])[0] for a in alphas]
-    np.testing.assert_array_equal(together, alone)
