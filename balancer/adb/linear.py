@@ -142,8 +142,8 @@ def _perturbed_bound(scaled: np.ndarray, growth: np.ndarray, norm: np.ndarray, n
     """Ten times the largest change of the growth rate under rounding-size perturbations.
 
     The first-order bound ``kappa eps ||J||`` holds for a simple eigenvalue; where two
-    eigenvalues nearly coincide kappa grows without limit (stress finding 30: 4e16 at one
-    speed, which split a stable interval at a grid point), while the eigenvalues move only
+    eigenvalues nearly coincide kappa grows without limit (4e16 at one speed of a five-ball
+    rotor, which split a stable interval at a grid point), while the eigenvalues move only
     by about sqrt(eps ||J|| ||N||). Each trial adds a matrix of independent normal entries
     of standard deviation ``eps ||J||_F``, whose effect on a simple eigenvalue is of the
     size of the first-order bound and on a nearly defective one of the size of the square

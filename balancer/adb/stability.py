@@ -699,7 +699,7 @@ def threshold_sensitivity(params: ADBParameters, std: ParameterStd, speed_max_ra
         down = threshold(params.replace(**{name: max(value - step, 0.0)}))
         derivatives[name] = (up - down) / (value + step - max(value - step, 0.0))
     # g^T Σ g with the covariance of (k, c, M): identified from one mode they are strongly
-    # correlated (k and M nearly +1), which the independent sum ignored (issue 21)
+    # correlated (k and M nearly +1), which a sum of independent terms would ignore
     gradient = np.array([derivatives[name] for name in STD_ORDER])
     sigma = math.sqrt(max(float(gradient @ std.covariance @ gradient), 0.0))
     return ThresholdSensitivity(

@@ -1,4 +1,4 @@
-"""Stability verdicts of the balanced state without eigenvalues (issue 19, goal 3).
+"""Stability verdicts of the balanced state without eigenvalues.
 
 The balanced state's linearisation ``det(s^2 M0 + s C0 + K0)`` (nondimensional, see
 :func:`~balancer.adb.stability.linearised_matrices`) factors in closed form for any

@@ -111,3 +111,14 @@ def test_no_balancer_module_is_over_750_lines():
     long = {name: n for name, (path, _) in package_modules(ROOT, "balancer").items()
             if (n := len(path.read_text(encoding="utf-8").splitlines())) > 750}
     assert long == {}
+
+
+def test_no_project_bookkeeping_in_balancer_code_or_its_tests():
+    # comments say what the code does; issue, goal and finding numbers go stale
+    import re
+
+    pattern = re.compile(r"\b(issue|goal|finding)\s*#?\d+", re.IGNORECASE)
+    files = sorted((ROOT / "balancer").rglob("*.py")) + sorted((ROOT / "tests" / "balancer").rglob("*.py"))
+    found = [f"{path.relative_to(ROOT)}:{number}" for path in files
+             for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1) if pattern.search(line)]
+    assert found == []

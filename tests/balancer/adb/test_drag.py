@@ -88,7 +88,7 @@ def test_parameters_with_fluid_drag():
     assert oil.D == pytest.approx(3 * math.pi * 0.03 * 0.017 * 0.05**2, rel=1e-14)
     assert drag.regime == ("stokes",) and oil.replace(D=p.D) == p
     # 20 g steel balls (d = 17 mm) in light oil: beta = 0.0025, far below the reference's 0.20, so
-    # (finding 2) the balanced state becomes stable only at a higher speed
+    # (less drag, higher threshold: adb.md) the balanced state becomes stable only at a higher speed
     wn = p.natural_frequency_rad_s
     # beta = D / (m R^2 wn) = 3 pi mu d / (m wn) in the Stokes limit: 0.00245, derived (rounding only)
     assert oil.drag_ratio == pytest.approx(3 * math.pi * 0.03 * 0.017 / (0.02 * wn), rel=1e-12)

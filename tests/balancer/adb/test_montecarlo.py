@@ -1,4 +1,4 @@
-"""Ball-balancer parameter studies on Dask (issue 18, "beyond one file"): the probability of stable operation
+"""Ball-balancer parameter studies on Dask (balancer.adb.montecarlo): the probability of stable operation
 per speed from the identified standard errors of k, c, M (Monte-Carlo), and stability maps cut into chunks;
 the same numbers here and on a real Dask cluster (the session fixture ``dask_cluster``)."""
 from __future__ import annotations

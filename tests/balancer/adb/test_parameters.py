@@ -17,7 +17,7 @@ REFERENCE = dict(M=1.0, m=0.02, n=2, R=0.05, e=0.5e-3, k=1e4, c=20.0, D=1e-3)
 
 def test_reference_groups():
     p = ADBParameters(**REFERENCE)
-    # omega_n = sqrt(1e4 / 1.04) = 98.058 rad/s (issue); closed forms, so rounding only.
+    # omega_n = sqrt(1e4 / 1.04) = 98.058 rad/s (the reference case); closed forms, so rounding only.
     assert p.natural_frequency_rad_s == pytest.approx(98.058, abs=5e-4)
     assert p.total_mass_kg == pytest.approx(1.04, rel=1e-15)
     assert p.mass_ratio == pytest.approx(0.02 / 1.04, rel=1e-15)

@@ -1,4 +1,4 @@
-"""The stability threshold's standard error from identified k, c, M: covariance, checked by Monte Carlo (issue 21).
+"""The stability threshold's standard error from identified k, c, M: covariance, checked by Monte Carlo.
 
 k, c and M identified from one mode share ωn, ζ and the modal constant: k = ωn²/|A|,
 M = 1/|A|, c = 2ζωn/|A|. Their errors are strongly correlated (k and M nearly +1), and
@@ -80,7 +80,7 @@ def test_threshold_error_from_the_covariance_matches_monte_carlo():
     nominal, thresholds, correlated, independent, _ = _monte_carlo()
     z = (thresholds - nominal) / correlated
     # 200 seeds: the SD of 200 standard normals has standard error 1/sqrt(400) = 0.05; ±0.15 is 3 of
-    # those (the issue's calibration bound); the mean has standard error 0.071, |mean| <= 0.3 is 4.2
+    # those (the calibration bound the standard errors are held to); the mean has standard error 0.071, |mean| <= 0.3 is 4.2
     assert abs(np.std(z) - 1) <= 0.15, (np.std(z), np.mean(z))
     assert abs(np.mean(z)) <= 0.3, np.mean(z)
     # the independent sum overstates the threshold's error (the common 1/|A| of k and M cancels in

@@ -1,5 +1,5 @@
 """Stability verdicts from the closed-form characteristic polynomial and a vectorised Routh
-test (issue 19, goal 3) against the eigenvalue path."""
+test (balancer.adb.verdict) against the eigenvalue path."""
 from __future__ import annotations
 
 import numpy as np

@@ -1,5 +1,5 @@
 """The rotor without balls along a constant speed or a linear run-up: exact modal solution
-(issue 19 goal 4: the demo's comparison run without a second integration) against solve_ivp."""
+(the demo's comparison run, without a second integration) against solve_ivp."""
 from __future__ import annotations
 
 import importlib

@@ -5,7 +5,7 @@ from balancer.compressor import crank
 
 
 def test_every_public_parameter_is_documented():
-    # numpydoc discipline (style guide 1.7 item 8), without a numpydoc dependency
+    # numpydoc discipline, without a numpydoc dependency
     import inspect
     import re
 

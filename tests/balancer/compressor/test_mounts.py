@@ -1,4 +1,4 @@
-"""Six-degree-of-freedom compressor body on mounts (issue 5).
+"""Six-degree-of-freedom compressor body on mounts (balancer.compressor.mounts).
 
 Body and mount data are seed 000's Table 1 and mount table, with the mount
 layout read as a triangle below the CG (reference note ``crank_drive.md``

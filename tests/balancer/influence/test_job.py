@@ -1,11 +1,5 @@
-"""Balancing jobs as users write them: readings files, the `influence` command, the scene's [balance]."""
+"""Balancing jobs as users write them (balancer.influence.job): readings files, and the scene's [balance]."""
 from __future__ import annotations
-
-import json
-import os
-import subprocess
-import sys
-from pathlib import Path
 
 import h5py
 import numpy as np
@@ -14,9 +8,7 @@ import pytest
 from balancer.influence.job import balance, load_job, parse_job
 from modal.errors import FormatError, ParameterError, SceneError
 
-from support.paths import ROOT  # noqa: E402
-READINGS = ROOT / "data" / "synthetic" / "balance_readings.toml"
-STUDY_SCENE = ROOT / "data" / "synthetic" / "balance_scene.toml"
+from support.balancing import READINGS, inline_scene
 
 
 def test_bundled_readings_give_the_rotor_unbalance_back():
@@ -76,41 +68,6 @@ def test_unreadable_readings_file(tmp_path):
         load_job(tmp_path / "bad.toml")
 
 
-def run_cli(*args, cwd=ROOT):
-    env = dict(os.environ, PYTHONPATH=str(ROOT), MPLBACKEND="Agg")
-    return subprocess.run([sys.executable, "-m", "balancer", *args], capture_output=True, text=True, cwd=cwd, env=env,
-                          timeout=120)
-
-
-def test_influence_command_line(tmp_path):
-    out = run_cli("influence", str(READINGS), "--method", "minmax", "--grade", "2.5", "--rotor-mass", "100",
-                  "--speed-rpm", "3000", "--holes", "8", "--json")
-    assert out.returncode == 0, out.stderr
-    doc = json.loads(out.stdout)
-    assert doc["method"] == "minmax" and doc["mass_units"] == "g" and len(doc["correction"]) == 2
-    assert doc["iso"]["verdict"] in ("pass", "fail") and len(doc["iso"]["permissible_per_plane_kg_m"]) == 2
-    assert doc["iso"]["permissible_unbalance_kg_m"] == pytest.approx(2.5e-3 * 100 / (3000 * np.pi / 30), rel=1e-12)
-    assert all(len(row) <= 2 for row in doc["split"])
-    ls = json.loads(run_cli("influence", str(READINGS), "--json").stdout)
-    assert doc["worst_residual"] <= ls["worst_residual"] * (1 + 1e-9)
-    text = run_cli("influence", str(READINGS))
-    assert text.returncode == 0 and "plane 1:" in text.stdout and "condition number" in text.stdout
-    (tmp_path / "bad.toml").write_text(READINGS.read_text().replace("units = \"um\"", "units = \"furlong\""))
-    bad = run_cli("influence", str(tmp_path / "bad.toml"))
-    assert bad.returncode == 1 and bad.stderr.count("\n") == 1 and "units" in bad.stderr and "bad.toml" in bad.stderr
-    assert run_cli("influence").returncode == 2
-
-
-def inline_scene(tmp_path, **extra):
-    import tomllib
-
-    job = tomllib.loads(READINGS.read_text())
-    section = {**job, "method": "minmax", "holes": 12,
-               "iso": {"grade_mm_s": 2.5, "rotor_mass_kg": 100.0, "speed_rpm": 3000.0, "distances_m": [0.4, 0.6]}, **extra}
-    return {"scene": {"name": "inline"}, "balance": section,
-            "outputs": {"tables": ["balance"], "plots": ["balance"], "archive": True}}
-
-
 def test_scene_balance_section_inline(tmp_path):
     import balancer
 
@@ -133,33 +90,6 @@ def test_scene_balance_section_inline(tmp_path):
     assert again.stages["balance"] == "reused"
 
 
-def test_balance_plot_draws_the_report(tmp_path):
-    """What the polar plot draws: the readings, the prediction and the corrections of the report."""
-    import balancer
-    from balancer.influence.plots import plot_balance
-
-    report = balancer.run_scene(inline_scene(tmp_path)).results["balance"].report
-    figure = plot_balance(report)
-    ax_v, ax_m = figure.axes[:2]
-    for values, style in ((report.initial, "-"), (report.residual, "--")):
-        amplitude, phase = report.in_user_units(values)
-        arrows = [line for line in ax_v.get_lines() if line.get_linestyle() == style]
-        assert len(arrows) == len(report.sensors)
-        for line, a, p in zip(arrows, amplitude, phase):  # from the origin to (phase lag, amplitude)
-            np.testing.assert_allclose(line.get_xdata(), [0, np.deg2rad(p)])
-            np.testing.assert_allclose(line.get_ydata(), [0, a])
-    markers = [line for line in ax_v.get_lines() if line.get_label().startswith("trial plane")]
-    assert len(markers) == len(report.trial_runs)
-    for line, run in zip(markers, report.trial_runs):
-        np.testing.assert_allclose(line.get_ydata(), report.in_user_units(run)[0])
-    scale = 1e3 if report.mass_units == "g" else 1.0
-    heads = [(text.xy[0], text.xy[1]) for text in ax_m.texts]
-    np.testing.assert_allclose(heads, np.column_stack([np.deg2rad(report.correction_angle_deg),
-                                                       report.correction_mass_kg * scale]))
-    assert ax_m.get_ylim() == pytest.approx((0.0, 1.2 * report.correction_mass_kg.max() * scale))
-    assert report.reading_units in ax_v.get_title() and report.mass_units in ax_m.get_title()
-
-
 def test_scene_balance_errors_before_any_work(tmp_path):
     import balancer
 
@@ -170,18 +100,3 @@ def test_scene_balance_errors_before_any_work(tmp_path):
     scene = inline_scene(tmp_path, method="median")
     with pytest.raises(SceneError, match="balance.method"):
         balancer.run_scene(scene)
-
-
-def test_bundled_study_scene(tmp_path):
-    """Identified k, c, M predict alpha within the identification error; both methods cut the vibration
-    by an order of magnitude at 5 % reading noise; the ideal ball balancer does better still."""
-    import balancer
-
-    run = balancer.run_scene(STUDY_SCENE, out=tmp_path / "s.h5", plots_dir=tmp_path / "p")
-    study = run.results["balance"].study
-    assert np.all(study.alpha_model_error < 0.02)  # k, c, M identified to < 1 % (their standard errors)
-    for left in (study.amplitude_least_squares_m, study.amplitude_minmax_m, study.amplitude_model_only_m):
-        assert np.all(left < 0.2 * study.amplitude_before_m)
-    assert study.minmax.worst_residual <= study.least_squares.worst_residual
-    assert study.adb_speed_rad_s == 250.0 and study.adb_residual_amplitude_m < study.amplitude_minmax_m[-1]
-    assert {p.name for p in (tmp_path / "p").iterdir()} == {"balance_polar.png", "balance_comparison.png"}

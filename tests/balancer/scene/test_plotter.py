@@ -1,4 +1,4 @@
-"""Plots drawn in a forked child while the scene runs on (issue 19 goal 4).
+"""Plots drawn by forked plotting processes while the scene runs on (balancer.scene.plotter).
 
 Each case runs in a fresh interpreter: the test process may have threads alive (Dask
 clients of other tests), and run_scene then rightly declines to fork.

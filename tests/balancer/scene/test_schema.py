@@ -1,0 +1,67 @@
+"""Scene files checked before any work (balancer.scene.schema): every bad scene gets one clear error."""
+import copy
+
+import pytest
+
+from balancer import run_scene
+
+from modal.errors import SceneError
+from support.scenes import SYNTH_FRF, ROTOR, ADB, COMPRESSOR
+
+
+BAD_SCENES = [
+    ({"outputs": {"tables": ["compressor"]}, "compresor": {}}, "unknown key 'compresor'"),
+    ({"outputs": {"tables": ["compressor"]}, "compressor": {**COMPRESSOR, "spead_rpm": 1}}, "unknown key 'compressor.spead_rpm'"),
+    ({"outputs": {"tables": ["compressor"]}, "compressor": {k: v for k, v in COMPRESSOR.items() if k != "speed_rpm"}},
+     "'compressor.speed_rpm' is missing"),
+    ({"outputs": {"tables": ["compressor"]}, "compressor": {**COMPRESSOR, "speed_rpm": "2950 rpm"}},
+     "'compressor.speed_rpm' = '2950 rpm': expected a number"),
+    ({"outputs": {"tables": ["compressor"]}, "compressor": {**COMPRESSOR, "rotating_mass_kg": -1.0}}, "expected a number >= 0"),
+    ({"outputs": {"tables": ["compressor"]}, "compressor": {**COMPRESSOR, "speed_rpm": True}}, "expected a number"),
+    ({"outputs": {"tables": ["compresor"]}, "compressor": COMPRESSOR}, "'outputs.tables'"),
+    ({"outputs": {}}, "outputs"),
+    ({"compressor": COMPRESSOR}, "'outputs' is missing"),
+    ({"outputs": {"tables": ["adb_stability"]}, "rotor": ROTOR}, "needs section [adb]"),
+    ({"outputs": {"tables": ["adb_stability"]}, "rotor": ROTOR, "adb": ADB}, "refers to stage 'identify'"),
+    ({"outputs": {"tables": ["adb_stability"]}, "frf": SYNTH_FRF, "adb": ADB,
+      "rotor": {**ROTOR, "k": "identified:mode1.stifness"}}, "identified field"),
+    ({"outputs": {"tables": ["adb_stability"]}, "frf": SYNTH_FRF, "adb": ADB, "rotor": {**ROTOR, "k": "measured:k"}},
+     "reference like"),
+    ({"outputs": {"tables": ["adb_stability"]}, "frf": SYNTH_FRF, "adb": ADB, "rotor": {**ROTOR, "M": "drive:speed"}},
+     "reference to identified"),
+    ({"outputs": {"tables": ["identify"]}, "frf": {"file": "x.csv", **SYNTH_FRF}}, "both 'file' and 'synthetic'"),
+    ({"outputs": {"tables": ["identify"]}, "frf": {"kind": "mobility"}}, "needs 'file'"),
+    ({"outputs": {"tables": ["identify"]}, "frf": {"file": "missing.csv"}}, "missing.csv"),
+    ({"outputs": {"tables": ["adb_stability"]}, "frf": SYNTH_FRF, "adb": ADB, "rotor": {**ROTOR, "k": "identified:mode7.stiffness"}},
+     "found 2 mode(s), expected at least 7"),
+    ({"outputs": {"tables": ["adb_stability"]}, "frf": SYNTH_FRF, "identify": {"channel": 3}, "adb": ADB, "rotor": ROTOR},
+     "'identify.channel' = 3"),
+    ({"outputs": {"tables": ["adb_stability"]}, "frf": SYNTH_FRF, "adb": {**ADB, "m": 0.0001}, "rotor": ROTOR},
+     "cannot balance"),
+    ({"outputs": {"tables": ["identify"]}, "frf": {"synthetic": {**SYNTH_FRF["synthetic"], "damping_ratio": [0.05]}}},
+     "one per natural frequency"),
+    ({"outputs": {"tables": ["mounts"]}, "compressor": COMPRESSOR}, "needs section [compressor.body]"),
+]
+
+
+@pytest.mark.parametrize("config, message", BAD_SCENES, ids=[m[:30] for _, m in BAD_SCENES])
+def test_bad_scenes_give_one_clear_error(tmp_path, config, message):
+    path = tmp_path / "bad.toml"
+    import tomllib  # noqa: F401  (the dict form and the file form go through the same validation)
+
+    with pytest.raises(SceneError) as info:
+        from balancer.scene.schema import parse_scene
+
+        run_scene(parse_scene(copy.deepcopy(config), source=str(path), folder=tmp_path), out=tmp_path / "o.h5")
+    text = str(info.value)
+    assert message in text, text
+    assert text.startswith(str(path)) and "\n" not in text
+
+
+def test_invalid_toml_and_missing_scene(tmp_path):
+    path = tmp_path / "broken.toml"
+    path.write_text("[compressor\nspeed_rpm = 1\n")
+    with pytest.raises(SceneError, match="broken.toml: not valid TOML"):
+        run_scene(path)
+    with pytest.raises(SceneError, match="no such scene file"):
+        run_scene(tmp_path / "none.toml")
