@@ -206,7 +206,8 @@ def goal3(runs: int) -> dict:
 
 
 # --------------------------------------------------------------------------- goal 4
-FLOOR = "import numpy, scipy, h5py, matplotlib, modal, balancer"
+#: what the demo imports (scipy.integrate and scipy.optimize: its run-up and its roots and minimum)
+FLOOR = "import numpy, scipy, scipy.integrate, scipy.optimize, h5py, matplotlib, modal, balancer"
 
 
 def goal4(runs: int) -> dict:

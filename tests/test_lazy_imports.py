@@ -1,4 +1,4 @@
-"""What a run does not use is not imported (issue 19 goal 4)."""
+"""What a run does not use is not imported."""
 from __future__ import annotations
 
 import json
@@ -40,24 +40,3 @@ def test_the_scene_runner_imports_the_solvers_only_when_a_stage_needs_them():
     loaded = _modules_after("import balancer.cli, balancer.scene.runner, balancer.scene.plots")
     assert not any(loaded[m] for m in ("scipy.optimize", "scipy.integrate", "scipy.linalg"))
     assert not loaded["h5py"]  # only the parent writes the archive, after the fork
-    # a non-stiff simulation runs DOP853 in balancer.adb.dop853: no scipy.integrate (whose package
-    # import loads scipy.optimize too); the stiff methods still use solve_ivp
-    loaded = _modules_after("from balancer.adb import ADBParameters, simulate\n"
-                            "simulate(ADBParameters(M=1.0, m=0.02, n=2, R=0.05, e=5e-4, k=1e4, c=20.0, D=1e-3), 150.0,"
-                            " 0.05)")
-    assert not loaded["scipy.integrate"] and not loaded["scipy.optimize"]
-    assert _modules_after("from balancer.adb import ADBParameters, simulate\n"
-                          "simulate(ADBParameters(M=1.0, m=0.02, n=2, R=0.05, e=5e-4, k=1e4, c=20.0, D=1e-3), 150.0,"
-                          " 0.05, method='LSODA')")["scipy.integrate"] is True
-
-
-def test_the_demo_scene_stages_need_no_scipy_solver_module():
-    # the demo's three roots and one bounded minimum run in balancer.solve1d, its run-up in
-    # balancer.adb.dop853, the mounts' 6 x 6 generalised eigenproblem in numpy: together ~0.15-0.25 s
-    # of imports the demo no longer pays
-    loaded = _modules_after(f"from balancer.scene import run_scene\n"
-                            f"import tempfile, pathlib\n"
-                            f"scene = pathlib.Path({str(ROOT)!r}) / 'data' / 'synthetic' / 'demo_scene.toml'\n"
-                            f"with tempfile.TemporaryDirectory() as d:\n"
-                            f"    run_scene(scene, out=pathlib.Path(d) / 'demo.h5', plot_jobs=2)")
-    assert not any(loaded[m] for m in ("scipy.optimize", "scipy.integrate", "scipy.linalg"))

@@ -27,7 +27,6 @@ import numpy as np
 from modal.errors import ParameterError
 
 from .._checks import finite_positive
-from ..solve1d import find_root
 from .equations import rotating_frame_jacobian, rotating_frame_rhs, rotating_state_size
 from .linear import CLASS_NAMES, eigen_analysis
 from .parameters import ADBParameters, ParameterBatch
@@ -68,7 +67,9 @@ def symmetric_spacing_rad(n: int, unbalance_ratio: float) -> float:
     def kernel(delta: float) -> float:
         return math.sin(n * delta / 2.0) / math.sin(delta / 2.0) - a
 
-    return find_root(kernel, 1e-12, 2.0 * math.pi / n, xtol=1e-15, rtol=4 * np.finfo(float).eps)
+    from scipy.optimize import brentq  # imported when used: a plotting process unpickles this package's results
+
+    return brentq(kernel, 1e-12, 2.0 * math.pi / n, xtol=1e-15, rtol=4 * np.finfo(float).eps)
 
 
 def balanced_ball_angles(params: ADBParameters, free_angles_rad=None) -> np.ndarray:

@@ -3,9 +3,7 @@
 * The integrator is chosen by stiffness: DOP853 (explicit, 8th order) unless the ball
   drag rate ``D / (m R^2)`` exceeds ``STIFFNESS_RATIO`` times the fastest dynamic rate
   ``max(omega_n, |omega|)``; then LSODA with the exact (complex-step) Jacobian,
-  banded for stacked batches.  DOP853 runs in :func:`.dop853.dop853` (SciPy's method and
-  arithmetic in one lean loop, without importing ``scipy.integrate``); the stiff methods
-  in ``solve_ivp``.
+  banded for stacked batches.
 * A batch of parameter sets is one stacked ``solve_ivp`` system.  Because ``solve_ivp``
   controls an RMS norm over all components, the tolerances are divided by ``sqrt(B)``,
   which bounds every member's local error estimate by the single-run tolerance.
@@ -22,7 +20,6 @@ import numpy as np
 
 from modal.errors import ParameterError
 
-from .dop853 import dop853
 from .equations import (
     fixed_frame_jacobian,
     fixed_frame_rhs,
@@ -219,13 +216,10 @@ def integrate(
         options["jac"] = jac
         if chosen == "LSODA" and batch.size > 1:
             options["lband"] = options["uband"] = size - 1
-    if chosen == "DOP853":  # the lean loop: no scipy.integrate (nor the scipy.optimize it imports)
-        solution = dop853(fun, (times[0], times[-1]), y0.reshape(-1), times, rtol=rtol_eff, atol=atol_eff)
-    else:
-        from scipy.integrate import solve_ivp  # scipy.integrate only for the stiff methods
+    from scipy.integrate import solve_ivp  # imported when used: a plotting process unpickles these results
 
-        solution = solve_ivp(fun, (times[0], times[-1]), y0.reshape(-1), method=chosen, t_eval=times,
-                             rtol=rtol_eff, atol=atol_eff, **options)
+    solution = solve_ivp(fun, (times[0], times[-1]), y0.reshape(-1), method=chosen, t_eval=times,
+                         rtol=rtol_eff, atol=atol_eff, **options)
     if solution.status != 0:
         raise ParameterError(f"integration failed ({chosen}): {solution.message}")
     states = solution.y.reshape(batch.size, size, -1).transpose(0, 2, 1)

@@ -19,7 +19,6 @@ from modal.errors import ParameterError
 
 from .._checks import finite_positive
 from .analysis import classify_final_state, settling_time
-from .dop853 import dop853
 from .equations import fixed_to_rotating, rotating_to_fixed, scalar_rhs
 from .equilibria import balanced_ball_angles
 from .integrate import IntegrationResult, _absolute_tolerances, integrate
@@ -331,8 +330,10 @@ def _integrate_clamped_then_free(params, profile, y0, times, release, frame, met
     max_speed = float(np.max(np.abs(profile.speed_rad_s(times)))) if not constant else abs(profile.speed)
     atol = _absolute_tolerances(batch, rtol, max_speed, frame == "fixed")
     before = times[times <= release]
-    first = dop853(fun, (times[0], release), y0, np.append(before, release) if before[-1] < release else before,
-                   rtol=rtol, atol=atol)
+    from scipy.integrate import solve_ivp  # imported when used: a plotting process unpickles these results
+
+    first = solve_ivp(fun, (times[0], release), y0, method="DOP853",
+                      t_eval=np.append(before, release) if before[-1] < release else before, rtol=rtol, atol=atol)
     if first.status != 0:
         raise ParameterError(f"integration with clamped balls failed: {first.message}")
     after = times[times > release]
@@ -429,7 +430,7 @@ def _without_balls(params, profile, frame, position, velocity, speed0, times, rt
     """The same rotor (mass M) with the balls removed: the n = 0 case of the equations.
 
     Along a constant speed or a linear run-up the response is the exact modal solution
-    (:func:`_without_balls_exact`); otherwise DOP853 (:func:`.dop853.dop853`).
+    (:func:`_without_balls_exact`); otherwise DOP853 (:func:`scipy.integrate.solve_ivp`).
     """
     if isinstance(profile, (ConstantSpeed, LinearRunUp)):
         exact = _without_balls_exact(params, profile, position, velocity, times)
@@ -454,7 +455,9 @@ def _without_balls(params, profile, frame, position, velocity, speed0, times, rt
 
         def fun(t, y):
             return bare(y, float(profile.speed_rad_s(t)), float(profile.acceleration_rad_s2(t)))
-    solution = dop853(fun, (times[0], times[-1]), y0, times, rtol=rtol, atol=atol)
+    from scipy.integrate import solve_ivp
+
+    solution = solve_ivp(fun, (times[0], times[-1]), y0, method="DOP853", t_eval=times, rtol=rtol, atol=atol)
     if solution.status != 0:
         raise ParameterError(f"integration without balls failed: {solution.message}")
     states = solution.y.T

@@ -14,7 +14,6 @@ import numpy as np
 
 from modal.errors import ParameterError
 
-from ..solve1d import find_root
 from .equilibria import balanced_state
 from .linear import CLASS_NAMES, STABLE, EigenAnalysis, eigen_analysis_nondimensional
 from .parameters import STD_ORDER, ADBParameters, ParameterStd
@@ -250,7 +249,7 @@ def stable_speed_intervals(
     The speed range is scanned on a uniform grid (Routh verdicts as in :func:`stability_map`
     with ``margin=False``; batched eigenvalues for ``n = 1``); every change of sign of the
     largest real part (an eigenvalue problem per evaluation) is then refined by Brent's method
-    (:func:`balancer.solve1d.find_root`).  Intervals narrower than the grid spacing can be
+    (:func:`scipy.optimize.brentq`).  Intervals narrower than the grid spacing can be
     missed: raise ``grid_points`` if in doubt.
 
     Parameters
@@ -285,6 +284,8 @@ def stable_speed_intervals(
     stable = _stable_on_grid(params, speeds, angles)
     wn = params.natural_frequency_rad_s
 
+    from scipy.optimize import brentq  # imported when used: a plotting process unpickles this package's results
+
     def growth(speed: float) -> float:
         return float(_analyse_balanced([params], np.array([speed]), [angles]).max_real_part_per_s[0])
 
@@ -294,7 +295,7 @@ def stable_speed_intervals(
         low, high = speeds[index], speeds[index + 1]
         if growth(low) * growth(high) > 0.0:
             return high if stable[index + 1] else low
-        return find_root(growth, low, high, xtol=xtol_ratio * wn, rtol=4 * np.finfo(float).eps)
+        return brentq(growth, low, high, xtol=xtol_ratio * wn, rtol=4 * np.finfo(float).eps)
 
     intervals = []
     start = speeds[0] if stable[0] else None

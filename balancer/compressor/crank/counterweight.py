@@ -11,7 +11,6 @@ from modal.errors import ParameterError
 
 from .forces import _check_objective, _objective_value, _refined_max
 from ..._checks import bounded
-from ...solve1d import find_root, minimize_bounded
 from .model import (
     PAPER_RULES,
     Objective,
@@ -246,7 +245,7 @@ def optimal_counterweight(mech: SliderCrank, speed_rpm: float, objective: Object
     ``-m_rot/m_rec <= alpha <= 1``.  The convex objective is minimised by
     bounded Brent (inner maxima refined to 1e-10 rad); for ``"max"`` the
     result is then polished by solving the equal-peak condition with
-    Brent's root finder when two peaks are active (:mod:`balancer.solve1d`).
+    Brent's root finder when two peaks are active (:func:`scipy.optimize.brentq`).
 
     Parameters
     ----------
@@ -273,8 +272,12 @@ def optimal_counterweight(mech: SliderCrank, speed_rpm: float, objective: Object
     def phi(alpha: float) -> float:
         return _objective_value(mech, omega, (m_rot + alpha * m_rec) * r, objective)
 
+    from scipy.optimize import minimize_scalar  # imported when used: a plotting process unpickles these results
+
     # For "max" a coarse bracket suffices: the equal-peak root polishes it.
-    alpha, method = minimize_bounded(phi, lower, upper, xatol=1e-7 if objective == "max" else 1e-10), "bounded Brent"
+    found = minimize_scalar(phi, bounds=(lower, upper), method="bounded",
+                            options={"xatol": 1e-7 if objective == "max" else 1e-10, "maxiter": 500})
+    alpha, method = float(found.x), "bounded Brent"
     # Compare with the bounds: the bounded method never evaluates them.
     for bound in (lower, upper):
         if phi(bound) < phi(alpha):
@@ -322,8 +325,9 @@ def _polish_equal_peak(mech: SliderCrank, omega: float, alpha: float, lower: flo
         lo, hi = max(lower, alpha - step), min(upper, alpha + step)
         g_lo, g_hi = gap(lo), gap(hi)
         if g_lo * g_hi < 0:
-            return find_root(gap, lo, hi, xtol=1e-15, rtol=4 * np.finfo(float).eps), \
-                "equal-peak root"
+            from scipy.optimize import brentq
+
+            return brentq(gap, lo, hi, xtol=1e-15, rtol=4 * np.finfo(float).eps), "equal-peak root"
         step *= 4.0
     return alpha, method
 
