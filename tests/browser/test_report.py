@@ -69,6 +69,17 @@ def test_the_mode_selector_changes_the_shape_shown(opened):
     assert opened.errors == []
 
 
+def test_a_mode_chosen_while_paused_is_shown_at_its_largest_deflection(opened):
+    page = opened.page
+    page.click("#shape-play")
+    opened.wait_until("!window.modalReport.playing")
+    page.select_option("#shape-mode", "1")
+    # phase 0 draws the normalised shape's real part, its largest deflection: a paused picture
+    # taken for a slide never shows the structure caught at rest mid-cycle
+    opened.wait_until("window.modalReport.phase === 0")
+    assert opened.errors == []
+
+
 def test_the_animation_advances(opened):
     page = opened.page
     frames, picture = page.evaluate("window.modalReport.frames"), opened.canvas("shape-canvas")

@@ -242,6 +242,7 @@
   ShapeView.prototype.use = function (r, m) {
     var s = data.shapes[r]; this.s = s; this.mode = s.modes[m];
     state.result = r; state.mode = m;
+    this.phase = 0;  // a mode shown anew starts at its largest deflection (the shape's real part)
     var n = s.nodes.length / 3, lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
     for (var i = 0; i < n; i++) for (var a = 0; a < 3; a++) { lo[a] = Math.min(lo[a], s.nodes[3 * i + a]); hi[a] = Math.max(hi[a], s.nodes[3 * i + a]); }
     this.centre = [0, 1, 2].map(function (a) { return (lo[a] + hi[a]) / 2; });
