@@ -8,7 +8,10 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
+
+from .fitproc import DEFAULT_FILE_TIMEOUT_S
 
 __all__ = ["add_batch_parser", "run_batch"]
 
@@ -33,6 +36,10 @@ def add_batch_parser(sub, add_fit_options) -> argparse.ArgumentParser:
                        help="address of a running Dask scheduler (workers need this package installed and the "
                             "files at the same paths); default: a local cluster")
     batch.add_argument("--workers", type=int, metavar="N", help="local cluster: worker processes (default: the cores)")
+    batch.add_argument("--file-timeout", dest="file_timeout", type=float, default=DEFAULT_FILE_TIMEOUT_S,
+                       metavar="SECONDS",
+                       help=f"time limit of one file's fit (default {DEFAULT_FILE_TIMEOUT_S:g} s; 0: none): a file "
+                            "still fitting then is listed as failed ('timed out after N s') and the batch goes on")
     add_fit_options(batch)
     return batch
 
@@ -48,10 +55,13 @@ def run_batch(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
         parser.error("--workers applies to the local cluster; the cluster at --scheduler has its own workers")
     if args.workers is not None and args.workers < 1:
         parser.error(f"--workers {args.workers}: expected 1 or more")
+    if not (args.file_timeout >= 0 and math.isfinite(args.file_timeout)):
+        parser.error(f"--file-timeout {args.file_timeout:g}: expected seconds > 0, or 0 for no limit")
     try:
         options = FitOptions.from_args(args)
         result = fit_files(args.inputs, client=args.scheduler, out=args.out, table=args.table, workers=args.workers,
-                           progress=sys.stderr.isatty(), **{k: v for k, v in vars(options).items()})
+                           progress=sys.stderr.isatty(), file_timeout_s=args.file_timeout or None,
+                           **{k: v for k, v in vars(options).items()})
     except ParameterError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import dataclasses
+import math
 import os
 import time
 from collections.abc import Iterator, Sequence
@@ -12,6 +13,7 @@ from typing import Any
 from ..errors import ParameterError
 from ..fitting import FitOptions
 from .discover import file_sha256, find_files
+from .fitproc import DEFAULT_FILE_TIMEOUT_S
 from .records import BatchInfo, Entry, FileFit, Outcome, one_line
 from .store import PartStore, entry_of, parse_table, parts_folder, write_batch_archive, write_table
 
@@ -74,7 +76,8 @@ def _progress(total: int, enabled: bool):
 
 def iter_fit(paths: str | os.PathLike | Sequence[str | os.PathLike], *, client: Any = None,
              out: str | os.PathLike | None = None, table: str | os.PathLike | None = None,
-             workers: int | None = None, progress: bool = False, **fit_options: Any) -> Iterator[Outcome]:
+             workers: int | None = None, progress: bool = False,
+             file_timeout_s: float | None = DEFAULT_FILE_TIMEOUT_S, **fit_options: Any) -> Iterator[Outcome]:
     """Fit every FRF file, yielding each file's :class:`Outcome` as it is done.
 
     Parameters
@@ -94,6 +97,11 @@ def iter_fit(paths: str | os.PathLike | Sequence[str | os.PathLike], *, client: 
         Workers of the local cluster (default: the cores).
     progress : bool
         Show a progress bar on stderr.
+    file_timeout_s : float or None
+        Time limit of one file's fit, s (default :data:`~modal.batch.fitproc.DEFAULT_FILE_TIMEOUT_S`);
+        a file still fitting then is listed as failed (``timed out after N s``, tried again by a
+        rerun) and the batch goes on. None: no limit. Each file is fitted in a process of its own
+        beside the worker (:mod:`modal.batch.fitproc`), so a file that hangs or crashes fails alone.
     **fit_options
         The options of ``modal fit`` under their Python names (:class:`modal.fitting.FitOptions`):
         ``method``, ``bands_hz``, ``kind``, ``driving_point``, ``modes_hz``, ...
@@ -109,6 +117,7 @@ def iter_fit(paths: str | os.PathLike | Sequence[str | os.PathLike], *, client: 
         Unknown or contradictory options, no file found, a missing output folder.
     """
     options = FitOptions.from_kwargs(**fit_options)
+    file_timeout_s = _check_timeout(file_timeout_s)
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
         raise ParameterError(f"workers must be a whole number >= 1, got {workers!r}")
     if out is not None:
@@ -127,14 +136,27 @@ def iter_fit(paths: str | os.PathLike | Sequence[str | os.PathLike], *, client: 
         shown = paths if isinstance(paths, (str, os.PathLike)) else ", ".join(map(str, paths))
         raise ParameterError(f"no FRF file found in {shown}; expected folders, glob patterns or files "
                              "(UFF, CSV, MAT, HDF5)")
-    return _run(files, options, client, out, table, workers, progress)
+    return _run(files, options, client, out, table, workers, progress, file_timeout_s)
+
+
+def _check_timeout(value) -> float | None:
+    if value is None:
+        return None
+    try:
+        seconds = float(value)
+    except (TypeError, ValueError):
+        seconds = math.nan
+    if isinstance(value, bool) or not (seconds > 0 and math.isfinite(seconds)):
+        raise ParameterError(f"file timeout {value!r}: expected a time in seconds > 0 (or None for no limit)")
+    return seconds
 
 
 def _outcome(entry: Entry, status: str) -> Outcome:
     return Outcome(entry.source, status, entry.error, parse_table(entry.source, entry.table), entry.fit)
 
 
-def _run(files: list[str], options: FitOptions, client, out, table, workers, progress) -> Iterator[Outcome]:
+def _run(files: list[str], options: FitOptions, client, out, table, workers, progress,
+         file_timeout_s) -> Iterator[Outcome]:
     start = time.perf_counter()
     settings, settings_hash = options.settings_json(), options.settings_hash()
     store = PartStore(out) if out is not None else None
@@ -164,7 +186,8 @@ def _run(files: list[str], options: FitOptions, client, out, table, workers, pro
             else:
                 pending.append(path)
         if pending:
-            yield from _fit_pending(pending, options, hashes, client, workers, store, done, statuses, bar)
+            yield from _fit_pending(pending, options, hashes, client, workers, store, done, statuses, bar,
+                                    file_timeout_s)
     finally:
         bar.close()
     if out is not None:
@@ -186,7 +209,8 @@ def chunk_size(n_files: int, n_workers: int) -> int:
     return max(1, min(16, -(-n_files // (4 * max(1, n_workers)))))
 
 
-def _fit_pending(pending, options, hashes, client, workers, store, done, statuses, bar) -> Iterator[Outcome]:
+def _fit_pending(pending, options, hashes, client, workers, store, done, statuses, bar,
+                 file_timeout_s) -> Iterator[Outcome]:
     from distributed import as_completed
 
     from .._version import __version__
@@ -198,7 +222,7 @@ def _fit_pending(pending, options, hashes, client, workers, store, done, statuse
         size = chunk_size(len(pending), len(dask.scheduler_info().get("workers", {})))
         chunks = [pending[i:i + size] for i in range(0, len(pending), size)]
         futures = {dask.submit(fit_and_store, chunk, options, [hashes[p] for p in chunk], archive, __version__,
-                               pure=False): chunk
+                               file_timeout_s, pure=False): chunk
                    for chunk in chunks}
         for future in as_completed(futures, loop=dask.loop):
             chunk = futures[future]
@@ -223,7 +247,8 @@ def _fit_pending(pending, options, hashes, client, workers, store, done, statuse
 
 def fit_files(paths: str | os.PathLike | Sequence[str | os.PathLike], *, client: Any = None,
               out: str | os.PathLike | None = None, table: str | os.PathLike | None = None,
-              workers: int | None = None, progress: bool = False, **fit_options: Any) -> BatchResult:
+              workers: int | None = None, progress: bool = False,
+              file_timeout_s: float | None = DEFAULT_FILE_TIMEOUT_S, **fit_options: Any) -> BatchResult:
     """Fit every FRF file and return all outcomes (the Python side of ``modal batch``).
 
     Parameters are those of :func:`iter_fit`.
@@ -241,7 +266,7 @@ def fit_files(paths: str | os.PathLike | Sequence[str | os.PathLike], *, client:
     """
     start = time.perf_counter()
     outcomes = {o.file: o for o in iter_fit(paths, client=client, out=out, table=table, workers=workers,
-                                            progress=progress, **fit_options)}
+                                            progress=progress, file_timeout_s=file_timeout_s, **fit_options)}
     ordered = tuple(outcomes[p] for p in sorted(outcomes))
     table_path = None if out is None else str(Path(table) if table is not None else default_table(out))
     return BatchResult(outcomes=ordered, archive=None if out is None else str(out), table=table_path,

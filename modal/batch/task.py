@@ -7,6 +7,7 @@ import warnings
 from ..errors import ModalError
 from ..fitting import FitOptions, fit_path
 from .discover import file_sha256
+from .fitproc import DEFAULT_FILE_TIMEOUT_S, fit_in_process
 from .records import Entry, FileFit, one_line
 from .store import PartStore, entry_of, table_text
 
@@ -56,12 +57,15 @@ def fit_one(path: str, options: FitOptions, sha256: str | None = None) -> FileFi
 
 
 def fit_and_store(paths: list[str], options: FitOptions, hashes: list[str], archive: str | None = None,
-                  client_version: str | None = None) -> list[Entry]:
-    """:func:`fit_one` for a chunk of files, then (with ``archive``) their results written to one part
-    in the archive's parts folder by the process that fitted them; returns the client's
-    :class:`Entry` per file (small: the table rows and where the result is, or the result itself when
-    it is not stored). A worker with another version of the toolkit than the client's
-    (``client_version``) fits nothing: every file fails with that reason (and a rerun tries again)."""
+                  client_version: str | None = None,
+                  file_timeout_s: float | None = DEFAULT_FILE_TIMEOUT_S) -> list[Entry]:
+    """:func:`fit_one` for a chunk of files, each in a fitting process of this worker
+    (:mod:`modal.batch.fitproc`: a file that hangs, crashes or passes ``file_timeout_s`` fails
+    alone), then (with ``archive``) their results written to one part in the archive's parts
+    folder by the worker; returns the client's :class:`Entry` per file (small: the table rows and
+    where the result is, or the result itself when it is not stored). A worker with another
+    version of the toolkit than the client's (``client_version``) fits nothing: every file fails
+    with that reason (and a rerun tries again)."""
     from .._version import __version__
 
     if client_version is not None and client_version != __version__:
@@ -70,7 +74,7 @@ def fit_and_store(paths: list[str], options: FitOptions, hashes: list[str], arch
         return [entry_of(FileFit(source=path, sha256=sha, settings=options.settings_json(),
                                  settings_hash=options.settings_hash(), error=error, retry=True))
                 for path, sha in zip(paths, hashes)]
-    fits = [fit_one(path, options, sha) for path, sha in zip(paths, hashes)]
+    fits = [fit_in_process(path, options, sha, file_timeout_s) for path, sha in zip(paths, hashes)]
     keep = [fit for fit in fits if not fit.retry]
     if archive is None or not keep:
         return [entry_of(fit) for fit in fits]

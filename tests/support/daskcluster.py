@@ -16,10 +16,12 @@ def free_port() -> int:
         return sock.getsockname()[1]
 
 
-def start_worker(address: str, name: str, folder: Path) -> subprocess.Popen:
-    """One worker process without a nanny (so that killing it loses it for good)."""
-    return subprocess.Popen([str(DASK), "worker", address, "--name", name, "--nthreads", "1", "--no-nanny",
-                             "--no-dashboard", "--host", "127.0.0.1", "--local-directory", str(folder)],
+def start_worker(address: str, name: str, folder: Path, nanny: bool = False) -> subprocess.Popen:
+    """One worker, without a nanny by default (so that killing it loses it for good); with ``nanny``
+    as ``dask worker`` runs by default: the worker is then a daemonic child process of its nanny."""
+    return subprocess.Popen([str(DASK), "worker", address, "--name", name, "--nthreads", "1",
+                             "--nanny" if nanny else "--no-nanny", "--no-dashboard", "--host", "127.0.0.1",
+                             "--local-directory", str(folder)],
                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, cwd=folder)
 
 
@@ -43,7 +45,8 @@ def stop(procs) -> None:
 
 
 def cluster(tmp_path_factory):
-    """``dask scheduler`` and two ``dask worker`` processes on 127.0.0.1; yields (address, folder)."""
+    """``dask scheduler`` and two ``dask worker`` processes on 127.0.0.1, each with its nanny as in a
+    deployment (the worker processes are daemonic); yields (address, folder, processes)."""
     assert DASK.is_file(), f"{DASK}: the dask command is not installed (dask[distributed] is a dependency)"
     folder = tmp_path_factory.mktemp("dask")  # the processes' working and local directory
     port = free_port()
@@ -51,7 +54,7 @@ def cluster(tmp_path_factory):
     procs = [subprocess.Popen([str(DASK), "scheduler", "--host", "127.0.0.1", "--port", str(port), "--no-dashboard"],
                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, cwd=folder)]
     try:
-        procs += [start_worker(address, f"w{i}", folder) for i in range(2)]
+        procs += [start_worker(address, f"w{i}", folder, nanny=True) for i in range(2)]
         wait_for_workers(address, 2)
         yield address, folder, procs
     finally:
