@@ -54,3 +54,24 @@ def test_orphaned_reader_ends_itself(tmp_path):
     if alive:
         os.kill(child, signal.SIGKILL)
     assert not alive
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="POSIX fork")
+def test_readers_work_in_a_daemonic_process(tmp_path):
+    """multiprocessing refuses children to daemonic processes (a Pool's workers, the worker processes
+    of Dask's nannies): the reader's child is forked with os.fork itself, so MAT and HDF5 files read there."""
+    import multiprocessing
+
+    import numpy as np
+
+    from modal import read_frf, write_frf
+    from modal.synthetic import modal_frf
+
+    frf = modal_frf(np.linspace(10.0, 100.0, 91), [40.0], [0.02], [1.0], kind="mobility")
+    paths = [str(tmp_path / "a.mat"), str(tmp_path / "a.h5")]
+    for path in paths:
+        write_frf(frf, path)
+    with multiprocessing.get_context("fork").Pool(1) as pool:  # its worker is daemonic
+        back = pool.map(read_frf, paths)
+    for item in back:
+        np.testing.assert_array_equal(item.response, frf.response)

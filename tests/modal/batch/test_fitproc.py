@@ -1,0 +1,92 @@
+"""Each file's fit in a fitting process beside the worker (modal/batch/fitproc.py) and the batch's
+time limit per file (``--file-timeout``): a pathological file is listed as failed and the batch goes on."""
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from modal.archive import read_archive
+from modal.batch import fit_files
+from modal.batch.fitproc import FitProcess, ProcessEnded, fit_in_process
+from modal.errors import ParameterError
+from modal.fitting import FitOptions
+from modal.io import write_frf
+
+from support.batchfiles import FRF_MODES_HZ, mobility, write_hanging_hdf5, write_many_modes
+
+
+def run_cli(*args):
+    return subprocess.run([sys.executable, "-m", "modal", "batch", *map(str, args)], capture_output=True, text=True,
+                          timeout=300)
+
+
+def session_members(sid: int) -> list[int]:
+    """Processes of session ``sid`` (Linux /proc)."""
+    members = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rpartition(")")[2].split()
+        except OSError:
+            continue
+        if int(fields[3]) == sid and fields[0] != "Z":  # fields after the name: state, ppid, pgrp, session
+            members.append(int(stat.parent.name))
+    return members
+
+
+def test_a_pathological_file_times_out_and_the_batch_goes_on(dask_cluster, tmp_path):
+    folder = tmp_path / "in"
+    folder.mkdir()
+    write_many_modes(folder / "many_modes.h5")  # 150 modes on 60 000 lines: minutes of identification
+    for k in range(3):
+        write_frf(mobility(seed=k), folder / f"good{k}.uff")
+    out = tmp_path / "r.h5"
+    start = time.monotonic()
+    done = run_cli(folder, "--out", out, "--scheduler", dask_cluster[0], "--file-timeout", 3, "--json")
+    elapsed = time.monotonic() - start
+    assert done.returncode == 1, done.stderr
+    doc = json.loads(done.stdout)
+    assert doc["fitted"] == 3
+    assert doc["failed"] == [{"file": str(folder / "many_modes.h5"),
+                              "error": f"{folder / 'many_modes.h5'}: timed out after 3 s"}]
+    assert elapsed < 60  # the file alone identifies for minutes
+    fits = {Path(f.source).name: f for f in read_archive(out)["files"]}
+    slow = fits["many_modes.h5"]
+    assert slow.retry and slow.fit_time_s == 3.0 and slow.results == ()  # a rerun tries it again
+    for k in range(3):
+        modes = sorted(m.natural_frequency_hz for m in fits[f"good{k}.uff"].results[0].modes)
+        assert modes == pytest.approx(FRF_MODES_HZ, abs=0.05)  # standard errors ~1e-3 Hz
+
+
+def test_a_timed_out_process_and_the_reader_it_forked_are_ended(tmp_path):
+    """The hanging HDF5 reader runs in a child the fitting process forked; at the time limit the
+    whole session goes: no process is left spinning in libhdf5."""
+    write_hanging_hdf5(tmp_path / "hang.h5")
+    proc = FitProcess()
+    with pytest.raises(ProcessEnded, match="timed out after 2 s") as caught:
+        proc.fit(str(tmp_path / "hang.h5"), FitOptions(), None, 2.0)
+    assert caught.value.timed_out and not proc.alive()
+    assert session_members(proc.pid) == []
+
+
+def test_fitted_in_a_process_equals_fitted_here(tmp_path):
+    from modal.batch.task import fit_one
+
+    path = tmp_path / "a.uff"
+    write_frf(mobility(), path)
+    here = fit_one(str(path), FitOptions(method="nls"))
+    there = fit_in_process(str(path), FitOptions(method="nls"), None, 60.0)
+    assert there.ok and there.table == here.table and there.sha256 == here.sha256
+
+
+def test_the_time_limit_must_be_a_positive_time(tmp_path):
+    write_frf(mobility(), tmp_path / "a.uff")
+    for bad in (0, -1, float("nan"), float("inf"), "soon", True):
+        with pytest.raises(ParameterError, match="file timeout"):
+            fit_files(tmp_path, file_timeout_s=bad)
+    done = run_cli(tmp_path, "--out", tmp_path / "r.h5", "--file-timeout", -5)
+    assert done.returncode == 2 and "--file-timeout -5: expected seconds > 0" in done.stderr
