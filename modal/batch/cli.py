@@ -36,6 +36,9 @@ def add_batch_parser(sub, add_fit_options) -> argparse.ArgumentParser:
                        help="address of a running Dask scheduler (workers need this package installed and the "
                             "files at the same paths); default: a local cluster")
     batch.add_argument("--workers", type=int, metavar="N", help="local cluster: worker processes (default: the cores)")
+    batch.add_argument("--dashboard", nargs="?", const="127.0.0.1:8787", metavar="HOST:PORT",
+                       help="local cluster: serve Dask's dashboard (default 127.0.0.1:8787; needs bokeh); without "
+                            "it the local cluster opens no web port")
     batch.add_argument("--file-timeout", dest="file_timeout", type=float, default=DEFAULT_FILE_TIMEOUT_S,
                        metavar="SECONDS",
                        help=f"time limit of one file's fit (default {DEFAULT_FILE_TIMEOUT_S:g} s; 0: none): a file "
@@ -53,14 +56,19 @@ def run_batch(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
 
     if args.scheduler and args.workers is not None:
         parser.error("--workers applies to the local cluster; the cluster at --scheduler has its own workers")
+    if args.scheduler and args.dashboard:
+        parser.error("--dashboard applies to the local cluster; the scheduler at --scheduler serves its own")
     if args.workers is not None and args.workers < 1:
         parser.error(f"--workers {args.workers}: expected 1 or more")
     if not (args.file_timeout >= 0 and math.isfinite(args.file_timeout)):
         parser.error(f"--file-timeout {args.file_timeout:g}: expected seconds > 0, or 0 for no limit")
+    if args.dashboard:
+        print(f"dashboard: http://{args.dashboard}/status (Dask's, while files are fitted)", file=sys.stderr)
     try:
         options = FitOptions.from_args(args)
         result = fit_files(args.inputs, client=args.scheduler, out=args.out, table=args.table, workers=args.workers,
                            progress=sys.stderr.isatty(), file_timeout_s=args.file_timeout or None,
+                           dashboard=args.dashboard or False,
                            **{k: v for k, v in vars(options).items()})
     except ParameterError as exc:
         print(f"error: {exc}", file=sys.stderr)

@@ -77,7 +77,8 @@ def _progress(total: int, enabled: bool):
 def iter_fit(paths: str | os.PathLike | Sequence[str | os.PathLike], *, client: Any = None,
              out: str | os.PathLike | None = None, table: str | os.PathLike | None = None,
              workers: int | None = None, progress: bool = False,
-             file_timeout_s: float | None = DEFAULT_FILE_TIMEOUT_S, **fit_options: Any) -> Iterator[Outcome]:
+             file_timeout_s: float | None = DEFAULT_FILE_TIMEOUT_S, dashboard: bool | str = False,
+             **fit_options: Any) -> Iterator[Outcome]:
     """Fit every FRF file, yielding each file's :class:`Outcome` as it is done.
 
     Parameters
@@ -102,6 +103,9 @@ def iter_fit(paths: str | os.PathLike | Sequence[str | os.PathLike], *, client: 
         a file still fitting then is listed as failed (``timed out after N s``, tried again by a
         rerun) and the batch goes on. None: no limit. Each file is fitted in a process of its own
         beside the worker (:mod:`modal.batch.fitproc`), so a file that hangs or crashes fails alone.
+    dashboard : bool or str
+        Local cluster: serve Dask's dashboard (True: at :data:`~modal.batch.cluster.DEFAULT_DASHBOARD`,
+        or at this ``HOST:PORT``); by default the local cluster starts no HTTP server at all.
     **fit_options
         The options of ``modal fit`` under their Python names (:class:`modal.fitting.FitOptions`):
         ``method``, ``bands_hz``, ``kind``, ``driving_point``, ``modes_hz``, ...
@@ -118,6 +122,9 @@ def iter_fit(paths: str | os.PathLike | Sequence[str | os.PathLike], *, client: 
     """
     options = FitOptions.from_kwargs(**fit_options)
     file_timeout_s = _check_timeout(file_timeout_s)
+    if dashboard and client is not None:
+        raise ParameterError("dashboard applies to the local cluster; a running scheduler serves its own")
+    dashboard = ("127.0.0.1:8787" if dashboard is True else str(dashboard)) if dashboard else None
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
         raise ParameterError(f"workers must be a whole number >= 1, got {workers!r}")
     if out is not None:
@@ -136,7 +143,7 @@ def iter_fit(paths: str | os.PathLike | Sequence[str | os.PathLike], *, client: 
         shown = paths if isinstance(paths, (str, os.PathLike)) else ", ".join(map(str, paths))
         raise ParameterError(f"no FRF file found in {shown}; expected folders, glob patterns or files "
                              "(UFF, CSV, MAT, HDF5)")
-    return _run(files, options, client, out, table, workers, progress, file_timeout_s)
+    return _run(files, options, client, out, table, workers, progress, file_timeout_s, dashboard)
 
 
 def _check_timeout(value) -> float | None:
@@ -156,7 +163,7 @@ def _outcome(entry: Entry, status: str) -> Outcome:
 
 
 def _run(files: list[str], options: FitOptions, client, out, table, workers, progress,
-         file_timeout_s) -> Iterator[Outcome]:
+         file_timeout_s, dashboard) -> Iterator[Outcome]:
     start = time.perf_counter()
     settings, settings_hash = options.settings_json(), options.settings_hash()
     store = PartStore(out) if out is not None else None
@@ -187,7 +194,7 @@ def _run(files: list[str], options: FitOptions, client, out, table, workers, pro
                 pending.append(path)
         if pending:
             yield from _fit_pending(pending, options, hashes, client, workers, store, done, statuses, bar,
-                                    file_timeout_s)
+                                    file_timeout_s, dashboard)
     finally:
         bar.close()
     if out is not None:
@@ -210,7 +217,7 @@ def chunk_size(n_files: int, n_workers: int) -> int:
 
 
 def _fit_pending(pending, options, hashes, client, workers, store, done, statuses, bar,
-                 file_timeout_s) -> Iterator[Outcome]:
+                 file_timeout_s, dashboard) -> Iterator[Outcome]:
     from distributed import as_completed
 
     from .._version import __version__
@@ -218,7 +225,7 @@ def _fit_pending(pending, options, hashes, client, workers, store, done, statuse
     from .task import fit_and_store
 
     archive = None if store is None else str(store.archive.resolve())
-    with open_client(client, workers) as dask:
+    with open_client(client, workers, dashboard) as dask:
         size = chunk_size(len(pending), len(dask.scheduler_info().get("workers", {})))
         chunks = [pending[i:i + size] for i in range(0, len(pending), size)]
         futures = {dask.submit(fit_and_store, chunk, options, [hashes[p] for p in chunk], archive, __version__,
@@ -248,7 +255,8 @@ def _fit_pending(pending, options, hashes, client, workers, store, done, statuse
 def fit_files(paths: str | os.PathLike | Sequence[str | os.PathLike], *, client: Any = None,
               out: str | os.PathLike | None = None, table: str | os.PathLike | None = None,
               workers: int | None = None, progress: bool = False,
-              file_timeout_s: float | None = DEFAULT_FILE_TIMEOUT_S, **fit_options: Any) -> BatchResult:
+              file_timeout_s: float | None = DEFAULT_FILE_TIMEOUT_S, dashboard: bool | str = False,
+              **fit_options: Any) -> BatchResult:
     """Fit every FRF file and return all outcomes (the Python side of ``modal batch``).
 
     Parameters are those of :func:`iter_fit`.
@@ -266,7 +274,8 @@ def fit_files(paths: str | os.PathLike | Sequence[str | os.PathLike], *, client:
     """
     start = time.perf_counter()
     outcomes = {o.file: o for o in iter_fit(paths, client=client, out=out, table=table, workers=workers,
-                                            progress=progress, file_timeout_s=file_timeout_s, **fit_options)}
+                                            progress=progress, file_timeout_s=file_timeout_s,
+                                            dashboard=dashboard, **fit_options)}
     ordered = tuple(outcomes[p] for p in sorted(outcomes))
     table_path = None if out is None else str(Path(table) if table is not None else default_table(out))
     return BatchResult(outcomes=ordered, archive=None if out is None else str(out), table=table_path,
