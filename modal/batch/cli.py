@@ -13,7 +13,7 @@ import sys
 
 from .fitproc import DEFAULT_FILE_TIMEOUT_S
 
-__all__ = ["add_batch_parser", "run_batch"]
+__all__ = ["add_batch_parser", "run_batch", "failure_line"]
 
 
 def add_batch_parser(sub, add_fit_options) -> argparse.ArgumentParser:
@@ -39,12 +39,20 @@ def add_batch_parser(sub, add_fit_options) -> argparse.ArgumentParser:
     batch.add_argument("--dashboard", nargs="?", const="127.0.0.1:8787", metavar="HOST:PORT",
                        help="local cluster: serve Dask's dashboard (default 127.0.0.1:8787; needs bokeh); without "
                             "it the local cluster opens no web port")
+    batch.add_argument("--follow-symlinks", dest="follow_symlinks", action="store_true",
+                       help="follow every symbolic link in the folders (default: only links that lead inside the "
+                            "folders given)")
     batch.add_argument("--file-timeout", dest="file_timeout", type=float, default=DEFAULT_FILE_TIMEOUT_S,
                        metavar="SECONDS",
                        help=f"time limit of one file's fit (default {DEFAULT_FILE_TIMEOUT_S:g} s; 0: none): a file "
                             "still fitting then is listed as failed ('timed out after N s') and the batch goes on")
     add_fit_options(batch)
     return batch
+
+
+def failure_line(path: str, error: str) -> str:
+    """A failed file's line: the error, which names the file, as it is; otherwise the file first."""
+    return error if error.startswith(f"{path}:") else f"{path}: {error}"
 
 
 def run_batch(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
@@ -68,7 +76,7 @@ def run_batch(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
         options = FitOptions.from_args(args)
         result = fit_files(args.inputs, client=args.scheduler, out=args.out, table=args.table, workers=args.workers,
                            progress=sys.stderr.isatty(), file_timeout_s=args.file_timeout or None,
-                           dashboard=args.dashboard or False,
+                           dashboard=args.dashboard or False, follow_symlinks=args.follow_symlinks,
                            **{k: v for k, v in vars(options).items()})
     except ParameterError as exc:
         print(f"error: {exc}", file=sys.stderr)
@@ -84,7 +92,7 @@ def run_batch(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
               "to finish", file=sys.stderr)
         return 130
     for item in result.failed:
-        print(f"failed: {item['file']}: {item['error']}", file=sys.stderr)
+        print(f"failed: {failure_line(item['file'], item['error'])}", file=sys.stderr)
     if args.json:
         json.dump(jsonable(result.summary()), sys.stdout, indent=1, allow_nan=False)
         sys.stdout.write("\n")

@@ -78,13 +78,14 @@ def iter_fit(paths: str | os.PathLike | Sequence[str | os.PathLike], *, client: 
              out: str | os.PathLike | None = None, table: str | os.PathLike | None = None,
              workers: int | None = None, progress: bool = False,
              file_timeout_s: float | None = DEFAULT_FILE_TIMEOUT_S, dashboard: bool | str = False,
-             **fit_options: Any) -> Iterator[Outcome]:
+             follow_symlinks: bool = False, **fit_options: Any) -> Iterator[Outcome]:
     """Fit every FRF file, yielding each file's :class:`Outcome` as it is done.
 
     Parameters
     ----------
     paths : path-like or sequence of path-likes
         Folders (searched recursively), glob patterns or files (:func:`modal.batch.find_files`).
+        A symbolic link is followed only when it leads inside the folders given, unless ``follow_symlinks``.
     client : distributed.Client or str, optional
         A Dask client, or a scheduler address ``tcp://HOST:PORT``; default an embedded local
         cluster of ``workers`` processes, started only when some file needs fitting.
@@ -106,6 +107,8 @@ def iter_fit(paths: str | os.PathLike | Sequence[str | os.PathLike], *, client: 
     dashboard : bool or str
         Local cluster: serve Dask's dashboard (True: at :data:`~modal.batch.cluster.DEFAULT_DASHBOARD`,
         or at this ``HOST:PORT``); by default the local cluster starts no HTTP server at all.
+    follow_symlinks : bool
+        Follow every symbolic link found in the folders, wherever it leads.
     **fit_options
         The options of ``modal fit`` under their Python names (:class:`modal.fitting.FitOptions`):
         ``method``, ``bands_hz``, ``kind``, ``driving_point``, ``modes_hz``, ...
@@ -118,7 +121,8 @@ def iter_fit(paths: str | os.PathLike | Sequence[str | os.PathLike], *, client: 
     Raises
     ------
     ParameterError
-        Unknown or contradictory options, no file found, a missing output folder.
+        Unknown or contradictory options, an input that does not exist, no file found, a missing
+        output folder.
     """
     options = FitOptions.from_kwargs(**fit_options)
     file_timeout_s = _check_timeout(file_timeout_s)
@@ -138,7 +142,7 @@ def iter_fit(paths: str | os.PathLike | Sequence[str | os.PathLike], *, client: 
     elif table is not None:
         raise ParameterError("table needs out (the archive that makes a run resumable)")
     exclude = [] if out is None else [out, table, parts_folder(out)]
-    files = find_files(paths, exclude=exclude)
+    files = find_files(paths, exclude=exclude, follow_symlinks=follow_symlinks)
     if not files:
         shown = paths if isinstance(paths, (str, os.PathLike)) else ", ".join(map(str, paths))
         raise ParameterError(f"no FRF file found in {shown}; expected folders, glob patterns or files "
@@ -256,7 +260,7 @@ def fit_files(paths: str | os.PathLike | Sequence[str | os.PathLike], *, client:
               out: str | os.PathLike | None = None, table: str | os.PathLike | None = None,
               workers: int | None = None, progress: bool = False,
               file_timeout_s: float | None = DEFAULT_FILE_TIMEOUT_S, dashboard: bool | str = False,
-              **fit_options: Any) -> BatchResult:
+              follow_symlinks: bool = False, **fit_options: Any) -> BatchResult:
     """Fit every FRF file and return all outcomes (the Python side of ``modal batch``).
 
     Parameters are those of :func:`iter_fit`.
@@ -275,7 +279,8 @@ def fit_files(paths: str | os.PathLike | Sequence[str | os.PathLike], *, client:
     start = time.perf_counter()
     outcomes = {o.file: o for o in iter_fit(paths, client=client, out=out, table=table, workers=workers,
                                             progress=progress, file_timeout_s=file_timeout_s,
-                                            dashboard=dashboard, **fit_options)}
+                                            dashboard=dashboard, follow_symlinks=follow_symlinks,
+                                            **fit_options)}
     ordered = tuple(outcomes[p] for p in sorted(outcomes))
     table_path = None if out is None else str(Path(table) if table is not None else default_table(out))
     return BatchResult(outcomes=ordered, archive=None if out is None else str(out), table=table_path,

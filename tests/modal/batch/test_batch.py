@@ -265,7 +265,7 @@ def test_hundred_files_with_two_broken_then_rerun_reuses_everything(dask_cluster
     assert sorted(item["file"] for item in doc["failed"]) == sorted([str(truncated), str(garbage)])
     for item in doc["failed"]:
         assert "\n" not in item["error"] and Path(item["file"]).name in item["error"]  # one line naming the file
-        assert f"failed: {item['file']}: {item['error']}" in first.stderr
+        assert f"failed: {item['error']}\n" in first.stderr  # the error names the file: once on the line
     rows = read_table(tmp_path / "table.csv")
     assert len(rows) == 200 and not any("broken" in r["file"] for r in rows)
     assert_correct(rows)
@@ -298,7 +298,8 @@ def test_bad_usage_exits_2(small_set, tmp_path, capsys):
     from modal.cli import main
 
     cases = [
-        (tmp_path / "nothing_here", "--out", tmp_path / "r.h5"),  # no file found
+        (tmp_path / "nothing_here", "--out", tmp_path / "r.h5"),  # no such folder
+        (tmp_path / "nothing_here*", "--out", tmp_path / "r.h5"),  # no file found
         (small_set, "--out", tmp_path / "r.h5", "--scheduler", "tcp://127.0.0.1:1", "--workers", "2"),
         (small_set, "--out", tmp_path / "r.h5", "--method", "nls", "--modes-hz", "70"),
         (small_set, "--out", tmp_path / "missing" / "r.h5"),
