@@ -1,6 +1,7 @@
 """``python -m modal batch DIR_OR_GLOB... --out RESULTS.h5``: the command line of :mod:`modal.batch`.
 
-Exit codes: 0 every file fitted, 1 some failed (the archive holds the others), 2 bad usage.
+Exit codes: 0 every file fitted, 1 some failed (the archive holds the others) or the output is in use by
+another run, 2 bad usage.
 stdout: one summary line, or one JSON document with ``--json``; stderr: the failures, one line
 each, and a progress bar when stderr is a terminal.
 """
@@ -23,12 +24,14 @@ def add_batch_parser(sub, add_fit_options) -> argparse.ArgumentParser:
         description="Fit every FRF file found (folders are searched recursively for UFF, CSV, MAT and HDF5 files) "
                     "with the options of 'modal fit', on an embedded Dask cluster or an existing one; write one "
                     "archive (a group per file) and one CSV table (a row per file, mode and channel). A rerun "
-                    "with the same options reuses the results of unchanged files. Exit 0: every file fitted; "
-                    "1: some failed (listed); 2: bad usage.")
+                    "with the same options reuses the results of unchanged files (by their content's SHA-256). "
+                    "One run per output: a second run on the same --out refuses at once, naming the running one. "
+                    "Symbolic links are followed only where they stay inside the folders given. Exit 0: every "
+                    "file fitted; 1: some failed (listed), or the output is in use; 2: bad usage.")
     batch.add_argument("inputs", nargs="+", metavar="DIR_OR_GLOB", help="folders, glob patterns or files")
     batch.add_argument("--out", required=True, metavar="RESULTS.h5",
                        help="the archive (replaced whole at the end; results go to RESULTS.h5.parts/ "
-                            "meanwhile, so an interrupted run resumes)")
+                            "meanwhile, so an interrupted run resumes; RESULTS.h5.lock says which run holds it)")
     batch.add_argument("--table", metavar="RESULTS.csv", help="the CSV table (default: the archive's name with .csv)")
     batch.add_argument("--json", action="store_true",
                        help="print one JSON document: files, fitted, reused, failed, archive, table, wall_time_s")

@@ -14,6 +14,7 @@ from ..errors import ParameterError
 from ..fitting import FitOptions
 from .discover import file_sha256, find_files
 from .fitproc import DEFAULT_FILE_TIMEOUT_S
+from .lock import RunLock, lock_path
 from .records import BatchInfo, Entry, FileFit, Outcome, one_line
 from .store import PartStore, entry_of, parse_table, parts_folder, write_batch_archive, write_table
 
@@ -141,7 +142,7 @@ def iter_fit(paths: str | os.PathLike | Sequence[str | os.PathLike], *, client: 
                 raise ParameterError(f"--{name} {target}: is a folder; expected a file name")
     elif table is not None:
         raise ParameterError("table needs out (the archive that makes a run resumable)")
-    exclude = [] if out is None else [out, table, parts_folder(out)]
+    exclude = [] if out is None else [out, table, parts_folder(out), lock_path(out)]
     files = find_files(paths, exclude=exclude, follow_symlinks=follow_symlinks)
     if not files:
         shown = paths if isinstance(paths, (str, os.PathLike)) else ", ".join(map(str, paths))
@@ -168,6 +169,19 @@ def _outcome(entry: Entry, status: str) -> Outcome:
 
 def _run(files: list[str], options: FitOptions, client, out, table, workers, progress,
          file_timeout_s, dashboard) -> Iterator[Outcome]:
+    """The run, holding the output's lock from the first file hashed to the table written."""
+    lock = RunLock(out) if out is not None else None
+    if lock is not None:
+        lock.acquire()  # before anything is read or written: a second run on the same output stops here
+    try:
+        yield from _locked_run(files, options, client, out, table, workers, progress, file_timeout_s, dashboard)
+    finally:
+        if lock is not None:
+            lock.release()
+
+
+def _locked_run(files: list[str], options: FitOptions, client, out, table, workers, progress,
+                file_timeout_s, dashboard) -> Iterator[Outcome]:
     start = time.perf_counter()
     settings, settings_hash = options.settings_json(), options.settings_hash()
     store = PartStore(out) if out is not None else None

@@ -7,7 +7,9 @@ kill -9, a lost worker or client) loses at most the chunks in flight. One part p
 than per file: an HDF5 file costs about as much to create and check as a small fit. The archive itself is only ever replaced whole (temporary file, checked, renamed; see
 :func:`modal.io._atomic.atomic_path`): its groups are copied from the parts and from the previous
 archive (HDF5 object copies, no decoding), then the parts folder is removed. A rerun reuses a
-file's result from either place when its content hash and the settings hash are unchanged.
+file's result from either place when its content hash and the settings hash are unchanged; every
+copy is checked by those hashes, never taken by its position. One run at a time writes an archive
+and its parts (:mod:`modal.batch.lock`).
 """
 from __future__ import annotations
 
@@ -174,14 +176,40 @@ class PartStore:
         shutil.rmtree(self.folder, ignore_errors=True)
 
 
+def _by_content(handle, node: str, entry: Entry, settings_hash: str):
+    """The group of ``handle`` holding the result of ``entry``'s content (its sha256) under these
+    settings: the group the index found (``node``) when it still does, else any that does, else None
+    (the file was replaced since it was indexed). Never a group by its position alone."""
+    def holds(group) -> bool:
+        return (isinstance(group, h5py.Group) and _text(group.get("sha256")) == entry.sha256
+                and _text(group.get("settings_hash")) == settings_hash)
+
+    found = handle.get(node)
+    if holds(found):
+        return found
+    files = handle.get("files")
+    for name in files.keys() if isinstance(files, h5py.Group) else ():
+        if holds(files[name]):
+            return files[name]
+    return None
+
+
 def write_batch_archive(path: str | os.PathLike, info: BatchInfo, entries: Sequence[Entry]) -> Path:
     """The batch archive, written whole and atomically: ``/batch`` (:class:`BatchInfo`) and
     ``/files/<i>`` (one :class:`FileFit` per file, in the order given), read back by
     :func:`modal.archive.read_archive` as ``archive["batch"]`` and the list ``archive["files"]``.
 
     Stored results are copied as HDF5 objects from their part file or the previous archive (which may
-    be ``path`` itself: it is replaced only after the new file is complete and checked); a reused
-    result of a file found under another path gets that path as ``source``.
+    be ``path`` itself: it is replaced only after the new file is complete and checked), each found by
+    its content hash and settings hash, never by its position alone (an archive replaced since it was
+    indexed holds other files at those positions); a reused result of a file found under another path
+    gets that path as ``source``.
+
+    Raises
+    ------
+    ArchiveError
+        A stored result can no longer be read, or its file no longer holds it (replaced during the run):
+        nothing is written, the parts are kept, a rerun completes the archive.
     """
     path = Path(path)
 
@@ -207,8 +235,18 @@ def write_batch_archive(path: str | os.PathLike, info: BatchInfo, entries: Seque
                         continue
                     name, node = entry.location
                     if name not in sources:
-                        sources[name] = h5py.File(name, "r")
-                    sources[name].copy(sources[name][node], files, name=str(i))
+                        try:
+                            sources[name] = h5py.File(name, "r")
+                        except OSError as exc:
+                            raise ArchiveError(f"{path}: the saved result of {entry.source} cannot be read from "
+                                               f"{name} ({' '.join(str(exc).split())}); run the batch again "
+                                               "(what is saved is reused)") from None
+                    stored = _by_content(sources[name], node, entry, info.settings_hash)
+                    if stored is None:
+                        raise ArchiveError(f"{path}: {name} no longer holds the result of {entry.source} (sha256 "
+                                           f"{entry.sha256[:16]}...): it was replaced during the run; run the "
+                                           "batch again")
+                    sources[name].copy(stored, files, name=str(i))
                     group = files[str(i)]
                     if _text(group["source"]) != entry.source:
                         del group["source"]
