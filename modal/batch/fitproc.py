@@ -14,7 +14,9 @@ it does under ``modal fit``.
 A file still fitting after its time limit is listed as failed (``timed out after N s``): its
 process and whatever it forked are killed (a session of their own) and the next file gets a
 new process. A process that dies (a crash outside the readers, the kernel's OOM killer) fails
-that file only. Its memory is its own: a file that needs a lot of it never grows the worker.
+that file only. Its memory is its own: a file that needs a lot of it never grows the worker, and
+the process may grow by the worker's memory limit at most (Dask's budget for the worker: the
+machine's memory shared among the workers), past which the file fails with a MemoryError.
 """
 from __future__ import annotations
 
@@ -32,7 +34,8 @@ from typing import Any
 
 from .records import FileFit
 
-__all__ = ["fit_in_process", "FitProcess", "ProcessEnded", "DEFAULT_FILE_TIMEOUT_S", "shutdown"]
+__all__ = ["fit_in_process", "FitProcess", "ProcessEnded", "DEFAULT_FILE_TIMEOUT_S", "shutdown",
+           "worker_memory_limit"]
 
 #: Default time limit of one file's fit, s. The toolkit's slowest ordinary case, a 100 000-line FRF,
 #: identifies in 0.5-1 s on an idle core and in under 60 s on a loaded one (benchmarks/REPORT.md):
@@ -96,10 +99,26 @@ def _read(fd: int, deadline: float | None = None) -> Any:
     return pickle.loads(body)
 
 
-def serve() -> None:  # pragma: no cover - runs in the fitting process (tests drive it through FitProcess)
+def _limit_memory(budget_bytes: int) -> None:
+    """Let this process grow by at most ``budget_bytes`` of address space beyond what it has now (its
+    interpreter and libraries): past it an allocation fails (numpy's MemoryError) instead of taking
+    the machine's memory."""
+    import resource
+
+    with open("/proc/self/statm") as fh:
+        now = int(fh.read().split()[0]) * os.sysconf("SC_PAGE_SIZE")
+    _, hard = resource.getrlimit(resource.RLIMIT_AS)
+    limit = now + int(budget_bytes)
+    if hard != resource.RLIM_INFINITY:
+        limit = min(limit, hard)
+    resource.setrlimit(resource.RLIMIT_AS, (limit, hard))
+
+
+def serve(memory_budget_bytes: int | None = None) -> None:  # pragma: no cover - runs in the fitting process
     """The fitting process: answer requests ``(path, options, sha256, timeout_s)`` on stdin with a
     :class:`FileFit` on stdout until stdin closes. Whatever the libraries print goes to /dev/null
-    (stdout is the channel of the answers)."""
+    (stdout is the channel of the answers). With ``memory_budget_bytes`` the process may grow by
+    that much at most (:func:`_limit_memory`)."""
     requests, answers = os.dup(0), os.dup(1)
     devnull = os.open(os.devnull, os.O_RDWR)
     os.dup2(devnull, 0)
@@ -107,6 +126,8 @@ def serve() -> None:  # pragma: no cover - runs in the fitting process (tests dr
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the worker decides when this process ends
     from .task import fit_one
 
+    if memory_budget_bytes and sys.platform == "linux":
+        _limit_memory(memory_budget_bytes)
     _write(answers, ("ready", os.getpid()))
     while True:
         try:
@@ -127,16 +148,24 @@ def serve() -> None:  # pragma: no cover - runs in the fitting process (tests dr
 class FitProcess:
     """One fitting process (see the module's description).
 
+    Parameters
+    ----------
+    memory_budget_bytes : int, optional
+        Memory the process may take beyond its interpreter and libraries (the worker's memory limit);
+        past it, a file fails with a MemoryError and the process serves the next one.
+
     Raises
     ------
     ProcessEnded
         The process could not be started.
     """
 
-    def __init__(self) -> None:
+    def __init__(self, memory_budget_bytes: int | None = None) -> None:
+        self.memory_budget_bytes = int(memory_budget_bytes) if memory_budget_bytes else None
         try:
             self._proc = subprocess.Popen(
-                [sys.executable, "-c", "from modal.batch.fitproc import serve; serve()"],
+                [sys.executable, "-c",
+                 f"from modal.batch.fitproc import serve; serve({self.memory_budget_bytes!r})"],
                 stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, start_new_session=True)
         except OSError as exc:
             raise ProcessEnded(f"cannot start a fitting process ({exc.strerror or exc})") from None
@@ -203,7 +232,19 @@ _IDLE: list[FitProcess] = []
 _LOCK = threading.Lock()
 
 
-def fit_in_process(path: str, options, sha256: str | None, timeout_s: float | None) -> FileFit:
+def worker_memory_limit() -> int | None:
+    """The memory limit of the Dask worker running this code, bytes (None: none, or not in a worker)."""
+    try:
+        from distributed import get_worker
+
+        limit = get_worker().memory_manager.memory_limit
+    except (ImportError, ValueError, AttributeError):
+        return None
+    return int(limit) if limit else None
+
+
+def fit_in_process(path: str, options, sha256: str | None, timeout_s: float | None,
+                   memory_budget_bytes: int | None = None) -> FileFit:
     """Fit one file in a fitting process of this process (an idle one, or a new one); never raises
     for a bad file.
 
@@ -215,6 +256,9 @@ def fit_in_process(path: str, options, sha256: str | None, timeout_s: float | No
         The hash the caller computed (the file is hashed again by :func:`modal.batch.task.fit_one`).
     timeout_s : float or None
         The file's time limit, s; None for none.
+    memory_budget_bytes : int, optional
+        The memory a fit may take (see :class:`FitProcess`); the Dask worker's memory limit by default
+        when one runs this code.
 
     Returns
     -------
@@ -226,11 +270,16 @@ def fit_in_process(path: str, options, sha256: str | None, timeout_s: float | No
         from .task import fit_one
 
         return fit_one(path, options, sha256)
+    budget = worker_memory_limit() if memory_budget_bytes is None else memory_budget_bytes
+    budget = int(budget) if budget else None
     with _LOCK:
-        proc = _IDLE.pop() if _IDLE else None
+        fitting = [p for p in _IDLE if p.memory_budget_bytes == budget]
+        proc = fitting[-1] if fitting else None
+        if proc is not None:
+            _IDLE.remove(proc)
     try:
         if proc is None or not proc.alive():
-            proc = FitProcess()
+            proc = FitProcess(budget)
         fit = proc.fit(path, options, sha256, timeout_s)
     except ProcessEnded as exc:
         return FileFit(source=path, sha256=sha256 or "", settings=options.settings_json(),

@@ -44,6 +44,10 @@ def fit_one(path: str, options: FitOptions, sha256: str | None = None) -> FileFi
         except ModalError as exc:  # the file's verdict: kept for reruns of the same content
             return FileFit(source=path, sha256=sha256, settings=settings, settings_hash=settings_hash,
                            error=one_line(exc), fit_time_s=time.perf_counter() - start)
+        except MemoryError as exc:  # past the fitting process's memory budget (the worker's memory limit)
+            return FileFit(source=path, sha256=sha256, settings=settings, settings_hash=settings_hash,
+                           error=f"{path}: out of memory ({one_line(exc)}); a file may use the worker's memory "
+                                 "limit at most", retry=True, fit_time_s=time.perf_counter() - start)
         except Exception as exc:  # noqa: BLE001 - per-file failures are data; a rerun tries again
             return FileFit(source=path, sha256=sha256, settings=settings, settings_hash=settings_hash,
                            error=one_line(exc), retry=True, fit_time_s=time.perf_counter() - start)

@@ -90,3 +90,36 @@ def test_the_time_limit_must_be_a_positive_time(tmp_path):
             fit_files(tmp_path, file_timeout_s=bad)
     done = run_cli(tmp_path, "--out", tmp_path / "r.h5", "--file-timeout", -5)
     assert done.returncode == 2 and "--file-timeout -5: expected seconds > 0" in done.stderr
+
+
+def test_a_file_needing_more_memory_than_its_budget_fails_alone(tmp_path):
+    """The fitting process may grow by its budget (in a batch: the worker's memory limit) at most:
+    an 8-channel 100 000-line FRF (13 MB of data, several copies while it is identified) does not fit
+    in 60 MB and fails with one line; the same process then fits a small file."""
+    import numpy as np
+
+    from modal.synthetic import add_noise, modal_frf
+
+    freq = np.linspace(10.0, 5010.0, 100_000)
+    big = add_noise(modal_frf(freq, [500.0, 2000.0], [0.01, 0.01], np.ones((8, 2)), kind="mobility"), 1e-3, seed=0)
+    write_frf(big, tmp_path / "big.h5")
+    write_frf(mobility(), tmp_path / "small.uff")
+    proc = FitProcess(memory_budget_bytes=60e6)
+    try:
+        failed = proc.fit(str(tmp_path / "big.h5"), FitOptions(), None, 120.0)
+        assert failed.retry and failed.error.startswith(f"{tmp_path / 'big.h5'}: out of memory (MemoryError: ")
+        fitted = proc.fit(str(tmp_path / "small.uff"), FitOptions(), None, 120.0)
+        assert fitted.ok and proc.alive()
+    finally:
+        proc.close()
+
+
+def test_in_a_worker_the_budget_is_the_workers_memory_limit(dask_cluster):
+    from distributed import Client
+
+    from modal.batch.fitproc import worker_memory_limit
+
+    assert worker_memory_limit() is None  # not in a worker: no budget
+    with Client(dask_cluster[0], timeout="30s", set_as_default=False) as client:
+        limits = {w["memory_limit"] for w in client.scheduler_info()["workers"].values()}
+        assert client.submit(worker_memory_limit, pure=False).result() in limits and min(limits) > 0
