@@ -4,7 +4,8 @@ The embedded cluster is quiet: its scheduler and workers listen on 127.0.0.1 for
 protocol only. Dask starts an HTTP server (dashboard, metrics, health) in the scheduler on port
 8787 and in every worker; here none is started unless a dashboard is asked for, so a batch opens
 no web port and never reports that port 8787 is taken. It also closes cleanly: a worker's
-heartbeat cut short by its own shutdown is not reported as an error.
+heartbeat cut short by its own shutdown is not reported as an error. The caller's environment
+variables are left as they were (Dask's nannies set their workers' in it).
 """
 from __future__ import annotations
 
@@ -145,6 +146,23 @@ def open_client(client: Any = None, workers: int | None = None, dashboard: str |
         with connected:
             yield connected
         return
-    with local_cluster(workers or default_workers(), dashboard) as cluster, \
-            Client(cluster, set_as_default=False) as local:
-        yield local
+    saved = dict(os.environ)
+    try:
+        with local_cluster(workers or default_workers(), dashboard) as cluster:
+            _restore_environment(saved)
+            with Client(cluster, set_as_default=False) as local:
+                yield local
+    finally:
+        _restore_environment(saved)  # again: a nanny that restarted its worker set them once more
+
+
+def _restore_environment(saved: dict[str, str]) -> None:
+    """Put back this process's environment as it was. A Dask nanny sets variables for the worker it
+    spawns (OMP_NUM_THREADS=1, PYTHONHASHSEED, ...) in its own process's environment, here the caller's,
+    where every subprocess the caller starts afterwards would inherit them (one BLAS thread, another
+    hash seed). The workers have their copies already; a nanny sets them again before a restart."""
+    for name in set(os.environ) - set(saved):
+        del os.environ[name]
+    for name, value in saved.items():
+        if os.environ.get(name) != value:
+            os.environ[name] = value

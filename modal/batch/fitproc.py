@@ -20,6 +20,7 @@ machine's memory shared among the workers), past which the file fails with a Mem
 """
 from __future__ import annotations
 
+import atexit
 import math
 import os
 import pickle
@@ -278,7 +279,10 @@ def fit_in_process(path: str, options, sha256: str | None, timeout_s: float | No
         if proc is not None:
             _IDLE.remove(proc)
     try:
-        if proc is None or not proc.alive():
+        if proc is not None and not proc.alive():
+            proc.kill()  # ended while idle: reap it
+            proc = None
+        if proc is None:
             proc = FitProcess(budget)
         fit = proc.fit(path, options, sha256, timeout_s)
     except ProcessEnded as exc:
@@ -291,9 +295,12 @@ def fit_in_process(path: str, options, sha256: str | None, timeout_s: float | No
 
 
 def shutdown() -> None:
-    """End the idle fitting processes of this process."""
+    """End the idle fitting processes of this process (at its exit, or when a caller is done)."""
     with _LOCK:
         idle = list(_IDLE)
         _IDLE.clear()
     for proc in idle:
         proc.close()
+
+
+atexit.register(shutdown)

@@ -53,9 +53,12 @@ class LockHolder:
 
     @classmethod
     def here(cls) -> "LockHolder":
+        """This process, now."""
+        program = sys.argv[0] if sys.argv else ""
+        program = "python -m modal" if program.endswith("__main__.py") else os.path.basename(program) or "python"
         return cls(pid=os.getpid(), host=socket.gethostname(),
                    started=datetime.now().astimezone().isoformat(timespec="seconds"),
-                   command=" ".join([os.path.basename(sys.argv[0] or "python"), *sys.argv[1:]])[:300])
+                   command=" ".join([program, *sys.argv[1:]])[:300])
 
     @classmethod
     def parse(cls, text: str) -> "LockHolder | None":

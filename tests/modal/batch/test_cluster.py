@@ -147,3 +147,17 @@ def test_the_embedded_cluster_closes_without_a_traceback(tmp_path):
     assert done.returncode == 0, done.stderr
     assert "Traceback" not in done.stderr and "ERROR" not in done.stderr, done.stderr
     assert done.stderr == ""
+
+
+def test_the_embedded_cluster_leaves_the_callers_environment_as_it_was(tmp_path):
+    """Dask's nannies set their workers' variables (OMP_NUM_THREADS=1, PYTHONHASHSEED, ...) in their
+    own process's environment: here the caller's, whose later subprocesses then ran with one BLAS
+    thread and another hash seed (tests/test_determinism.py's digests differed after such a run)."""
+    import os
+
+    from modal.batch import fit_files
+
+    before = dict(os.environ)
+    result = fit_files(write_inputs(tmp_path / "in", n=1), workers=1)
+    assert result.fitted == 1
+    assert dict(os.environ) == before

@@ -12,7 +12,7 @@ import pytest
 
 from modal.archive import read_archive
 from modal.batch import fit_files
-from modal.batch.fitproc import FitProcess, ProcessEnded, fit_in_process
+from modal.batch.fitproc import FitProcess, ProcessEnded, fit_in_process, shutdown
 from modal.errors import ParameterError
 from modal.fitting import FitOptions
 from modal.io import write_frf
@@ -79,8 +79,12 @@ def test_fitted_in_a_process_equals_fitted_here(tmp_path):
     path = tmp_path / "a.uff"
     write_frf(mobility(), path)
     here = fit_one(str(path), FitOptions(method="nls"))
-    there = fit_in_process(str(path), FitOptions(method="nls"), None, 60.0)
-    assert there.ok and there.table == here.table and there.sha256 == here.sha256
+    try:
+        there = fit_in_process(str(path), FitOptions(method="nls"), None, 60.0)
+        again = fit_in_process(str(path), FitOptions(method="nls"), None, 60.0)  # the same process, kept
+    finally:
+        shutdown()
+    assert there.ok and there.table == here.table == again.table and there.sha256 == here.sha256
 
 
 def test_the_time_limit_must_be_a_positive_time(tmp_path):

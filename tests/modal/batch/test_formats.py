@@ -1,7 +1,8 @@
 """Every format ``modal fit`` reads, fitted by ``modal batch`` on a real scheduler whose two workers
-run as ``dask worker`` deploys them (each a daemonic child process of its nanny), and the
-readers' protection against hostile files kept there: a file that crashes or hangs its reader
-fails alone, the worker lives on, the other files are fitted."""
+run as ``dask worker`` deploys them (each a daemonic child process of its nanny) and on the embedded
+cluster (whose workers are daemonic too); and the readers' protection against hostile files kept
+there: a file that crashes or hangs its reader fails alone, the worker lives on, the other files
+are fitted."""
 from __future__ import annotations
 
 import csv
@@ -10,6 +11,8 @@ import subprocess
 import sys
 from collections import defaultdict
 from pathlib import Path
+
+import pytest
 
 from modal.archive import read_archive
 from modal.batch import file_sha256
@@ -30,10 +33,18 @@ def frequencies_by_file(table: Path) -> dict[str, list[tuple[float, float]]]:
     return found
 
 
-def test_every_format_is_fitted_on_a_cluster_with_daemonic_workers(dask_cluster, tmp_path):
-    truth = write_every_format(tmp_path / "every")
+@pytest.fixture(scope="module")
+def every(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("formats") / "every"
+    return folder, write_every_format(folder)
+
+
+@pytest.mark.parametrize("where", ["scheduler", "embedded"])
+def test_every_format_is_fitted_on_a_cluster_with_daemonic_workers(every, where, dask_cluster, tmp_path):
+    folder, truth = every
     out = tmp_path / "r.h5"
-    done = run_cli(tmp_path / "every", "--out", out, "--scheduler", dask_cluster[0], "--kind", "mobility", "--json")
+    cluster = ["--scheduler", dask_cluster[0]] if where == "scheduler" else ["--workers", 2]
+    done = run_cli(folder, "--out", out, *cluster, "--kind", "mobility", "--json")
     assert done.returncode == 0, done.stderr
     doc = json.loads(done.stdout)
     assert (doc["files"], doc["fitted"], doc["failed"]) == (len(truth), len(truth), [])
