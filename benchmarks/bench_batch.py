@@ -4,7 +4,7 @@ Run ``python -m benchmarks.bench_batch [--files N] [--lines N] [--runs N] [--wor
 The files are UFF 58 driving-point mobilities with two modes and 0.1 % noise, fitted with the
 default options (method auto: band-wise NLS). Rows:
 
-- one process looping: :func:`modal.batch.task.fit_one` over the files in this process (no Dask,
+- one process looping: :func:`modal.batch.fitone.fit_one` over the files in this process (no Dask,
   no archive): the baseline; and the same loop writing the same archive at the end (one
   :func:`modal.archive.write_archive` of every result: what the batch's archive costs per file);
 - ``fit_files(..., workers=N, out=...)`` on the embedded LocalCluster (start of the cluster,
@@ -37,7 +37,7 @@ import numpy as np
 from modal.archive import write_archive
 from modal.batch import fit_files, find_files
 from modal.batch.cluster import default_workers
-from modal.batch.task import fit_one
+from modal.batch.fitone import fit_one
 from modal.fitting import FitOptions
 from modal.io import write_frf
 from modal.synthetic import add_noise, modal_frf

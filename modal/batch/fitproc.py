@@ -125,7 +125,7 @@ def serve(memory_budget_bytes: int | None = None) -> None:  # pragma: no cover -
     os.dup2(devnull, 0)
     os.dup2(devnull, 1)
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the worker decides when this process ends
-    from .task import fit_one
+    from .fitone import fit_one
 
     if memory_budget_bytes and sys.platform == "linux":
         _limit_memory(memory_budget_bytes)
@@ -254,7 +254,7 @@ def fit_in_process(path: str, options, sha256: str | None, timeout_s: float | No
     path : str
     options : FitOptions
     sha256 : str, optional
-        The hash the caller computed (the file is hashed again by :func:`modal.batch.task.fit_one`).
+        The hash the caller computed (the file is hashed again by :func:`modal.batch.fitone.fit_one`).
     timeout_s : float or None
         The file's time limit, s; None for none.
     memory_budget_bytes : int, optional
@@ -268,7 +268,7 @@ def fit_in_process(path: str, options, sha256: str | None, timeout_s: float | No
         whose process died is marked ``retry`` (a rerun tries it again).
     """
     if os.name != "posix":  # pragma: no cover - no sessions or pipes to select on: fitted here, without a limit
-        from .task import fit_one
+        from .fitone import fit_one
 
         return fit_one(path, options, sha256)
     budget = worker_memory_limit() if memory_budget_bytes is None else memory_budget_bytes

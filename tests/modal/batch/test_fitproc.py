@@ -74,7 +74,7 @@ def test_a_timed_out_process_and_the_reader_it_forked_are_ended(tmp_path):
 
 
 def test_fitted_in_a_process_equals_fitted_here(tmp_path):
-    from modal.batch.task import fit_one
+    from modal.batch.fitone import fit_one
 
     path = tmp_path / "a.uff"
     write_frf(mobility(), path)

@@ -1,0 +1,60 @@
+"""Read and fit one file as ``modal fit`` does, never raising for a bad file: the unit of work of a
+batch, run in a fitting process (:mod:`modal.batch.fitproc`) or in the caller's."""
+from __future__ import annotations
+
+import time
+import warnings
+
+from ..errors import ModalError
+from ..fitting import FitOptions, fit_path
+from .discover import file_sha256
+from .records import FileFit, one_line
+from .store import table_text
+
+__all__ = ["fit_one"]
+
+
+def fit_one(path: str, options: FitOptions, sha256: str | None = None) -> FileFit:
+    """Fit one file as ``modal fit`` does; never raises for a bad file.
+
+    Parameters
+    ----------
+    path : str
+    options : FitOptions
+    sha256 : str, optional
+        The hash the caller computed; the file is hashed again here and that hash is recorded
+        (a file replaced in between is keyed by what was fitted).
+
+    Returns
+    -------
+    FileFit
+        With ``error`` set (one line) when the file could not be read or fitted.
+    """
+    settings, settings_hash = options.settings_json(), options.settings_hash()
+    start = time.perf_counter()
+    try:
+        sha256 = file_sha256(path)
+    except OSError as exc:
+        return FileFit(source=path, sha256=sha256 or "", settings=settings, settings_hash=settings_hash,
+                       error=one_line(exc), retry=True)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            out = fit_path(path, options)
+        except ModalError as exc:  # the file's verdict: kept for reruns of the same content
+            return FileFit(source=path, sha256=sha256, settings=settings, settings_hash=settings_hash,
+                           error=one_line(exc), fit_time_s=time.perf_counter() - start)
+        except MemoryError as exc:  # past the fitting process's memory budget (the worker's memory limit)
+            return FileFit(source=path, sha256=sha256, settings=settings, settings_hash=settings_hash,
+                           error=f"{path}: out of memory ({one_line(exc)}); a file may use the worker's memory "
+                                 "limit at most", retry=True, fit_time_s=time.perf_counter() - start)
+        except Exception as exc:  # noqa: BLE001 - per-file failures are data; a rerun tries again
+            return FileFit(source=path, sha256=sha256, settings=settings, settings_hash=settings_hash,
+                           error=one_line(exc), retry=True, fit_time_s=time.perf_counter() - start)
+    frf = out.frf
+    texts = tuple(dict.fromkeys(" ".join(str(w.message).split()) for w in caught))
+    return FileFit(source=path, sha256=sha256, settings=settings, settings_hash=settings_hash,
+                   kind=frf.kind, n_channels=int(frf.n_channels), n_lines=int(frf.n_freq),
+                   frequency_range_hz=(float(frf.frequency_hz[0]), float(frf.frequency_hz[-1])),
+                   results=tuple(out.results), warnings=texts, fit_time_s=time.perf_counter() - start,
+                   table=table_text(out.results))
