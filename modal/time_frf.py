@@ -2,23 +2,25 @@
 
 The fit service (:mod:`modal.fitting`) and the command line (:mod:`modal.cli`,
 whose options :mod:`modal.cli_time` declares) both call :func:`frf_from_time`, so a
-time file gives the same FRFs either way.
+time file gives the same FRFs either way; a scene's ``[frf]`` table takes the same options
+under the same names and calls :func:`plan_time_frf` (when the scene is checked) and
+:func:`estimate_time_frf` (when its stage runs).
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Callable
 
 from .errors import FormatError
 from .estimate import estimate_frf
 from .frf import FRF_KINDS
 
-__all__ = ["TIME_OPTIONS", "wants_time", "frf_from_time"]
+__all__ = ["TIME_OPTIONS", "wants_time", "frf_from_time", "TimePlan", "plan_time_frf", "estimate_time_frf"]
 
 #: the attribute names the time options set (None when not given)
 TIME_OPTIONS = ("excitation", "response", "impact", "estimator", "window", "exponential_decay_s", "segment_length",
                 "overlap")
 _KIND_OF_QUANTITY = {"displacement": "receptance", "velocity": "mobility", "acceleration": "accelerance"}
-
 
 
 def wants_time(args, path) -> bool:
@@ -49,6 +51,56 @@ def frf_from_time(path, args, report: Callable[[str], None] | None = None):
     from .io.timedata import read_time
 
     record = read_time(path)
+    plan = plan_time_frf(record, args, report)
+    return estimate_time_frf(record, plan, args), record, list(plan.inputs), list(plan.outputs)
+
+
+@dataclass(frozen=True)
+class TimePlan:
+    """Which channels of a time record give which FRF: what can be checked before any estimation.
+
+    Attributes
+    ----------
+    inputs, outputs : tuple of int
+        0-based indices of the excitation and response channels.
+    kind : str
+        The FRF kind to estimate.
+    quantity : str or None
+        What the responses measured (None when the file does not say).
+    """
+
+    inputs: tuple[int, ...]
+    outputs: tuple[int, ...]
+    kind: str
+    quantity: str | None
+
+
+def _command_line_option(name: str) -> str:
+    return "--" + name.replace("_", "-")
+
+
+def plan_time_frf(record, args, report: Callable[[str], None] | None = None,
+                  option: Callable[[str], str] = _command_line_option) -> TimePlan:
+    """The excitation and response channels and the FRF kind, from the options and the record.
+
+    Parameters
+    ----------
+    record : TimeRecord
+    args : object
+        The time options as attributes (:data:`TIME_OPTIONS`, and ``kind``).
+    report : callable, optional
+        Called with a one-line note (the excitation channel taken when none was named).
+    option : callable
+        An option's name as the user writes it, in messages (default: the command line's
+        ``--exponential-decay-s``; a scene names its key).
+
+    Raises
+    ------
+    FormatError
+        A channel that does not exist (the message lists the valid ones), no or several
+        force channels and none named, a channel in the wrong role, or a kind the file does
+        not tell and the options do not give.
+    """
     src = record.source
     if args.excitation is not None:
         inputs = [record.channel_index(args.excitation)]
@@ -59,7 +111,7 @@ def frf_from_time(path, args, report: Callable[[str], None] | None = None):
                                 for k, (n, q) in enumerate(zip(record.names, record.quantities)))
             what = "no channel" if not inputs else f"{len(inputs)} channels"
             raise FormatError(f"{src}: {what} marked as force ({listing}); expected one: name the force channel "
-                              "with --excitation CHANNEL (an FRF needs an excitation)")
+                              f"with {option('excitation')} (an FRF needs an excitation)")
     if args.response:
         outputs = [record.channel_index(r) for r in args.response]
     else:
@@ -74,15 +126,20 @@ def frf_from_time(path, args, report: Callable[[str], None] | None = None):
     kind = getattr(args, "kind", None) or _KIND_OF_QUANTITY.get(quantity or "")
     if kind is None:
         listing = ", ".join(record.describe(k) for k in outputs)
-        raise FormatError(f"{src}: the file does not say what the responses measured ({listing}); give --kind "
-                          f"({', '.join(FRF_KINDS)})")
+        raise FormatError(f"{src}: the file does not say what the responses measured ({listing}); give "
+                          f"{option('kind')} ({', '.join(FRF_KINDS)})")
+    return TimePlan(tuple(inputs), tuple(outputs), kind, quantity)
+
+
+def estimate_time_frf(record, plan: TimePlan, args):
+    """The FRFs of ``record`` as ``plan`` says, with the estimation options of ``args`` (an EstimatedFRF)."""
+    inputs, outputs = list(plan.inputs), list(plan.outputs)
     window = args.window or ("force" if args.impact else "hann")
-    estimate = estimate_frf(
+    return estimate_frf(
         record.signals[inputs], record.signals[outputs], record.sample_rate_hz,
-        estimator=args.estimator or "H1", kind=kind, segment_length=args.segment_length,
+        estimator=args.estimator or "H1", kind=plan.kind, segment_length=args.segment_length,
         overlap=0.5 if args.overlap is None else args.overlap, window=window,
         exponential_decay_s=args.exponential_decay_s, impact=args.impact,
-        response_quantity=quantity, excitation_points=[record.names[k] for k in inputs],
-        response_points=[record.names[k] for k in outputs], source=src,
+        response_quantity=plan.quantity, excitation_points=[record.names[k] for k in inputs],
+        response_points=[record.names[k] for k in outputs], source=record.source,
         full_scale=None if record.full_scale is None else [record.full_scale[k] for k in inputs + outputs])
-    return estimate, record, inputs, outputs

@@ -16,8 +16,17 @@ from modal.io._atomic import atomic_path
 
 from .registry import REGISTRY, load
 
-__all__ = ["stage_figures", "save_stage_plot", "preload", "identify_figures", "stability_figures", "response_figures",
+__all__ = ["stage_figures", "save_stage_plot", "preload", "frf_figures", "identify_figures", "stability_figures", "response_figures",
            "compressor_figures", "mounts_figures", "drive_figures", "balance_figures"]
+
+
+def frf_figures(results):
+    """An FRF estimated from a time record: its magnitude with the coherence; nothing for an FRF file."""
+    from modal.estimate import EstimatedFRF
+    from modal.estimate.plots import plot_estimate
+
+    frf = results["frf"]
+    return [("estimate", plot_estimate(frf))] if isinstance(frf, EstimatedFRF) else []
 
 
 def identify_figures(results):

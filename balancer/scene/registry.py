@@ -27,6 +27,9 @@ from .rules import BOOL, INT, NONNEG, NUM, POS, STR, choice, complex_value, list
 __all__ = ["Stage", "REGISTRY", "STAGES", "load"]
 
 _KINDS = choice("receptance", "mobility", "accelerance")
+#: modal.estimate.ESTIMATORS and WINDOWS (the time options' choices; a test keeps them equal)
+_ESTIMATORS = ("H1", "H2", "Hv")
+_WINDOWS = ("rect", "hann", "force", "exponential")
 
 
 def _harmonics(v):
@@ -36,6 +39,28 @@ def _harmonics(v):
 def _mount_vector(v):
     """A mount's stiffness or damping: three values (x, y, z), or one identified value for all three."""
     return ref_or(POS, ("identified",))(v) if isinstance(v, str) else list_of(NONNEG, length=3)(v)
+
+
+def _time_channel(v):
+    """A channel of a time record: its number (from 1, in file order) or its name."""
+    if isinstance(v, str):
+        return STR(v)
+    if isinstance(v, bool) or not isinstance(v, int) or v < 1:
+        raise ValueError("a channel number from 1 (in file order) or a channel name")
+    return v
+
+
+def _positive_int(v):
+    if INT(v) < 1:
+        raise ValueError("a positive integer")
+    return v
+
+
+def _fraction(v):
+    v = NONNEG(v)
+    if v >= 1:
+        raise ValueError("a fraction 0 <= f < 1")
+    return v
 
 
 def _radius(v):
@@ -122,6 +147,10 @@ REGISTRY: dict[str, Stage] = {stage.name: stage for stage in (
             # the read options of `python -m modal fit`, under the same names
             "frequency_axis": choice("hz", "khz", "rad/s", "cpm", "rpm"), "frequency_step": POS,
             "frequency_start": NONNEG, "layout": STR, "delimiter": STR, "decimal": STR, "dataset": INT,
+            # a time record (hammer or shaker test): the time options of `python -m modal fit`, same names
+            "excitation": _time_channel, "response": list_of(_time_channel), "impact": BOOL,
+            "estimator": choice(*_ESTIMATORS), "window": choice(*_WINDOWS), "exponential_decay_s": POS,
+            "segment_length": _positive_int, "overlap": _fraction,
             "synthetic": {
                 "natural_frequency_hz": list_of(POS), "damping_ratio": list_of(NONNEG),
                 "modal_constant": list_of(complex_value), "kind": _KINDS,
@@ -129,6 +158,7 @@ REGISTRY: dict[str, Stage] = {stage.name: stage for stage in (
             },
         }},
         required={"frf.synthetic": ("natural_frequency_hz", "damping_ratio", "modal_constant", "f_max_hz", "n_lines")},
+        figures=f"{_PLOTS}:frf_figures", plot_inputs=("frf",), plot_modules=("modal.estimate.plots",),
         digest=f"{_SUMMARY}:frf_digest", rows=f"{_SUMMARY}:frf_rows"),
     Stage(
         "identify", run=f"{_STAGES}:stage_identify", needs=("frf",), depends=("frf",),

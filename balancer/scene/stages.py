@@ -83,6 +83,9 @@ class MountsStage:
 #: [frf] keys passed to modal.io.read_frf: the read options of ``python -m modal fit`` under the same names
 FRF_READ_OPTIONS = ("kind", "frequency_axis", "frequency_step", "frequency_start", "layout", "delimiter", "decimal",
                     "dataset")
+#: [frf] keys of a time record: the time options of ``python -m modal fit`` (modal.time_frf.TIME_OPTIONS), and ``kind``
+TIME_FRF_OPTIONS = ("excitation", "response", "impact", "estimator", "window", "exponential_decay_s",
+                    "segment_length", "overlap")
 
 
 # ---------------------------------------------------------------- references
@@ -147,13 +150,66 @@ def resolve(value, key: str, scene: Scene, identified=None, drive=None) -> float
 
 
 # -------------------------------------------------------------------- checks when the scene is read
-def check_frf(scene: Scene) -> None:
-    """[frf] names a file or describes a synthetic FRF: one of them."""
+def check_frf(scene: Scene):
+    """[frf] names a file or describes a synthetic FRF: one of them, with the options that apply to it.
+
+    A time record (a hammer or shaker test) is read here, its channels chosen and their roles
+    checked before any work: returns ``(record, plan)`` (:func:`modal.time_frf.plan_time_frf`)
+    for the stage to estimate from; None for an FRF file or a synthetic FRF.
+    """
     cfg = scene.section("frf")
     if "file" in cfg and "synthetic" in cfg:
         raise SceneError(f"{scene.source}: key 'frf' has both 'file' and 'synthetic'; expected one of them")
     if "file" not in cfg and "synthetic" not in cfg:
         raise SceneError(f"{scene.source}: key 'frf' needs 'file' or a [frf.synthetic] table")
+    time_keys = [k for k in TIME_FRF_OPTIONS if k in cfg]
+    if "synthetic" in cfg:
+        if time_keys:
+            raise SceneError(f"{scene.source}: key 'frf.{time_keys[0]}' applies to a time record in 'file'; "
+                             "expected no time options with [frf.synthetic]")
+        return None
+    from modal.errors import ModalError
+    from modal.time_frf import wants_time
+
+    path = scene.folder / cfg["file"]
+    if not wants_time(_time_options(cfg), path):
+        return None
+    read_keys = [k for k in FRF_READ_OPTIONS if k in cfg and k != "kind"]
+    if read_keys:
+        raise SceneError(f"{scene.source}: key 'frf.{read_keys[0]}' applies to an FRF file, but {cfg['file']!r} is a "
+                         f"time record; expected its time options ({', '.join(TIME_FRF_OPTIONS)}, kind)")
+    from modal.io.timedata import read_time
+    from modal.time_frf import plan_time_frf
+
+    try:
+        record = read_time(path)
+    except ModalError as exc:
+        raise SceneError(f"{scene.source}: key 'frf.file' = {cfg['file']!r}: {exc}") from None
+    # each named channel is looked up under its own key, so that an error names it
+    for key, spec in [("excitation", cfg.get("excitation"))] + [
+            (f"response[{i}]", r) for i, r in enumerate(cfg.get("response", []))]:
+        if spec is None:
+            continue
+        try:
+            record.channel_index(spec)
+        except ModalError as exc:
+            raise SceneError(f"{scene.source}: key 'frf.{key}' = {spec!r}: {exc}") from None
+    try:
+        plan = plan_time_frf(record, _time_options(cfg), option=lambda name: f"frf.{name}")
+    except ModalError as exc:
+        raise SceneError(f"{scene.source}: key 'frf': {exc}") from None
+    return record, plan
+
+
+def _time_options(cfg: dict):
+    """The [frf] time options as the attributes :mod:`modal.time_frf` reads (the command line's names)."""
+    from types import SimpleNamespace
+
+    values = {name: cfg.get(name) for name in TIME_FRF_OPTIONS}
+    values["impact"] = bool(values["impact"])
+    values["excitation"] = None if values["excitation"] is None else str(values["excitation"])
+    values["response"] = None if values["response"] is None else [str(r) for r in values["response"]]
+    return SimpleNamespace(kind=cfg.get("kind"), **values)
 
 
 def read_balance_job(scene: Scene):
@@ -174,8 +230,15 @@ def read_balance_job(scene: Scene):
 
 # -------------------------------------------------------------------- stages
 def stage_frf(scene: Scene) -> modal.FRF:
-    """Read the FRF file or make the synthetic FRF."""
+    """Read the FRF file, estimate the FRF of a time record (an :class:`~modal.estimate.EstimatedFRF`), or
+    make the synthetic FRF."""
     cfg = scene.section("frf")
+    timed = scene.inputs["frf"]
+    if timed is not None:  # a time record, read and checked with the scene
+        from modal.time_frf import estimate_time_frf
+
+        record, plan = timed
+        return estimate_time_frf(record, plan, _time_options(cfg))
     if "file" in cfg:
         from modal.io import read_frf
 

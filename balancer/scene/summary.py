@@ -32,11 +32,25 @@ def _table(stage: str, result) -> list[str]:
 # ------------------------------------------------------------------ each stage's digest and summary rows
 # (named by the stage's entry in balancer.scene.registry; a row function gets the result and its digest)
 def frf_digest(result) -> dict:
-    return {"n_channels": result.n_channels, "n_lines": result.n_freq, "kind": result.kind}
+    from modal.estimate import EstimatedFRF
+
+    d = {"n_channels": result.n_channels, "n_lines": result.n_freq, "kind": result.kind}
+    if isinstance(result, EstimatedFRF):  # estimated from a time record in the scene
+        d["estimate"] = {"source": result.source, "estimator": result.estimator, "window": result.window,
+                         "averages": result.averages, "rejected": [dict(r) for r in result.rejected],
+                         "excitation_points": list(result.reference_points or ()),
+                         "response_points": list(result.response_points or ())}
+    return d
 
 
 def frf_rows(result, d: dict) -> list[str]:
-    return [f"  {d['n_channels']} channel(s), {d['n_lines']} lines, {d['kind']}"]
+    rows = [f"  {d['n_channels']} channel(s), {d['n_lines']} lines, {d['kind']}"]
+    est = d.get("estimate")
+    if est is not None:
+        rejected = "; ".join(f"hit {r['hit']} at {r['time_s']:.3g} s: {r['reason']}" for r in est["rejected"])
+        rows.append(f"  estimated from {est['source']}: {est['estimator']}, {est['averages']} average(s), window "
+                    f"{est['window']}; {len(est['rejected'])} hit(s) rejected{': ' + rejected if rejected else ''}")
+    return rows
 
 
 def identify_digest(result) -> dict:

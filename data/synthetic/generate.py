@@ -9,6 +9,14 @@ demo_frf.csv
     c = 20 N s/m: 15.61 Hz, ζ = 9.8 %) and two housing modes (120 Hz, 2 %;
     310 Hz, 1.5 %), 0.25 Hz lines up to 400 Hz, noise 0.5 % of max |H|.
 
+hammer.csv
+    The rig's hammer test as recorded: force and driving-point acceleration (both at point
+    1+Z) sampled at 1024 Hz for 10 s, eight hits 1.25 s apart (2 ms half-sine pulses of
+    about 50 N, 10 % scatter in peak and width; each response dies out before the next hit), white measurement noise of 0.2 % (force) and
+    0.5 % (acceleration) of each channel's peak. Exact discrete time (modal.synthetic's
+    impact_record): the rotor's mode (the demo's M, k, c) and the two housing modes;
+    hammer_scene.toml runs it from the record to the balancing studies.
+
 plate_geometry.uff, plate_frf.uff
     A simply supported steel plate (0.6 m x 0.4 m x 3 mm) measured on a 6 x 5 grid: the
     geometry (UFF 15 nodes, UFF 82 trace lines along the grid) and roving-accelerometer
@@ -42,19 +50,47 @@ def demo_frf():
     """The demo FRF object (accelerance, one driving-point channel)."""
     from modal.synthetic import add_noise, modal_frf
 
-    wn = np.sqrt(RIG_STIFFNESS_N_PER_M / RIG_MASS_KG)
-    zeta = RIG_DAMPING_N_S_PER_M / (2 * np.sqrt(RIG_STIFFNESS_N_PER_M * RIG_MASS_KG))
     f = np.arange(1, 1601) * 0.25
     frf = modal_frf(
         f,
-        [wn / (2 * np.pi), *HOUSING_FREQUENCY_HZ],
-        [zeta, *HOUSING_DAMPING_RATIO],
-        [1 / RIG_MASS_KG, *HOUSING_MODAL_CONSTANT],
+        *rig_modes(),
         kind="accelerance",
         response_points=["1+X"],
         reference_points=["1+X"],
     )
     return add_noise(frf, NOISE_LEVEL, seed=SEED)
+
+
+#: the rig's hammer test (SI): sample rate, record length, hits, pulse and noise
+HAMMER_SAMPLE_RATE_HZ = 1024.0
+HAMMER_DURATION_S = 10.0
+HAMMER_HIT_TIMES_S = tuple(0.2 + 1.25 * i for i in range(8))
+HAMMER_PULSE_WIDTH_S = 0.002
+HAMMER_PEAK_N = 50.0
+HAMMER_SCATTER = 0.1
+HAMMER_FORCE_NOISE = 0.002
+HAMMER_RESPONSE_NOISE = 0.005
+
+
+def rig_modes():
+    """The rig's modes: (natural frequencies, Hz; damping ratios; driving-point modal constants, 1/kg)."""
+    wn = np.sqrt(RIG_STIFFNESS_N_PER_M / RIG_MASS_KG)
+    zeta = RIG_DAMPING_N_S_PER_M / (2 * np.sqrt(RIG_STIFFNESS_N_PER_M * RIG_MASS_KG))
+    return ([wn / (2 * np.pi), *HOUSING_FREQUENCY_HZ], [zeta, *HOUSING_DAMPING_RATIO],
+            [1 / RIG_MASS_KG, *HOUSING_MODAL_CONSTANT])
+
+
+def hammer_record():
+    """The rig's hammer test (a SyntheticRecord: the record and the digital system it came from)."""
+    from modal.synthetic import DigitalModes, impact_record
+
+    frequency_hz, damping_ratio, modal_constant = rig_modes()
+    system = DigitalModes(frequency_hz, damping_ratio, [modal_constant], HAMMER_SAMPLE_RATE_HZ)
+    return impact_record(system, HAMMER_HIT_TIMES_S, HAMMER_DURATION_S, pulse_width_s=HAMMER_PULSE_WIDTH_S,
+                         amplitude_n=HAMMER_PEAK_N, amplitude_variation=HAMMER_SCATTER,
+                         width_variation=HAMMER_SCATTER, force_noise=HAMMER_FORCE_NOISE,
+                         response_noise=HAMMER_RESPONSE_NOISE, response_quantity="acceleration",
+                         names=["1+Z", "1+Z"], seed=SEED + 2, source="hammer.csv")
 
 
 #: the plate (SI): size, areal mass, the five modes (m, n) and their damping ratios
@@ -135,16 +171,19 @@ def _fixed_date(path: Path) -> None:
 def main(out_dir: Path = HERE) -> list[Path]:
     from modal.io import write_frf
     from modal.io.geometry import write_geometry_uff
+    from modal.io.timewrite import write_time
 
     out_dir.mkdir(parents=True, exist_ok=True)
     path = out_dir / "demo_frf.csv"
     write_frf(demo_frf(), path)
+    hammer = out_dir / "hammer.csv"
+    write_time(hammer_record().record, hammer)
     geometry = out_dir / "plate_geometry.uff"
     write_geometry_uff(plate_geometry(), geometry)
     frf = out_dir / "plate_frf.uff"
     write_frf(plate_frf(), frf)
     _fixed_date(frf)
-    return [path, geometry, frf]
+    return [path, hammer, geometry, frf]
 
 
 if __name__ == "__main__":
