@@ -25,8 +25,9 @@ def build_parser(influence: bool = True) -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True)
     run = sub.add_parser("run", help="run a scene end to end")
     run.add_argument("scene", help="scene TOML file")
-    run.add_argument("--out", metavar="ARCHIVE.h5", help="archive to write (default out/<scene name>.h5)")
-    run.add_argument("--plots", metavar="DIR", help="folder for the plots")
+    run.add_argument("--out", metavar="ARCHIVE.h5", help="archive to write, in an existing folder (default out/<scene name>.h5)")
+    run.add_argument("--plots", metavar="DIR", help="folder for the plots, made in an existing folder (for a scene whose [outputs] lists no "
+                     "plots: the figures of every stage it runs)")
     run.add_argument("--archive", metavar="EARLIER.h5", help="earlier archive of the scene: reuse unchanged stages")
     run.add_argument("--json", action="store_true", help="print one JSON document on stdout")
     if influence:

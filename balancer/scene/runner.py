@@ -4,13 +4,14 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable
 
 import modal
-from modal.errors import ArchiveError, PlotError, SceneError
+from modal.errors import ArchiveError, ModalError, PlotError, SceneError
 
 from .plotter import Plotter, plot_error
 from .registry import REGISTRY, STAGES, load
@@ -143,10 +144,12 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, p
     scene : path, dict or Scene
         A TOML file, the same content as a dict, or a validated scene.
     out : path, optional
-        Archive to write; default ``out/<scene name>.h5`` when the scene asks
-        for an archive.
+        Archive to write, in an existing folder; default ``out/<scene name>.h5`` (``out`` is
+        made) when the scene asks for an archive. The folders are checked before any work.
     plots_dir : path, optional
-        Folder for the plots; default ``<archive stem>_plots`` beside the archive.
+        Folder for the plots (made inside an existing folder); default ``<archive stem>_plots``
+        beside the archive. Given for a scene whose ``[outputs]`` lists no plots, it draws the
+        figures of every stage the scene runs (a warning says so when none of them draws one).
     archive : path, optional
         An earlier archive of the same scene: stages whose inputs are unchanged
         are read back from it instead of being recomputed.
@@ -165,6 +168,25 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, p
     elif isinstance(scene, dict):
         scene = parse_scene(scene)
     say = progress or (lambda _msg: None)
+    outputs = scene.section("outputs")
+    name = scene.section("scene.name") or Path(scene.source).stem or "scene"
+    stored = outputs.get("archive", False)
+    archive_path = None
+    if stored or out is not None:
+        archive_path = Path(out) if out is not None else Path("out") / f"{_slug(name)}.h5"
+    plotted = list(outputs.get("plots") or [])
+    if not plotted and plots_dir is not None:
+        plotted = _default_plots(scene, plots_dir, say)
+    folder = None
+    if plotted:
+        folder = Path(plots_dir) if plots_dir is not None else (
+            archive_path.with_name(archive_path.stem + "_plots") if archive_path else Path("out") / f"{_slug(name)}_plots")
+    # where the outputs go is checked before any work (nothing is made yet): a folder the caller names must exist
+    # (the plots' own folder is made in it), the default out/ is made where it can be
+    if archive_path is not None:
+        _check_folder(archive_path, "archive", ArchiveError, made=out is None)
+    if folder is not None:
+        _check_folder(folder, "plots", PlotError, made=plots_dir is None)
     earlier = _open_earlier(archive)
     try:
         status, hashes = plan(scene, earlier)
@@ -178,17 +200,6 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, p
     finally:
         if earlier is not None:
             earlier.close()
-    outputs = scene.section("outputs")
-    name = scene.section("scene.name") or Path(scene.source).stem or "scene"
-    stored = outputs.get("archive", False)
-    archive_path = None
-    if stored or out is not None:
-        archive_path = Path(out) if out is not None else Path("out") / f"{_slug(name)}.h5"
-    plotted = list(outputs.get("plots") or [])
-    folder = None
-    if plotted:
-        folder = Path(plots_dir) if plots_dir is not None else (
-            archive_path.with_name(archive_path.stem + "_plots") if archive_path else Path("out") / f"{_slug(name)}_plots")
     plotter = Plotter(plot_jobs, folder, plotted) if plotted else None
     # plot stages not yet handed to the child, in output order (a stage without figures draws nothing)
     pending = [stage for stage in plotted if REGISTRY[stage].figures]
@@ -221,13 +232,13 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, p
                 hand_over()
         if archive_path is not None:
             keep = [s for s in STAGES if s in results and (stored is True or stored is False or s in stored)]
-            archive_path.parent.mkdir(parents=True, exist_ok=True)
             from modal.archive import write_archive
 
+            archive_path.parent.mkdir(parents=True, exist_ok=True)  # checked above: exists, or is the default
             write_archive(archive_path, {s: results[s] for s in keep}, scene_text=scene.text or None,
                           inputs_hash={s: hashes[s] for s in keep})
         if plotted:
-            folder.mkdir(parents=True, exist_ok=True)
+            folder.mkdir(parents=True, exist_ok=True)  # checked above
             mine = {}
             if pending:  # not handed to the plotter (no fork here, or results that do not pickle)
                 from .plots import save_stage_plot
@@ -250,6 +261,41 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, p
                              str(archive_path) if archive_path else None, plot_paths)
     return SceneRun(status, results, hashes, str(archive_path) if archive_path else None, tuple(map(str, plot_paths)),
                     summary, timings)
+
+
+def _default_plots(scene: Scene, plots_dir, say: Callable[[str], None]) -> list[str]:
+    """The plots drawn when the caller names a folder and the scene lists none: every figure of the stages it runs."""
+    drawing = [stage for stage in scene.graph if REGISTRY[stage].figures]
+    if drawing:
+        say(f"plots: the scene's [outputs] lists none; drawing those of the stages it runs ({', '.join(drawing)}) "
+            f"in {plots_dir}")
+    else:
+        from modal.errors import warn
+
+        warn(f"{plots_dir}: no plot drawn: the stages this scene runs ({', '.join(scene.graph)}) draw no figure",
+             stacklevel=3)
+    return drawing
+
+
+def _check_folder(target: Path, what: str, error: type[ModalError], made: bool) -> None:
+    """``target`` (the archive, or the plots' folder) can be written: its folder exists and is writable, or, when
+    ``made``, the nearest existing folder above it is (where it will be made). Raises ``error`` naming ``target``."""
+    parent = target.parent
+    if not parent.exists() and not made:
+        raise error(f"{target}: the folder {parent} does not exist; expected an existing folder for the {what} "
+                    "(create it first)")
+    existing = parent
+    while not existing.exists() and existing != existing.parent:
+        existing = existing.parent
+    if not existing.is_dir():
+        raise error(f"{target}: {existing} is not a folder; expected a folder for the {what}")
+    if not os.access(existing, os.W_OK | os.X_OK):
+        raise error(f"{target}: the folder {existing} is not writable; expected a folder the {what} can be "
+                    "written to")
+    if what == "archive" and target.is_dir():
+        raise error(f"{target}: is a folder; expected an archive file")
+    if what == "plots" and target.exists() and not target.is_dir():
+        raise error(f"{target}: is a file; expected a folder for the plots")
 
 
 def _slug(text: str) -> str:

@@ -137,3 +137,51 @@ def test_sigkill_during_write_never_damages_the_previous_archive(tmp_path):
             old = target.read_bytes()
     # the kills must have hit writes in progress, or the test proves nothing
     assert outcomes["old"] >= 5, outcomes
+
+
+# ---- where the outputs go ----------------------------------------------------------------------------------------
+
+def test_a_plots_folder_for_a_scene_listing_no_plots_draws_every_stages_figures(tmp_path):
+    """--plots DIR was ignored when [outputs] listed no plots: it now draws the figures of every stage the scene runs,
+    and says so; a scene none of whose stages draws says why nothing was drawn."""
+    import pytest
+
+    said = []
+    run = run_scene(scene(frf=SYNTH_FRF, identify={}, rotor=ROTOR, adb=ADB, outputs={"tables": ["adb_stability"]}),
+                    plots_dir=tmp_path / "plots", progress=said.append)
+    drawn = sorted(p.name for p in (tmp_path / "plots").iterdir())
+    assert drawn == ["adb_stability_stability.png", "identify_fit.png"]  # the synthetic FRF's own plot draws nothing
+    assert sorted(os.path.basename(p) for p in run.plot_paths) == drawn
+    assert any("lists none" in line and "identify" in line for line in said), said
+    with pytest.warns(UserWarning, match=r"none: no plot drawn: the stages this scene runs \(rotor\) draw no figure"):
+        quiet = run_scene(scene(rotor={"M": 1.0, "k": 1e4, "c": 1.0, "e": 1e-4}, adb=ADB, outputs={"tables": ["rotor"]}),
+                          plots_dir=tmp_path / "none")
+    assert quiet.plot_paths == () and not (tmp_path / "none").exists()
+
+
+def test_a_missing_output_folder_is_reported_before_any_work(tmp_path, monkeypatch):
+    import pytest
+
+    from modal.errors import ArchiveError, PlotError, SceneError
+
+    said = []
+    config = full_scene(tmp_path)
+    with pytest.raises(ArchiveError, match="the folder .*missing does not exist; expected an existing folder"):
+        run_scene(config, out=tmp_path / "missing" / "a.h5", progress=said.append)
+    (tmp_path / "a_file").write_text("")
+    with pytest.raises(ArchiveError, match="a_file is not a folder"):
+        run_scene(config, out=tmp_path / "a_file" / "a.h5", progress=said.append)
+    with pytest.raises(PlotError, match="the folder .*missing does not exist"):
+        run_scene({**config, "outputs": {"plots": ["identify"]}}, out=tmp_path / "a.h5",
+                  plots_dir=tmp_path / "missing" / "plots", progress=said.append)
+    assert said == [] and not (tmp_path / "missing").exists()  # no stage ran
+    # nothing is made before the work: a scene that fails leaves no default out/ behind
+    monkeypatch.chdir(tmp_path)
+    broken = {**config, "frf": {"file": "no_such.csv"}}
+    with pytest.raises(SceneError, match="no_such.csv"):
+        run_scene(broken, progress=said.append)
+    assert not (tmp_path / "out").exists()
+    # the plots' own folder is made inside an existing one, and the default out/ is made
+    run = run_scene({**config, "outputs": {"plots": ["identify"], "archive": True}}, plots_dir=tmp_path / "plots")
+    assert (tmp_path / "plots" / "identify_fit.png").exists() and run.archive_path == os.path.join("out", "scene.h5")
+    assert (tmp_path / "out" / "scene.h5").is_file()
