@@ -25,7 +25,14 @@ def pytest_configure(config):
     derandomised test drew other cases after another test file had been imported (checked:
     st.floats(0, 2) gave 1e-05 in place of 0.001 once test_crank.py ran first). The default
     run (``-m "not stress"``) switches that harvest off; ``-m stress`` keeps it, for exploration.
+
+    Every run is also watched for files its tests leave in the checkout (every test writes under a
+    temporary folder): support.checkout compares ``git status`` (and the files inside untracked and
+    ignored folders) at the start and the end, and fails the run naming what it left.
     """
+    from support.checkout import CheckoutGuard
+
+    config.pluginmanager.register(CheckoutGuard(ROOT), "modalbal-checkout-guard")
     if "not stress" not in (config.option.markexpr or ""):
         return
     try:
@@ -78,3 +85,4 @@ def dask_cluster(tmp_path_factory):
     from support.daskcluster import cluster
 
     yield from cluster(tmp_path_factory)
+

@@ -12,7 +12,7 @@ def test_balance_plot_draws_the_report(tmp_path):
     import balancer
     from balancer.influence.plots import plot_balance
 
-    report = balancer.run_scene(inline_scene(tmp_path)).results["balance"].report
+    report = balancer.run_scene(inline_scene(tmp_path), out=tmp_path / "inline.h5").results["balance"].report
     figure = plot_balance(report)
     ax_v, ax_m = figure.axes[:2]
     for values, style in ((report.initial, "-"), (report.residual, "--")):
