@@ -10,7 +10,7 @@ import argparse
 import json
 import sys
 
-from modal.errors import ModalError
+from modal.errors import ModalError, ParameterError
 from modal.report import jsonable
 
 __all__ = ["add_parser", "run", "report_document"]
@@ -27,6 +27,9 @@ def add_parser(sub) -> argparse.ArgumentParser:
     p.add_argument("--rotor-mass", type=float, metavar="KG", help="rotor mass (kg) for the ISO check")
     p.add_argument("--speed-rpm", type=float, metavar="RPM", help="maximum service speed (rpm) for the ISO check")
     p.add_argument("--holes", type=int, metavar="N", help="split the correction onto N equally spaced holes (first at the mark)")
+    p.add_argument("--weight-resolution", type=float, metavar="MASS",
+                   help="round the masses on the holes to multiples of MASS (in the readings file's mass units), "
+                        "the smallest step of the weights at hand")
     p.add_argument("--max-correction", type=float, metavar="KG_M", help="largest correction per plane (kg m)")
     p.add_argument("--json", action="store_true", help="print one JSON document on stdout")
     return p
@@ -34,11 +37,14 @@ def add_parser(sub) -> argparse.ArgumentParser:
 
 def report_document(report) -> dict:
     """The report as a JSON-ready dict (user units for readings and masses; SI where named)."""
+    from .readings import reading_unit, user_digits
+
     scale = 1e3 if report.mass_units == "g" else 1.0
     amp0, ph0 = report.in_user_units(report.initial)
     amp1, ph1 = report.in_user_units(report.residual)
     doc = {
-        "method": report.method, "reading_units": report.reading_units, "mass_units": report.mass_units,
+        "method": report.method, "reading_units": reading_unit(report.reading_units).label,
+        "mass_units": report.mass_units,
         "correction": [{"plane": j + 1, "mass": float(report.correction_mass_kg[j] * scale),
                         "angle_deg": float(report.correction_angle_deg[j]), "radius_m": float(report.radius_m[j]),
                         "unbalance_kg_m": float(abs(report.correction_kg_m[j]))}
@@ -51,8 +57,10 @@ def report_document(report) -> dict:
         "condition_number": report.condition_number, "flags": list(report.flags),
     }
     if report.positions_deg.size:
-        doc["split"] = [[{"hole_deg": float(p), "mass": float(m * scale)} for p, m in zip(report.positions_deg, row) if m > 0]
-                        for row in report.split_mass_kg]
+        doc["split"] = [[{"hole_deg": float(p), "mass": float(user_digits(m * scale))}
+                         for p, m in zip(report.positions_deg, row) if m > 0] for row in report.split_mass_kg]
+        if report.weight_resolution_kg is not None:
+            doc["weight_resolution"] = float(user_digits(report.weight_resolution_kg * scale))
     if report.iso is not None:
         iso = report.iso
         doc["iso"] = {"grade_mm_s": iso.grade_mm_s, "verdict": iso.verdict,
@@ -69,7 +77,8 @@ def _text(doc: dict) -> str:
     for c in doc["correction"]:
         lines.append(f"  plane {c['plane']}: {c['mass']:.4g} {mu} at {c['angle_deg']:.1f} deg (radius {c['radius_m']:g} m)")
     for j, row in enumerate(doc.get("split", [])):
-        lines.append(f"  plane {j + 1} on holes: " + ", ".join(f"{h['mass']:.4g} {mu} at {h['hole_deg']:g} deg" for h in row))
+        lines.append(f"  plane {j + 1} on holes: " + ", ".join(f"{h['mass']:.4g} {mu} at {h['hole_deg']:g} deg" for h in row)
+                     + (f" (to {doc['weight_resolution']:g} {mu})" if "weight_resolution" in doc else ""))
     lines += ["", f"{'reading':<28} {'initial':>18} {'predicted after':>20}"]
     for r in doc["readings"]:
         lines.append(f"{r['sensor']:<28} {r['initial_amplitude']:>9.4g} {unit} {r['initial_phase_deg']:>5.0f}° "
@@ -91,6 +100,7 @@ def run(args) -> int:
     from pathlib import Path
 
     from .job import balance, load_job
+    from .readings import MASS_UNITS
 
     try:
         job = load_job(args.readings)
@@ -99,13 +109,19 @@ def run(args) -> int:
         grade = args.grade if args.grade is not None else iso.get("grade_mm_s")
         mass = args.rotor_mass if args.rotor_mass is not None else iso.get("rotor_mass_kg")
         speed = args.speed_rpm if args.speed_rpm is not None else iso.get("speed_rpm")
+        resolution = args.weight_resolution if args.weight_resolution is not None else options.get("weight_resolution")
+        if resolution is not None and not (isinstance(resolution, (int, float)) and 0 < resolution < float("inf")):
+            where = "--weight-resolution" if args.weight_resolution is not None else f"{args.readings}: weight_resolution"
+            raise ParameterError(f"{where} = {resolution!r}: expected the step of the weights at hand, a mass > 0 "
+                                 f"in {job.mass_units}")
         report = balance(job, args.method or options.get("method", "least_squares"),
                          weights=options.get("weights"),
                          max_unbalance_kg_m=args.max_correction if args.max_correction is not None else options.get("max_unbalance_kg_m"),
                          holes=args.holes if args.holes is not None else options.get("holes"),
                          positions_deg=None if args.holes is not None else options.get("positions_deg"),
                          grade_mm_s=grade, rotor_mass_kg=mass, speed_rpm=speed,
-                         distances_m=tuple(iso["distances_m"]) if "distances_m" in iso else None)
+                         distances_m=tuple(iso["distances_m"]) if "distances_m" in iso else None,
+                         weight_resolution_kg=None if resolution is None else resolution * MASS_UNITS[job.mass_units])
     except ModalError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 1

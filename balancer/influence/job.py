@@ -22,8 +22,9 @@ File format (``READINGS.toml``; the same keys form a scene's ``[balance]`` secti
 Instead of inline amplitudes, ``readings = "runs.csv"`` names a CSV file with the
 columns ``run,amplitude,phase_deg`` (``run`` = ``initial``, ``trial1`` ... ``trialN`` or
 ``after``; rows in reading order); ``[[trial]]`` then gives only ``mass`` and ``angle_deg``.
-Options: ``method``, ``weights``, ``max_unbalance_kg_m``, ``holes`` or ``positions_deg``
-and ``[iso]`` (``grade_mm_s``, ``rotor_mass_kg``, ``speed_rpm``, ``distances_m``).
+Options: ``method``, ``weights``, ``max_unbalance_kg_m``, ``holes`` or ``positions_deg``,
+``weight_resolution`` (in ``mass_units``: the masses on the holes rounded to multiples of it, the
+smallest step of the weights at hand) and ``[iso]`` (``grade_mm_s``, ``rotor_mass_kg``, ``speed_rpm``, ``distances_m``).
 """
 from __future__ import annotations
 
@@ -44,7 +45,7 @@ from .split import equally_spaced_deg, split_correction
 __all__ = ["BalanceJob", "BalanceReport", "parse_job", "load_job", "balance", "JOB_KEYS"]
 
 JOB_KEYS = ("units", "mass_units", "radius_m", "sensors", "initial", "trial", "after", "readings",
-            "method", "weights", "max_unbalance_kg_m", "holes", "positions_deg", "iso")
+            "method", "weights", "max_unbalance_kg_m", "holes", "positions_deg", "weight_resolution", "iso")
 _ISO_KEYS = ("grade_mm_s", "rotor_mass_kg", "speed_rpm", "distances_m")
 _UNITS_PER_KG_M = {"m": "m/(kg m)", "m/s": "m/s/(kg m)", "m/s^2": "m/s^2/(kg m)"}
 
@@ -247,11 +248,13 @@ class BalanceReport:
     positions_deg : ndarray
         Holes used for the split (empty: no split).
     split_mass_kg : ndarray, shape (n_planes, n_positions)
-        Masses on the holes.
+        Masses on the holes (multiples of ``weight_resolution_kg`` when that is given).
     residual_unbalance_kg_m : ndarray, shape (n_planes,)
         Residual unbalance per plane equivalent to the vibration left (the check run if
         measured, else the prediction): ``max_i |v_i| / max_i |alpha_ij|``.
     iso : IsoCheck or None
+    weight_resolution_kg : float or None
+        The step the masses on the holes were rounded to (None: not rounded).
     """
 
     method: str
@@ -280,6 +283,7 @@ class BalanceReport:
     split_mass_kg: np.ndarray
     residual_unbalance_kg_m: np.ndarray
     iso: IsoCheck | None
+    weight_resolution_kg: float | None = None
 
     def archive_units(self) -> dict[str, str]:
         """Units of the numeric fields whose unit depends on the readings (for the archive)."""
@@ -297,7 +301,7 @@ class BalanceReport:
 def balance(job: BalanceJob, method: str = "least_squares", *, weights=None, max_unbalance_kg_m=None,
             holes: int | None = None, positions_deg=None, grade_mm_s: float | None = None,
             rotor_mass_kg: float | None = None, speed_rpm: float | None = None,
-            distances_m: tuple[float, float] | None = None) -> BalanceReport:
+            distances_m: tuple[float, float] | None = None, weight_resolution_kg: float | None = None) -> BalanceReport:
     """Influence matrix, correction, split onto holes and ISO verdict of a job.
 
     Parameters
@@ -312,6 +316,9 @@ def balance(job: BalanceJob, method: str = "least_squares", *, weights=None, max
         Explicit hole positions (deg) instead of ``holes``.
     grade_mm_s, rotor_mass_kg, speed_rpm : float, optional
         ISO 21940-11 check (all three needed); ``distances_m`` as in :func:`~balancer.influence.iso_check`.
+    weight_resolution_kg : float, optional
+        Round the masses on the holes to multiples of this (kg): the smallest step of the weights at hand
+        (a hole whose mass rounds to zero gets none). Default: not rounded.
 
     Returns
     -------
@@ -325,6 +332,12 @@ def balance(job: BalanceJob, method: str = "least_squares", *, weights=None, max
         np.asarray(positions_deg, dtype=float) if positions_deg is not None else np.zeros(0))
     n_planes = alpha.shape[1]
     split = split_correction(result.unbalance_kg_m, positions) / job.radius_m[:, None] if positions.size else np.zeros((n_planes, 0))
+    if weight_resolution_kg is not None:
+        step = float(weight_resolution_kg)
+        if not np.isfinite(step) or step <= 0:
+            raise ParameterError(f"weight_resolution = {weight_resolution_kg!r}: expected a mass step > 0")
+        # multiples of the step, written as the step's own digits would be (0.1 g steps give 0.3 g, not 0.30000000000000004)
+        split = np.array([float(f"{v:.12g}") for v in (np.round(split / step) * step).ravel()]).reshape(split.shape)
     left = job.after if job.after.size else result.residual
     sensitivity = np.max(np.abs(alpha), axis=0)
     residual_unbalance = np.max(np.abs(left)) / sensitivity
@@ -346,4 +359,5 @@ def balance(job: BalanceJob, method: str = "least_squares", *, weights=None, max
         worst_residual=result.worst_residual, rms_residual=result.rms_residual,
         condition_number=result.condition_number, minmax_gap=result.minmax_gap, flags=result.flags,
         positions_deg=positions, split_mass_kg=split, residual_unbalance_kg_m=residual_unbalance, iso=iso,
+        weight_resolution_kg=None if weight_resolution_kg is None else float(weight_resolution_kg),
     )

@@ -10,6 +10,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from .job import BalanceReport
+from .readings import reading_unit
 
 __all__ = ["plot_balance"]
 
@@ -42,8 +43,8 @@ def plot_balance(report: BalanceReport, fig: Figure | None = None) -> Figure:
     def arrows(values, style, label):
         amplitude, phase = report.in_user_units(values)
         for i, (a, p) in enumerate(zip(amplitude, phase)):
-            ax_v.plot([0, np.deg2rad(p)], [0, a], style, color=colours[i], lw=1.5,
-                      label=label if i == 0 else None)
+            ax_v.plot([0, np.deg2rad(p)], [0, a], style, color=colours[i], lw=1.5)
+        ax_v.plot([], [], style, color="0.3", lw=1.5, label=label)  # the style's entry, in grey
 
     arrows(report.initial, "-", "initial")
     for j, run in enumerate(report.trial_runs):
@@ -53,7 +54,9 @@ def plot_balance(report: BalanceReport, fig: Figure | None = None) -> Figure:
     arrows(report.residual, "--", f"predicted after ({report.method})")
     if report.after.size:
         arrows(report.after, ":", "measured after")
-    ax_v.set_title(f"1x vibration [{report.reading_units}], phase lag")
+    for i, sensor in enumerate(report.sensors):  # every reading's colour
+        ax_v.plot([], [], "-", color=colours[i], lw=4, label=sensor)
+    ax_v.set_title(f"1x vibration [{reading_unit(report.reading_units).label}], phase lag")
     ax_v.legend(loc="lower left", bbox_to_anchor=(-0.15, -0.18), fontsize="small", ncol=2)
 
     mass_scale = 1e3 if report.mass_units == "g" else 1.0
@@ -74,7 +77,9 @@ def plot_balance(report: BalanceReport, fig: Figure | None = None) -> Figure:
         if report.positions_deg.size:
             on = report.split_mass_kg[j] > 0
             ax_m.plot(np.deg2rad(report.positions_deg[on]), report.split_mass_kg[j][on] * mass_scale, "x", color=f"C{j}",
-                      ms=9, mew=2)
+                      ms=9, mew=2, label=f"plane {j + 1} on holes: " + ", ".join(
+                          f"{m * mass_scale:.3g} {report.mass_units} at {p:g}°"
+                          for p, m in zip(report.positions_deg[on], report.split_mass_kg[j][on])))
     ax_m.set_ylim(0, 1.2 * top)
     ax_m.set_title(f"correction masses [{report.mass_units}] at their radius")
     ax_m.legend(loc="lower left", bbox_to_anchor=(-0.1, -0.18), fontsize="small")

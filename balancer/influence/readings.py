@@ -49,6 +49,12 @@ class ReadingUnit:
     quantity: str  # "displacement" | "velocity" | "acceleration"
     si_unit: str  # "m" | "m/s" | "m/s^2"
     to_si: float
+    symbol: str = ""  # how outputs write it, where that differs from the name (µm)
+
+    @property
+    def label(self) -> str:
+        """The unit as every output (tables, JSON, plots) writes it: ``"µm"`` for ``"um"``, ``"m/s²"``."""
+        return self.symbol or self.name
 
 
 READING_UNITS: dict[str, ReadingUnit] = {
@@ -56,16 +62,17 @@ READING_UNITS: dict[str, ReadingUnit] = {
     for u in (
         ReadingUnit("m", "displacement", "m", 1.0),
         ReadingUnit("mm", "displacement", "m", 1e-3),
-        ReadingUnit("um", "displacement", "m", 1e-6),
+        ReadingUnit("um", "displacement", "m", 1e-6, "µm"),
         ReadingUnit("mil", "displacement", "m", 25.4e-6),
         ReadingUnit("m/s", "velocity", "m/s", 1.0),
         ReadingUnit("mm/s", "velocity", "m/s", 1e-3),
         ReadingUnit("in/s", "velocity", "m/s", 25.4e-3),
-        ReadingUnit("m/s^2", "acceleration", "m/s^2", 1.0),
+        ReadingUnit("m/s^2", "acceleration", "m/s^2", 1.0, "m/s²"),
         ReadingUnit("g", "acceleration", "m/s^2", STANDARD_GRAVITY_M_S2),
     )
 }
-_ALIASES = {"µm": "um", "μm": "um", "micron": "um", "mils": "mil", "ips": "in/s", "m/s2": "m/s^2", "m/s**2": "m/s^2"}
+_ALIASES = {"µm": "um", "μm": "um", "micron": "um", "mils": "mil", "ips": "in/s", "m/s2": "m/s^2", "m/s**2": "m/s^2",
+            "m/s²": "m/s^2"}
 
 MASS_UNITS: dict[str, float] = {"kg": 1.0, "g": 1e-3}
 """Mass units accepted for trial and correction masses, with their factor to kg."""
@@ -108,11 +115,19 @@ def vibration(amplitude, phase_lag_deg, units: str, field: str = "reading") -> n
     return a * unit.to_si * np.exp(1j * np.deg2rad(p))
 
 
+def user_digits(values) -> np.ndarray:
+    """Values in a user's unit rounded to 15 significant digits: a reading given as 3.8 and carried through SI and
+    back (3.7999999999999994) is 3.8 again; 15 digits keep every digit a double holds for sure."""
+    a = np.asarray(values, dtype=float)
+    return np.array([float(f"{v:.15g}") for v in a.ravel()]).reshape(a.shape)
+
+
 def amplitude_phase(values, units: str) -> tuple[np.ndarray, np.ndarray]:
-    """Complex SI readings back to (amplitude in ``units``, phase lag in deg within [0, 360))."""
+    """Complex SI readings back to (amplitude in ``units``, phase lag in deg within [0, 360)), to 15 significant
+    digits (:func:`user_digits`)."""
     unit = reading_unit(units)
     z = np.asarray(values, dtype=complex)
-    return np.abs(z) / unit.to_si, np.mod(np.rad2deg(np.angle(z)), 360.0)
+    return user_digits(np.abs(z) / unit.to_si), np.mod(user_digits(np.rad2deg(np.angle(z))), 360.0)
 
 
 def unbalance_kg_m(mass, radius_m, angle_deg, mass_units: str = "kg", field: str = "mass") -> np.ndarray:

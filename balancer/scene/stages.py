@@ -404,6 +404,7 @@ class BalanceStage:
 def stage_balance(scene: Scene, rotor: RotorStage | None = None, adb_response=None) -> BalanceStage:
     """Correction, split, predicted residual and ISO verdict; or the simulated study on the [rotor]."""
     from ..influence.job import balance
+    from ..influence.readings import MASS_UNITS
     from ..influence.study import field_balancing_study
 
     cfg = scene.section("balance")
@@ -411,7 +412,9 @@ def stage_balance(scene: Scene, rotor: RotorStage | None = None, adb_response=No
     options = {"weights": cfg.get("weights"), "max_unbalance_kg_m": cfg.get("max_unbalance_kg_m"),
                "holes": cfg.get("holes"), "positions_deg": cfg.get("positions_deg"),
                "grade_mm_s": iso.get("grade_mm_s"), "rotor_mass_kg": iso.get("rotor_mass_kg"),
-               "speed_rpm": iso.get("speed_rpm"), "distances_m": tuple(iso["distances_m"]) if "distances_m" in iso else None}
+               "speed_rpm": iso.get("speed_rpm"), "distances_m": tuple(iso["distances_m"]) if "distances_m" in iso else None,
+               "weight_resolution_kg": (cfg["weight_resolution"] * MASS_UNITS[cfg.get("mass_units", "g")]
+                                        if "weight_resolution" in cfg else None)}
     method = cfg.get("method", "least_squares")
     sim = cfg.get("simulate")
     if sim is None:  # the readings as read when the scene was checked
@@ -427,7 +430,7 @@ def stage_balance(scene: Scene, rotor: RotorStage | None = None, adb_response=No
                                   noise=sim.get("noise", 0.05), seed=sim.get("seed", 0), units=cfg["units"],
                                   mass_units=cfg.get("mass_units", "g"), adb=adb_response)
     report = study.minmax if method == "minmax" else study.least_squares
-    if any(options[k] is not None for k in ("holes", "positions_deg", "grade_mm_s")):
+    if any(options[k] is not None for k in ("holes", "positions_deg", "grade_mm_s", "weight_resolution_kg")):
         from ..influence.study import simulated_job
 
         job = simulated_job(true_M, true_k, true_c, p.e, sim["speeds_rad_s"], sim["trial_mass"], sim.get("trial_angle_deg", 0.0),

@@ -151,15 +151,19 @@ def balance_digest(result) -> dict:
     r = result.report
     amplitude, _ = r.in_user_units(r.initial)
     left, _ = r.in_user_units(r.residual)
-    d = {"method": r.method, "reading_units": r.reading_units, "mass_units": r.mass_units,
+    from balancer.influence.readings import reading_unit, user_digits
+
+    d = {"method": r.method, "reading_units": reading_unit(r.reading_units).label, "mass_units": r.mass_units,
          "correction_mass": [float(m) * (1e3 if r.mass_units == "g" else 1.0) for m in r.correction_mass_kg],
          "correction_angle_deg": [float(a) for a in r.correction_angle_deg],
          "correction_kg_m": [[float(u.real), float(u.imag)] for u in r.correction_kg_m],
          "worst_initial": float(np.max(amplitude)), "worst_residual": float(np.max(left)),
          "condition_number": r.condition_number, "flags": list(r.flags)}
     if r.positions_deg.size:
-        d["split"] = [{f"{p:g}": float(m) * (1e3 if r.mass_units == "g" else 1.0) for p, m in zip(r.positions_deg, row) if m > 0}
-                      for row in r.split_mass_kg]
+        d["split"] = [{f"{p:g}": float(user_digits(m * (1e3 if r.mass_units == "g" else 1.0)))
+                       for p, m in zip(r.positions_deg, row) if m > 0} for row in r.split_mass_kg]
+        if r.weight_resolution_kg is not None:
+            d["weight_resolution"] = float(user_digits(r.weight_resolution_kg * (1e3 if r.mass_units == "g" else 1.0)))
     if r.iso is not None:
         d["iso"] = {"grade_mm_s": r.iso.grade_mm_s, "verdict": r.iso.verdict,
                     "permissible_per_plane_kg_m": [float(v) for v in r.iso.permissible_per_plane_kg_m],
@@ -185,7 +189,8 @@ def balance_rows(result, d: dict) -> list[str]:
              f"  worst reading {d['worst_initial']:.4g} -> {d['worst_residual']:.3g} {d['reading_units']} predicted; "
              f"condition number {d['condition_number']:.3g}{'; flags: ' + ', '.join(d['flags']) if d['flags'] else ''}"]
     for j, row in enumerate(d.get("split", [])):
-        lines.append(f"  plane {j + 1} on holes: " + ", ".join(f"{m:.4g} {unit} at {p} deg" for p, m in row.items()))
+        lines.append(f"  plane {j + 1} on holes: " + ", ".join(f"{m:.4g} {unit} at {p} deg" for p, m in row.items())
+                     + (f" (to {d['weight_resolution']:g} {unit})" if "weight_resolution" in d else ""))
     if "iso" in d:
         iso = d["iso"]
         lines.append(f"  ISO 21940-11 G {iso['grade_mm_s']:g}: {iso['verdict']} (residual "

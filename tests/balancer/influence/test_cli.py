@@ -36,3 +36,49 @@ def test_influence_command_line(tmp_path):
     bad = run_cli("influence", str(tmp_path / "bad.toml"))
     assert bad.returncode == 1 and bad.stderr.count("\n") == 1 and "units" in bad.stderr and "bad.toml" in bad.stderr
     assert run_cli("influence").returncode == 2
+
+
+def test_readings_echo_as_given_and_every_output_writes_micrometres(tmp_path):
+    """A reading given as 3.8 um comes back as 3.8, not 3.7999999999999994 (carried through SI and back), and the unit
+    is µm in the JSON, the table and the scene's summary alike."""
+    import tomllib
+
+    given = tomllib.loads(READINGS.read_text())
+    doc = json.loads(run_cli("influence", str(READINGS), "--json").stdout)
+    assert [r["initial_amplitude"] for r in doc["readings"]] == given["initial"]["amplitude"]
+    assert [r["initial_phase_deg"] for r in doc["readings"]] == given["initial"]["phase_deg"]
+    assert doc["reading_units"] == "µm"
+    text = run_cli("influence", str(READINGS)).stdout
+    assert " µm" in text and " um" not in text
+    from balancer import run_scene
+    from support.balancing import inline_scene
+
+    summary = run_scene(inline_scene(tmp_path), out=tmp_path / "b.h5", plots_dir=tmp_path / "plots").summary
+    assert "µm predicted" in summary and " um" not in summary
+
+
+def test_the_split_is_rounded_to_the_weight_resolution(tmp_path):
+    """--weight-resolution (or weight_resolution in the file, in its mass units): every mass on a hole is a multiple
+    of the step, written as such, and the rounded split still makes the correction to within a step per hole."""
+    step = 0.5
+    raw = json.loads(run_cli("influence", str(READINGS), "--holes", "12", "--json").stdout)
+    assert any(h["mass"] < step / 2 for row in raw["split"] for h in row)  # a sliver of a gram without rounding
+    doc = json.loads(run_cli("influence", str(READINGS), "--holes", "12", "--weight-resolution", str(step),
+                             "--json").stdout)
+    assert doc["weight_resolution"] == step
+    for row, correction in zip(doc["split"], doc["correction"]):
+        masses = np.array([h["mass"] for h in row])
+        assert np.all(masses > 0) and np.all(masses / step == np.round(masses / step)), masses
+        made = sum(h["mass"] * np.exp(1j * np.deg2rad(h["hole_deg"])) for h in row)
+        wanted = correction["mass"] * np.exp(1j * np.deg2rad(correction["angle_deg"]))
+        assert abs(made - wanted) <= step / 2 * 2  # each of at most two holes off by half a step at most
+    text = run_cli("influence", str(READINGS), "--holes", "12", "--weight-resolution", str(step)).stdout
+    assert "(to 0.5 g)" in text
+    (tmp_path / "job.toml").write_text("weight_resolution = 0.5\nholes = 12\n" + READINGS.read_text())
+    assert json.loads(run_cli("influence", str(tmp_path / "job.toml"), "--json").stdout)["split"] == doc["split"]
+    bad = run_cli("influence", str(READINGS), "--holes", "12", "--weight-resolution", "0")
+    assert bad.returncode == 1 and "--weight-resolution = 0.0: expected the step of the weights at hand, a mass > 0 in g" \
+        in bad.stderr
+    (tmp_path / "bad.toml").write_text("weight_resolution = -1\n" + READINGS.read_text())
+    bad = run_cli("influence", str(tmp_path / "bad.toml"), "--holes", "12")
+    assert bad.returncode == 1 and "bad.toml: weight_resolution = -1: expected" in bad.stderr

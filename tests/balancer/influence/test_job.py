@@ -100,3 +100,15 @@ def test_scene_balance_errors_before_any_work(tmp_path):
     scene = inline_scene(tmp_path, method="median")
     with pytest.raises(SceneError, match="balance.method"):
         balancer.run_scene(scene)
+
+
+def test_scene_rounds_the_split_to_its_weight_resolution(tmp_path):
+    """[balance] weight_resolution (in mass_units) rounds every mass on a hole to a multiple of it, and says so."""
+    import balancer
+
+    run = balancer.run_scene(inline_scene(tmp_path, weight_resolution=0.5), out=tmp_path / "b.h5")
+    report = run.results["balance"].report
+    grams = report.split_mass_kg * 1e3
+    assert report.weight_resolution_kg == pytest.approx(0.5e-3)
+    assert np.allclose(grams / 0.5, np.round(grams / 0.5), rtol=0, atol=1e-9) and grams.max() > 0
+    assert "(to 0.5 g)" in run.summary
