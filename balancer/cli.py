@@ -19,11 +19,15 @@ from modal.report import jsonable
 __all__ = ["main"]
 
 
-def build_parser(influence: bool = True) -> argparse.ArgumentParser:
-    """The command-line parser; ``influence=False`` leaves out the ``influence`` command (not imported)."""
-    parser = argparse.ArgumentParser(prog="python -m balancer", description="Balancing studies fed by modal identification.")
+def build_parser(influence: bool = True, prog: str = "python -m balancer") -> argparse.ArgumentParser:
+    """The command-line parser; ``influence=False`` leaves out the ``influence`` command (not imported); ``prog`` is
+    the name usage and help give the program."""
+    parser = argparse.ArgumentParser(prog=prog, description="Balancing studies fed by modal identification.")
     sub = parser.add_subparsers(dest="command", required=True)
-    run = sub.add_parser("run", help="run a scene end to end")
+    run = sub.add_parser("run", help="run a scene end to end",
+                         description="Run a scene (a TOML file naming an FRF or a time record, the identification "
+                                     "and the balancing studies): only the stages its outputs need, reusing unchanged "
+                                     "stages of an earlier archive; writes the archive and plots and prints a summary.")
     run.add_argument("scene", help="scene TOML file")
     run.add_argument("--out", metavar="ARCHIVE.h5", help="archive to write, in an existing folder (default out/<scene name>.h5)")
     run.add_argument("--plots", metavar="DIR", help="folder for the plots, made in an existing folder (for a scene whose [outputs] lists no "
@@ -48,9 +52,12 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _main(argv: list[str] | None) -> int:
+    from modal.cli_name import program_name
+
+    prog = program_name("balancer", argv)
     argv = sys.argv[1:] if argv is None else list(argv)
     # a scene run does not need the influence command's modules
-    args = build_parser(influence=not (argv and argv[0] == "run")).parse_args(argv)
+    args = build_parser(influence=not (argv and argv[0] == "run"), prog=prog).parse_args(argv)
     warnings.showwarning = lambda message, *a, **k: print(f"warning: {message}", file=sys.stderr)
     if args.command == "influence":
         from .influence.cli import run as run_influence

@@ -55,8 +55,9 @@ def add_fit_options(parser: argparse.ArgumentParser) -> None:
     add_time_options(parser)
 
 
-def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="python -m modal", description="Experimental modal analysis.")
+def build_parser(prog: str = "python -m modal") -> argparse.ArgumentParser:
+    """The command-line parser; ``prog`` is the name usage and help give the program."""
+    parser = argparse.ArgumentParser(prog=prog, description="Experimental modal analysis.")
     sub = parser.add_subparsers(dest="command", required=True)
     fit = sub.add_parser("fit", help="identify the modes of an FRF file",
                          description="Identify natural frequency, damping, modal constant and k, c, m of every mode.")
@@ -255,7 +256,9 @@ def _report(args) -> int:
 
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit code."""
-    parser = build_parser()
+    from .cli_name import program_name
+
+    parser = build_parser(program_name("modal", argv))
     args = parser.parse_args(argv)  # exits with 2 on a usage error
     warnings.showwarning = _showwarning
     if args.command == "batch":

@@ -33,3 +33,11 @@ def test_cli_json_and_exit_codes(tmp_path):
     assert bad.returncode == 1 and bad.stderr.count("\n") == 1 and "s.toml" in bad.stderr
     usage = subprocess.run([sys.executable, "-m", "balancer", "run"], capture_output=True, text=True, timeout=60)
     assert usage.returncode == 2
+
+
+def test_run_help_says_what_a_run_does():
+    from balancer.cli import build_parser
+
+    run = build_parser()._subparsers._group_actions[0].choices["run"]
+    assert run.description and "scene" in run.description and "archive" in run.description
+    assert "Run a scene" in run.format_help()
