@@ -10,7 +10,7 @@ from matplotlib.ticker import MaxNLocator
 
 from .errors import ModalError
 from .figures import gap_fraction, margins, minor_tick_marks, plain_log_ticks
-from .frf import FRF, KIND_POWER
+from .frf import DEFAULT_UNITS, FRF, KIND_POWER
 from .model import mode_basis
 from .results import IdentificationResult
 
@@ -97,7 +97,8 @@ def _model_name(result: IdentificationResult) -> str:
 
 def plot_fit(frf: FRF, result: IdentificationResult | Sequence[IdentificationResult], channel: int | None = None,
              figure: Figure | None = None) -> Figure:
-    """Magnitude and phase with the fitted model(s) over the data, and each mode's Nyquist plot.
+    """Magnitude and phase with the fitted model(s) over the data, and each mode's Nyquist plot (mobility, the
+    model drawn densely around the resonance, its value at the natural frequency marked).
 
     Parameters
     ----------
@@ -130,17 +131,17 @@ def plot_fit(frf: FRF, result: IdentificationResult | Sequence[IdentificationRes
     nrows_nyq = max(-(-n_modes // _NYQUIST_COLUMNS), 1)
     if figure is None:
         # margins fixed in inches (a layout engine would measure every label twice before drawing)
-        width, height = 11.0, 5.0 + 2.2 * nrows_nyq
+        width, height = 11.0, 5.2 + 2.4 * nrows_nyq
         fig = Figure(figsize=(width, height))
         frame = margins(width, height, left=0.8, right=0.3, bottom=0.5, top=0.15)
         inner_w, inner_h = width - 1.1, height - 0.65
-        # between the phase and the Nyquist rows: the phase's x label, a Nyquist title and its offset text
-        outer = fig.add_gridspec(2, 1, height_ratios=[2.4, 1.1 * nrows_nyq], hspace=gap_fraction(0.95, inner_h, 2),
+        # between the phase and the Nyquist rows: the phase's x label and a Nyquist title of two lines
+        outer = fig.add_gridspec(2, 1, height_ratios=[2.4, 1.1 * nrows_nyq], hspace=gap_fraction(1.05, inner_h, 2),
                                  left=frame["left"], right=frame["right"], bottom=frame["bottom"], top=frame["top"])
-        top_h = (inner_h - 0.95) * 2.4 / (2.4 + 1.1 * nrows_nyq)
+        top_h = (inner_h - 1.05) * 2.4 / (2.4 + 1.1 * nrows_nyq)
         top = outer[0].subgridspec(2, 1, height_ratios=[1.4, 1.0], hspace=gap_fraction(0.3, top_h, 2))
         nyq = outer[1].subgridspec(nrows_nyq, ncols, wspace=gap_fraction(0.5, inner_w, ncols),
-                                   hspace=gap_fraction(0.75, inner_h - 0.95 - top_h, nrows_nyq))
+                                   hspace=gap_fraction(1.0, inner_h - 1.05 - top_h, nrows_nyq))
     else:
         fig = figure
         grid = fig.add_gridspec(2 + nrows_nyq, ncols, height_ratios=[1.4, 1.0] + [1.1] * nrows_nyq)
@@ -181,6 +182,7 @@ def plot_fit(frf: FRF, result: IdentificationResult | Sequence[IdentificationRes
             ax.axvline(mode.natural_frequency_hz, color="0.7", lw=0.6, zorder=0)
 
     power = KIND_POWER[frf.kind]
+    unit = _mobility_unit(frf)
     for r, mode in enumerate(first):
         ax = fig.add_subplot(nyq[r // _NYQUIST_COLUMNS, r % _NYQUIST_COLUMNS])
         if channel is not None:
@@ -195,24 +197,58 @@ def plot_fit(frf: FRF, result: IdentificationResult | Sequence[IdentificationRes
         w = omega[keep]
         to_mobility = (1j * w) ** (1 - power) if np.all(w > 0) else np.ones_like(w)
         y = data[ch, keep] * to_mobility
-        ax.plot(y.real, y.imag, ".", ms=3, color="0.3")
-        for k, (res, model) in enumerate(zip(results, models)):
+        traces = [("data", ".", "0.3", y, None)]
+        for k, (res, name, model) in enumerate(zip(results, names, models)):
             match = min(res.modes, key=lambda m: abs(m.natural_frequency_hz - mode.natural_frequency_hz), default=None)
             if match is None:
                 continue
-            dense = nyquist_omega(match.omega_n_rad_s, match.damping_ratio, w[0], w[-1])
+            # the model on lines dense around the resonance (a smooth circle however few measured lines fall
+            # there), and its value at the natural frequency marked
+            dense = np.union1d(nyquist_omega(match.omega_n_rad_s, match.damping_ratio, w[0], w[-1]),
+                               [match.omega_n_rad_s] if w[0] <= match.omega_n_rad_s <= w[-1] else [])
             ym = modes_response(dense, frf.kind, res)[ch] * ((1j * dense) ** (1 - power) if np.all(dense > 0) else 1)
             offset = np.mean(y - model[ch, keep] * to_mobility)  # what the model leaves out (other modes' tails)
-            ax.plot((ym + offset).real, (ym + offset).imag, _STYLES[k % 4], lw=1, color="C3" if k == 0 else f"C{k + 3}")
+            at_fn = np.flatnonzero(dense == match.omega_n_rad_s)
+            traces.append((f"model ({res.method})", _STYLES[k % 4], "C3" if k == 0 else f"C{k + 3}", ym + offset,
+                           at_fn[0] if at_fn.size else None))
+        # the panel's scale goes into its axis labels (an offset text above the panel would run into the title)
+        biggest = max(float(np.max(np.abs(np.concatenate([t[3].real, t[3].imag])))) for t in traces)
+        exponent = int(np.floor(np.log10(biggest))) if np.isfinite(biggest) and biggest > 0 else 0
+        exponent = 0 if 0 <= exponent <= 2 else exponent  # short tick labels: at most three digits before the point
+        scale = 10.0 ** exponent
+        for label, style, colour, values, mark in traces:
+            z = values / scale
+            if style == ".":
+                ax.plot(z.real, z.imag, ".", ms=3, color=colour, label=label)
+            else:
+                ax.plot(z.real, z.imag, style, lw=1, color=colour, label=label)
+                if mark is not None:
+                    ax.plot(z.real[mark], z.imag[mark], "x", ms=5, mew=1.2, color=colour,
+                            label="model at f_n" if r == 0 and label == traces[1][0] else None)
         ax.set_aspect("equal", adjustable="datalim")
-        ax.set_title(f"mode {r + 1}: {mode.natural_frequency_hz:.4g} Hz"
-                     + (f" (ch {ch})" if frf.n_channels > 1 else "")
-                     + (", flagged" if _serious(mode) else ""), fontsize="small")
+        detail = ", ".join(([f"ch {ch}"] if frf.n_channels > 1 else []) + (["flagged"] if _serious(mode) else []))
+        ax.set_title(f"mode {r + 1}: {mode.natural_frequency_hz:.4g} Hz" + (f"\n{detail}" if detail else ""),
+                     fontsize="small")
         ax.xaxis.set_major_locator(MaxNLocator(3))
         ax.yaxis.set_major_locator(MaxNLocator(4))
-        ax.ticklabel_format(style="sci", scilimits=(-2, 3))
+        ax.ticklabel_format(useOffset=False, style="plain")
         ax.tick_params(labelsize="x-small")
-        ax.set_xlabel("Re Y", fontsize="small")
+        factor = "" if exponent == 0 else f"10{str(exponent).translate(_SUPERSCRIPT)} "
+        ax.set_xlabel(f"Re Y [{factor}{unit}]", fontsize="small")
         if r % _NYQUIST_COLUMNS == 0:
-            ax.set_ylabel("Im Y (mobility)", fontsize="small")
+            ax.set_ylabel(f"Im Y [{factor}{unit}]", fontsize="small")
+        if r == 0:
+            ax.legend(loc="best", fontsize="xx-small", handlelength=1.5, framealpha=0.6)
     return fig
+
+
+_SUPERSCRIPT = str.maketrans("-0123456789", "⁻⁰¹²³⁴⁵⁶⁷⁸⁹")
+
+
+def _mobility_unit(frf: FRF) -> str:
+    """The unit of the Nyquist panels' mobility Y = H (iω)^(1 - p): m/s/N from SI units, else the FRF's own unit
+    times or over s."""
+    if frf.units == DEFAULT_UNITS[frf.kind]:
+        return DEFAULT_UNITS["mobility"]
+    power = KIND_POWER[frf.kind]
+    return frf.units if power == 1 else (f"{frf.units}·s" if power == 2 else f"({frf.units})/s")
