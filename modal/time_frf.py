@@ -8,12 +8,12 @@ under the same names and calls :func:`plan_time_frf` (when the scene is checked)
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Callable
 
 from .errors import FormatError
 from .estimate import estimate_frf
-from .frf import FRF_KINDS
+from .frf import DEFAULT_UNITS, FRF_KINDS
 
 __all__ = ["TIME_OPTIONS", "wants_time", "frf_from_time", "TimePlan", "plan_time_frf", "estimate_time_frf"]
 
@@ -135,7 +135,7 @@ def estimate_time_frf(record, plan: TimePlan, args):
     """The FRFs of ``record`` as ``plan`` says, with the estimation options of ``args`` (an EstimatedFRF)."""
     inputs, outputs = list(plan.inputs), list(plan.outputs)
     window = args.window or ("force" if args.impact else "hann")
-    return estimate_frf(
+    estimate = estimate_frf(
         record.signals[inputs], record.signals[outputs], record.sample_rate_hz,
         estimator=args.estimator or "H1", kind=plan.kind, segment_length=args.segment_length,
         overlap=0.5 if args.overlap is None else args.overlap, window=window,
@@ -143,3 +143,18 @@ def estimate_time_frf(record, plan: TimePlan, args):
         response_quantity=plan.quantity, excitation_points=[record.names[k] for k in inputs],
         response_points=[record.names[k] for k in outputs], source=record.source,
         full_scale=None if record.full_scale is None else [record.full_scale[k] for k in inputs + outputs])
+    units = _ratio_units(record, plan)
+    return estimate if units is None else replace(estimate, units=units)
+
+
+def _ratio_units(record, plan: TimePlan) -> str | None:
+    """The FRF's unit where the channels do not give the kind's own (``m/s^2/N``): what the responses were
+    recorded in over what the excitation was (a channel of unknown quantity is taken as it was stored); None
+    when a force in N and a response of known quantity give the kind's unit."""
+    force = all(record.quantities[k] == "force" for k in plan.inputs)
+    if force and plan.quantity is not None:
+        return None
+    top = DEFAULT_UNITS[plan.kind][:-2] if plan.quantity is not None else (
+        record.units[plan.outputs[0]] or "unit not given")
+    bottom = "N" if force else (record.units[plan.inputs[0]] or "unit not given")
+    return f"{top}/{bottom}" if "/" not in bottom and " " not in bottom else f"{top}/({bottom})"

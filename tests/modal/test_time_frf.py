@@ -31,3 +31,23 @@ def test_a_time_file_is_read_without_printing_and_the_choice_of_excitation_is_re
     fitted = fit_path(path, FitOptions(method="nls"))
     assert fitted.time_data is not None and len(fitted.results) == 1
     assert capsys.readouterr() == ("", "")
+
+
+def test_the_frf_unit_is_what_the_channels_were_recorded_in(tmp_path):
+    """A force in N over a response of known quantity gives the kind's unit; an excitation recorded in volts (taken as
+    the force, with a warning) gives m/.../V, and a response of unknown quantity keeps its own unit: never m/N by
+    default for what was not a force in N."""
+    import pytest
+
+    from modal.errors import ModalWarning
+
+    path = _time_csv(tmp_path / "record.csv")
+    text = path.read_text()
+    assert frf_from_time(path, FitOptions().namespace())[0].units == "m/N"
+    (tmp_path / "volts.csv").write_text(text.replace("force [N]", "drive [V]"))
+    with pytest.warns(ModalWarning, match="does not say it measured force"):
+        estimate = frf_from_time(tmp_path / "volts.csv", FitOptions(excitation="1").namespace())[0]
+    assert estimate.units == "m/V"
+    (tmp_path / "unknown.csv").write_text(text.replace("tip [m]", "tip [counts]"))
+    estimate = frf_from_time(tmp_path / "unknown.csv", FitOptions(kind="receptance").namespace())[0]
+    assert estimate.units == "counts/N"
