@@ -163,7 +163,7 @@ def _plotting_process(jobs_read: int, helpers: list[int]) -> dict:
     if setup is None:
         return {"drawn": {}}
     folder = Path(setup["folder"])
-    plots.preload(setup["stages"])  # and what drawing them imports: once, not in each drawing process
+    plots.preload(setup["stages"], setup.get("modules", ()))  # what drawing imports: once, not in each drawer
     read, write = os.pipe()
     helper = _fork_quietly()
     if helper == 0:
@@ -249,9 +249,12 @@ class Plotter:
         Folder of the figures.
     stages : sequence of str
         The plot stages it will be handed (the modules their figures need are imported at once).
+    modules : sequence of str
+        Modules of the run's result classes the figures are handed, imported at once too
+        (:func:`.plots.result_modules`).
     """
 
-    def __init__(self, jobs: int, folder: Path, stages=()):
+    def __init__(self, jobs: int, folder: Path, stages=(), modules=()):
         global _early
         self.folder = folder
         self.stages = list(stages)
@@ -265,7 +268,7 @@ class Plotter:
             _early = _spawn()
         if _early is not None:
             (self.pid, self._jobs, self._report), _early = _early, None
-            _write_record(self._jobs, {"folder": str(self.folder), "stages": self.stages})
+            _write_record(self._jobs, {"folder": str(self.folder), "stages": self.stages, "modules": list(modules)})
 
     @property
     def started(self) -> bool:

@@ -200,7 +200,11 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, p
     finally:
         if earlier is not None:
             earlier.close()
-    plotter = Plotter(plot_jobs, folder, plotted) if plotted else None
+    plotter = None
+    if plotted:
+        from .plots import result_modules
+
+        plotter = Plotter(plot_jobs, folder, plotted, result_modules(scene, plotted))
     # plot stages not yet handed to the child, in output order (a stage without figures draws nothing)
     pending = [stage for stage in plotted if REGISTRY[stage].figures]
 
