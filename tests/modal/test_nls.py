@@ -46,3 +46,23 @@ def test_residual_sum_of_squares_by_difference_matches_the_residual_it_stands_fo
         # the same rows formed alone: rounding of the fitted part, ~1e-16 of the data
         np.testing.assert_allclose(fit.residual[[3, 7]], residual[[3, 7]], rtol=0,
                                    atol=1e-13 * np.abs(frf.channels).max())
+
+
+def test_orthonormal_factor_of_the_design_matches_householder():
+    # the fit's projection: CholeskyQR2 of a well-conditioned design (mode columns with residual terms) gives
+    # Q orthonormal and Q R = Φ to rounding (a few ulp times the column count), like Householder's; a design
+    # with two equal columns (two poles at one frequency) is beyond it and takes Householder's QR, whose R
+    # then has a zero on its diagonal
+    from modal.nls import _orthonormal
+
+    omega = np.linspace(20, 400, 2001) / 100
+    basis = np.column_stack([1 / (w**2 - omega**2 + 2j * 0.01 * w * omega) for w in (0.5, 1.2, 2.5, 3.1)])
+    design = np.hstack([basis, (-omega**2)[:, None], np.ones((omega.size, 1))])
+    Q, R = _orthonormal(design)
+    assert np.abs(Q.conj().T @ Q - np.eye(6)).max() < 1e-14
+    assert np.abs(Q @ R - design).max() < 1e-14 * np.abs(design).max()
+    np.testing.assert_allclose(np.abs(np.diag(R)), np.abs(np.diag(np.linalg.qr(design)[1])), rtol=1e-12)
+    twice = np.hstack([basis, basis[:, :1]])
+    Q, R = _orthonormal(twice)
+    assert abs(R[-1, -1]) < 1e-12 * np.abs(R).max()
+    assert np.abs(Q @ R - twice).max() < 1e-14 * np.abs(twice).max()
