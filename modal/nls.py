@@ -44,6 +44,9 @@ class NLSFit:
         or over 1 where it is 0).
     line_weighted : bool
         The fit weighted its lines (``line_weight`` given): ``residual`` is the weighted one.
+    escaped : ndarray of bool, shape (n_modes,)
+        The poles within the lines whose damping ratio grew past ``max_damping`` (the fit stopped there,
+        not converged).
     """
 
     omega_n: np.ndarray
@@ -57,6 +60,7 @@ class NLSFit:
     residual: RowResidual | None = None
     channel_scale: np.ndarray | None = None
     line_weighted: bool = False
+    escaped: np.ndarray | None = None
 
 
 class RowResidual:
@@ -239,7 +243,8 @@ def _project(Phi, Y):
 def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, damping_ratio0,
               region: np.ndarray | None = None, max_iter: int = 200, step_tol: float = 1e-13,
               background_powers: tuple[int, ...] = (0,), residual_terms: bool = False,
-              line_weight: np.ndarray | None = None, channel_scale: np.ndarray | None = None) -> NLSFit:
+              line_weight: np.ndarray | None = None, channel_scale: np.ndarray | None = None,
+              max_damping: float | None = None) -> NLSFit:
     """Fit poles and modal constants of several modes to many channels at once.
 
     Parameters
@@ -277,6 +282,13 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
     channel_scale : ndarray, shape (n_channels,), optional
         max |H| of each channel over the lines, when the caller has it (each channel is fitted
         over it).
+    max_damping : float, optional
+        A pole within the lines whose damping ratio grows past this no longer describes a resonance: with
+        nothing in the data to lock onto (a pole on the tail of a mode outside the lines, or on noise) it
+        widens into a smooth background and absorbs what the residual terms leave. The fit stops at the
+        first accepted step that takes such a pole past it and marks it in ``escaped``, for the caller to
+        drop. Outside the lines a pole's damping is barely determined and a pole on its way to a mode
+        there may pass through wide ones: it is left to go on (the caller judges where it converges).
     """
     omega = np.asarray(omega, float)
     rows = np.ascontiguousarray(np.atleast_2d(np.asarray(response, complex)))  # (n_ch, n_freq), the FRF's unit
@@ -334,6 +346,7 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
         return Phi, dphi, Q, R, QhY, res, float(np.vdot(res, res).real)
 
     state = evaluate(params)
+    escaped = np.zeros(n_modes, bool)
     mode_of = np.repeat(np.arange(n_modes), 2)
     diagonal = np.arange(n_theta)
     lam = 1e-4
@@ -394,6 +407,11 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
             converged = bool(small or cost <= 1e-28 * np.vdot(Y, Y).real)
             break
         params, state = trial, new_state
+        if max_damping is not None:
+            wide = (params[1::2] > max_damping) & (params[0::2] >= x[0]) & (params[0::2] <= x[-1])
+            if wide.any():
+                escaped = wide
+                break
         lam = max(lam / 3, 1e-12)
         flat = cost - new_state[-1] <= 1e-13 * cost  # no decrease left above rounding
         if rel_step < step_tol or flat or new_state[-1] <= 1e-30 * np.vdot(Y, Y).real:
@@ -473,6 +491,7 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
         residual=residual,
         channel_scale=peak,
         line_weighted=weight is not None,
+        escaped=escaped,
     )
 
 

@@ -25,7 +25,7 @@ from ..nls import fit_modes
 from ..peaks import estimate_noise_std, find_modes
 from ..results import IdentificationResult
 from ..units import TWO_PI
-from .plscf import plscf_poles
+from .plscf import MAX_DAMPING, plscf_poles
 from .stabilisation import outside_band_poles, select_poles, stabilisation
 
 __all__ = ["identify_global", "channel_grid", "mpc"]
@@ -37,6 +37,14 @@ BEYOND_BAND = 1.25
 LOOSE_STEP_TOL = 1e-5
 #: ... and the final one (far below any standard error the data give, far above rounding)
 TIGHT_STEP_TOL = 1e-9
+#: rounds of the search for modes left in the residual, and candidates taken per round
+MISSING_ROUNDS = 3
+MISSING_PER_ROUND = 4
+#: a residual peak is a candidate mode only where its power over the channels stands this far above the
+#: residual's median over the lines (20 dB): the model's misfit of real data, 1-2 % everywhere, is no mode
+MISSING_PEAK_RATIO = 100.0
+#: ... and where it holds at least this share of the data's power (the model has no mode at the peak)
+MISSING_SHARE = 0.25
 
 
 def channel_grid(frf: FRF):
@@ -145,13 +153,174 @@ def _spare_duplicates(omega_n, weak, statistic):
 
 def _local_misfit(omega, H, misfit, noise, wn, zeta):
     """(chi-square, relative misfit) on the lines within ±3 half-power widths (at least ±3 lines) of a mode."""
-    near = lines_near_mode(omega, wn, zeta)
+    return _misfit_on(H, misfit, noise, lines_near_mode(omega, wn, zeta))
+
+
+def _inadequate(H, misfit, noise, near) -> bool:
+    """The flags' ``model_inadequate`` test on the lines ``near`` (a mask)."""
+    return model_inadequate(*_misfit_on(H, misfit, noise, near))
+
+
+def _misfit_on(H, misfit, noise, near):
+    """(chi-square, relative misfit) on the lines ``near`` (a mask over the lines)."""
     if not near.any():
         return np.nan, np.nan
     with np.errstate(divide="ignore", invalid="ignore"):
         chi2 = float(np.nanmean(np.abs(misfit[:, near]) ** 2 / np.where(noise > 0, noise, np.nan)[:, None] ** 2))
         relative = float(np.linalg.norm(misfit[:, near]) / np.linalg.norm(H[:, near]))
     return chi2, relative
+
+
+def _fit_within(omega, H, power, wn, zeta, step_tol):
+    """The joint fit with residual terms, without the poles that widen past :data:`MAX_DAMPING`.
+
+    A pole that the stabilisation kept on the tail of a mode outside the lines (or on noise) has no
+    resonance to lock onto: the fit widens it into a smooth background that absorbs what the residual
+    terms leave, two such poles side by side (an invented pair, ζ ≈ 3-8 on the 60-channel case, which the
+    significance test then kept: together they explain the out-of-band modes' leakage). The fit stops
+    when a pole within the lines leaves the physical damping range, or ends outside it anywhere; it is
+    dropped and the others go on from where they are.
+    Returns the fit and the dropped poles' frequencies (Hz).
+    """
+    removed: list[float] = []
+    while True:
+        with np.errstate(all="ignore"):
+            fit = fit_modes(omega, H, power, wn, zeta, region=None, residual_terms=True, step_tol=step_tol,
+                            max_damping=MAX_DAMPING)
+        # a pole outside the lines may pass through wide ones on its way to a mode there: only where it
+        # converges does its damping say it is background
+        wide = fit.escaped | (fit.damping_ratio > MAX_DAMPING)
+        if not wide.any() or wide.all():
+            return fit, removed
+        removed += [float(w / TWO_PI) for w in fit.omega_n[wide]]
+        wn, zeta = fit.omega_n[~wide], fit.damping_ratio[~wide]
+
+
+def _refine(omega, H, power, wn0, zeta0, noise):
+    """Joint refinement of the selected poles (rad/s, 1), with the significance test at the refined poles.
+
+    Two stages: to 1e-5 relative first, enough to test every mode's significance at its refined pole (a
+    pLSCF pole on the tail of a wide mode or near a band edge can pass the test at its pLSCF value, then
+    shrink onto a noise spike: 1 channel, 0.1 % noise: 1.9-9 against 13.8 after refinement), then, without
+    the modes that only fit noise, to 1e-9 relative: far below any standard error the data give (1e-6 at
+    best), far above rounding. A collapsing noise mode creeps for tens of iterations (its ζ shrinking by
+    ~20 % each); the first stage stops it early (benchmark case: 53 -> 24 iterations).
+    Returns the fit and the frequencies (Hz) of the poles dropped.
+    """
+    n_ch = H.shape[0]
+    fit, dropped = _fit_within(omega, H, power, wn0, zeta0, LOOSE_STEP_TOL)
+    tight = False
+    for _ in range(3):
+        statistic = _significance(omega, H, power, fit.omega_n, fit.damping_ratio, noise)
+        weak = np.zeros(fit.omega_n.size, bool) if statistic is None else statistic <= _significance_threshold(n_ch)
+        if weak.all():
+            weak[:] = False  # nothing explains more than the noise: keep the model, its flags say so
+        weak = _spare_duplicates(fit.omega_n, weak, statistic)
+        dropped += [float(w / TWO_PI) for w in fit.omega_n[weak]]
+        if tight and not weak.any():
+            break
+        fit, removed = _fit_within(omega, H, power, fit.omega_n[~weak], fit.damping_ratio[~weak], TIGHT_STEP_TOL)
+        dropped += removed
+        tight = True
+    return fit, dropped
+
+
+def _lsfd(omega, H, power, wn, zeta):
+    """One linear fit (LSFD) of every channel at the poles with the residual terms: the coefficients
+    (n_modes + 2, n_ch: the modal constants, then the upper and lower residual) and the misfit H − model."""
+    kind_factor = (1j * omega) ** power
+    design = np.hstack([mode_basis(omega, wn, zeta, power).T, kind_factor[:, None],
+                        -(kind_factor / omega**2)[:, None]])
+    coef = solve_linear(design, H.T)  # (n_modes + 2, n_ch)
+    return coef, H - (design @ coef).T
+
+
+def _residual_peaks(omega, H, misfit, noise, omega_n):
+    """Poles (rad/s, ζ) of modes the model misses, from peaks of its residual; empty arrays when none.
+
+    The residual power over the channels in units of each channel's noise variance, Σ_c |r_c|²/σ_c², is
+    Gamma(n_ch)-distributed on a line where the model explains all but noise. A candidate is a local
+    maximum of it above the 1e-6 quantile of that distribution divided among the lines (so noise alone
+    gives one once in 10⁶ fits) and :data:`MISSING_PEAK_RATIO` times its median over the lines, where the
+    residual holds at least :data:`MISSING_SHARE` of the data's power over the channels (the model has no
+    mode there: a missed mode leaves ~100 % of its peak; the misfit of a linear model near a measured peak,
+    real beam, at most 21 % in amplitude, 4 % in power), away from
+    the band's ends (an out-of-band mode's tail) and from the model's poles by two line spacings. Its
+    damping starts at the width over which the residual power stays above half its peak (a half-power
+    bandwidth of at least one line spacing). At most :data:`MISSING_PER_ROUND` candidates, the strongest.
+    """
+    if not np.all(np.isfinite(noise)) or np.any(noise <= 0) or omega.size < 10:
+        return np.zeros(0), np.zeros(0)
+    from scipy.special import gammainccinv
+
+    n_ch, n_freq = misfit.shape
+    power = np.einsum("cf,c->f", np.abs(misfit) ** 2, 1.0 / noise**2)
+    limit = max(float(gammainccinv(n_ch, 1e-6 / n_freq)), MISSING_PEAK_RATIO * float(np.median(power)))
+    share = np.sum(np.abs(misfit) ** 2, axis=0) / np.maximum(np.sum(np.abs(H) ** 2, axis=0), np.finfo(float).tiny)
+    inner = power[1:-1]
+    peak = np.flatnonzero((inner >= power[:-2]) & (inner > power[2:]) & (inner > limit)) + 1
+    peak = peak[share[peak] >= MISSING_SHARE]
+    spacing = float(np.median(np.diff(omega)))
+    peak = peak[(peak >= 2) & (peak <= n_freq - 3)]
+    if omega_n.size:
+        peak = peak[np.min(np.abs(omega[peak, None] - omega_n[None, :]), axis=1) > 2 * spacing]
+    peak = peak[np.argsort(power[peak])[::-1][:MISSING_PER_ROUND]]
+    wn, zeta = [], []
+    for k in peak:
+        lo, hi = k, k
+        while lo > 0 and power[lo - 1] > power[k] / 2:
+            lo -= 1
+        while hi < n_freq - 1 and power[hi + 1] > power[k] / 2:
+            hi += 1
+        width = max(omega[hi] - omega[lo], spacing)
+        wn.append(omega[k])
+        zeta.append(width / (2 * omega[k]))
+    return np.array(wn), np.array(zeta)
+
+
+def _add_missing(omega, H, power, fit, misfit, coef, noise):
+    """One round of the search for modes the model misses: (fit, misfit, coef, dropped Hz), or the inputs
+    with None when no candidate was kept.
+
+    Modes the stabilisation did not show stand in the residual of the fit: an under-resolved peak whose
+    damping wanders from order to order, where the model has no mode (:func:`_residual_peaks`), and a
+    mode pLSCF merged with its neighbour, where one pole leaves the data near it unexplained (the flags'
+    ``model_inadequate`` test: chi-square and relative misfit) and is tried as two, ωn(1 ± ζ). The
+    candidates enter the refinement together, and each is kept where the model with it explains the data
+    around it (the ``model_inadequate`` test passes there: misfit at the noise or within
+    :data:`~modal.flags.RELATIVE_MISFIT` of the data): a residual of real data that one more mode does not
+    explain is the model's limit, not a mode, and its candidate is taken out again.
+    """
+    wn_new, zeta_new = _residual_peaks(omega, H, misfit, noise, fit.omega_n)
+    regions = [np.abs(omega - w) <= 3.5 * float(np.median(np.diff(omega))) for w in wn_new]
+    split = np.zeros(fit.omega_n.size, bool)
+    for r, (wn, zeta) in enumerate(zip(fit.omega_n, fit.damping_ratio)):
+        chi2, relative = _local_misfit(omega, H, misfit, noise, wn, zeta)
+        if omega[0] < wn < omega[-1] and model_inadequate(chi2, relative) and split.sum() < MISSING_PER_ROUND:
+            split[r] = True
+            regions.append(lines_near_mode(omega, wn, zeta))
+    if not regions:
+        return fit, misfit, coef, None
+    pairs_wn = np.concatenate([fit.omega_n[split] * (1 - fit.damping_ratio[split]),
+                               fit.omega_n[split] * (1 + fit.damping_ratio[split])])
+    pairs_zeta = np.tile(fit.damping_ratio[split], 2)
+
+    def refit(take_new, take_split):
+        keep = ~(split & take_split)
+        wn0 = np.concatenate([fit.omega_n[keep], wn_new[take_new], pairs_wn[np.tile(take_split[split], 2)]])
+        zeta0 = np.concatenate([fit.damping_ratio[keep], zeta_new[take_new], pairs_zeta[np.tile(take_split[split], 2)]])
+        trial, removed = _refine(omega, H, power, wn0, zeta0, noise)
+        return (trial, removed, *_lsfd(omega, H, power, trial.omega_n, trial.damping_ratio))
+
+    trial, removed, coef_t, misfit_t = refit(np.ones(wn_new.size, bool), split)
+    explained = np.array([not _inadequate(H, misfit_t, noise, near) for near in regions])
+    if not explained.any():
+        return fit, misfit, coef, None
+    if not explained.all():
+        split_ok = np.zeros(fit.omega_n.size, bool)
+        split_ok[np.flatnonzero(split)] = explained[wn_new.size:]
+        trial, removed, coef_t, misfit_t = refit(explained[:wn_new.size], split_ok)
+    return trial, misfit_t, coef_t, removed
 
 
 def _default_max_order(frf: FRF, m: int) -> int:
@@ -233,44 +402,27 @@ def identify_global(frf: FRF, *, modes_hz=None, order: int | None = None, max_or
     if not selected:
         raise IdentificationError(f"{src}: no pole of the stabilisation diagram explains more than the noise; "
                                   "give modes_hz hints or check the data")
-    if modes_hz is None and order is None:
-        # modes just outside the lines, weakly seen by pLSCF: the refinement and its significance test decide
-        selected = sorted(selected + outside_band_poles(packs, diagram, work.frequency_hz[0], work.frequency_hz[-1],
-                                                        selected), key=lambda p: p.omega_n)
     wn0 = np.array([p.omega_n for p in selected])
     zeta0 = np.array([p.damping_ratio for p in selected])
-    # joint refinement in two stages: to 1e-5 relative first, enough to test every mode's significance at
-    # its refined pole (a pLSCF pole on the tail of a wide mode or near a band edge can pass the test at its
-    # pLSCF value, then shrink onto a noise spike: 1 channel, 0.1 % noise: 1.9-9 against 13.8 after
-    # refinement), then, without the modes that only fit noise, to 1e-9 relative: far below any standard
-    # error the data give (1e-6 at best), far above rounding. A collapsing noise mode creeps for tens of
-    # iterations (its ζ shrinking by ~20 % each); the first stage stops it early (benchmark case: 53 -> 24)
-    tight = False
-    with np.errstate(all="ignore"):
-        fit = fit_modes(omega, H, power, wn0, zeta0, region=None, residual_terms=True, step_tol=LOOSE_STEP_TOL)
-    for _ in range(3):
-        statistic = _significance(omega, H, power, fit.omega_n, fit.damping_ratio, noise)
-        weak = np.zeros(fit.omega_n.size, bool) if statistic is None else statistic <= _significance_threshold(n_ch)
-        if weak.all():
-            weak[:] = False  # nothing explains more than the noise: keep the model, its flags say so
-        weak = _spare_duplicates(fit.omega_n, weak, statistic)
-        dropped += [float(w / TWO_PI) for w in fit.omega_n[weak]]
-        if tight and not weak.any():
+    fit, removed = _refine(omega, H, power, wn0, zeta0, noise)
+    dropped += removed
+    coef, misfit = _lsfd(omega, H, power, fit.omega_n, fit.damping_ratio)
+    for _ in range(MISSING_ROUNDS):
+        fit, misfit, coef, removed = _add_missing(omega, H, power, fit, misfit, coef, noise)
+        if removed is None:
             break
-        with np.errstate(all="ignore"):
-            fit = fit_modes(omega, H, power, fit.omega_n[~weak], fit.damping_ratio[~weak], region=None,
-                            residual_terms=True, step_tol=TIGHT_STEP_TOL)
-        tight = True
-    # residual terms in physical form from one linear solve at the refined poles (LSFD)
-    basis = mode_basis(omega, fit.omega_n, fit.damping_ratio, power).T
-    kind_factor = (1j * omega) ** power
-    design = np.hstack([basis, kind_factor[:, None], -(kind_factor / omega**2)[:, None]])
-    coef = solve_linear(design, H.T)  # (n_modes + 2, n_ch)
-    residuals = coef[-2:].T  # (n_ch, 2): upper, lower
-
-    model = (basis @ coef[:-2] + np.outer(kind_factor, residuals[:, 0])
-             - np.outer(kind_factor / omega**2, residuals[:, 1])).T
-    misfit = H - model
+        dropped += removed
+    if modes_hz is None and order is None:
+        # modes just outside the lines, weakly seen by pLSCF, enter last, with the modes in the lines in place:
+        # their damping is barely determined and, started together with poles still moving, they wandered
+        # widely (into the lines as wide poles); the refinement and its significance test decide
+        outside = outside_band_poles(packs, diagram, work.frequency_hz[0], work.frequency_hz[-1], selected)
+        if outside:
+            fit, removed = _refine(omega, H, power, np.concatenate([fit.omega_n, [p.omega_n for p in outside]]),
+                                   np.concatenate([fit.damping_ratio, [p.damping_ratio for p in outside]]), noise)
+            dropped += removed
+            coef, misfit = _lsfd(omega, H, power, fit.omega_n, fit.damping_ratio)
+    residuals = coef[-2:].T  # (n_ch, 2): upper, lower: the residual terms in physical form
 
     spacing = float(np.median(np.diff(work.frequency_hz)))
     order_of = np.argsort(fit.omega_n)
@@ -299,8 +451,12 @@ def identify_global(frf: FRF, *, modes_hz=None, order: int | None = None, max_or
         if pole.n_stable_orders < WEAK_FRACTION * pole.n_orders or (pole.hinted and pole.n_stable_orders < 3):
             flags.add("weak_evidence")
         fn = wn / TWO_PI
+        # a half-power bandwidth under the line spacing (or about it): the fit still places the pole from the
+        # peak's shape, its errors from the Fisher information say how well, but the lines do not resolve it
         if fn < work.frequency_hz[0] + 2 * spacing or fn > work.frequency_hz[-1]:
             flags.add("outside_band")
+        elif np.count_nonzero(np.abs(work.frequency_hz - fn) <= zeta * fn) < 3:
+            flags.add("resolution_limited")
         later = fit.omega_n[fit.omega_n > wn]
         if later.size and wn < RIGID_BODY_RATIO * later.min():
             flags.add("rigid_body")

@@ -26,7 +26,11 @@ import numpy as np
 
 from ..errors import IdentificationError
 
-__all__ = ["PolePack", "plscf_poles"]
+__all__ = ["PolePack", "plscf_poles", "MAX_DAMPING"]
+
+#: largest damping ratio of a pole taken as a mode (pLSCF's poles beyond it are dropped; a pole the joint
+#: refinement widens beyond it is background, not a resonance)
+MAX_DAMPING = 0.3
 
 
 @dataclass(frozen=True)
@@ -57,7 +61,7 @@ def _toeplitz_blocks(seq: np.ndarray, order: int) -> np.ndarray:
     return seq[centre + j[None, :] - j[:, None]]
 
 
-def plscf_poles(omega: np.ndarray, frf: np.ndarray, orders, max_damping: float = 0.3,
+def plscf_poles(omega: np.ndarray, frf: np.ndarray, orders, max_damping: float = MAX_DAMPING,
                 beyond: float = 1.0) -> list[PolePack]:
     """Poles of the pLSCF model for each order in ``orders``.
 
