@@ -195,10 +195,11 @@ def _compress(rows: np.ndarray, scale: np.ndarray, probes: np.ndarray) -> np.nda
     randomised range finder of 20 columns with a power iteration, five products
     with Y, stayed within 3e-3). Modal constants and noise levels are computed
     afterwards on the full data. Both products read ``rows`` as they are (BLAS takes
-    the transpose): no scaled copy of every channel.
+    the transpose): no scaled copy of every channel. Both bases by :func:`_orthonormal` (CholeskyQR2 where
+    the columns are well apart, 3x faster than Householder's QR with its explicit Q here).
     """
-    basis, _ = np.linalg.qr(probes)
-    V, _ = np.linalg.qr((rows @ basis.conj()).conj() * scale[:, None])  # (n_ch, k) orthonormal: of (Q₀ᴴY)ᴴ
+    basis, _ = _orthonormal(probes)
+    V, _ = _orthonormal((rows @ basis.conj()).conj() * scale[:, None])  # (n_ch, k) orthonormal: of (Q₀ᴴY)ᴴ
     return rows.T @ (V * scale[:, None])
 
 
@@ -233,11 +234,21 @@ def _orthonormal(Phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.ascontiguousarray(Q), R
 
 
-def _project(Phi, Y):
+def _project(Phi, Y, y_energy):
+    """Q, R of ``Phi`` (:func:`_orthonormal`), QᴴY and the residual sum of squares ‖Y − Q QᴴY‖².
+
+    The sum is ‖Y‖² − ‖QᴴY‖² (``y_energy`` is ‖Y‖²; Q orthonormal): no residual of every line and column
+    is formed, where that difference keeps :data:`RSS_BY_DIFFERENCE` of ‖Y‖² (above the two sums' rounding
+    by 1e11); below (near-exact data) the residual is formed and summed.
+    """
     Q, R = _orthonormal(Phi)
     QhY = Q.conj().T @ Y
-    res = Y - Q @ QhY
-    return Q, R, QhY, res
+    parts = QhY.view(float)
+    cost = y_energy - float(np.einsum("ij,ij->", parts, parts))
+    if not cost >= RSS_BY_DIFFERENCE * y_energy:
+        res = Y - Q @ QhY
+        cost = float(np.vdot(res, res).real)
+    return Q, R, QhY, cost
 
 
 def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, damping_ratio0,
@@ -340,10 +351,12 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
         parts = Y.view(float)
         parts *= np.repeat(inverse_scale, 2)
 
+    y_energy = float(np.vdot(Y, Y).real)
+
     def evaluate(p):
         Phi, dphi = design(p)
-        Q, R, QhY, res = _project(Phi, Y)
-        return Phi, dphi, Q, R, QhY, res, float(np.vdot(res, res).real)
+        Q, R, QhY, cost = _project(Phi, Y, y_energy)
+        return Phi, dphi, Q, R, QhY, cost
 
     state = evaluate(params)
     escaped = np.zeros(n_modes, bool)
@@ -353,7 +366,7 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
     converged = False
     n_iter = 0
     for n_iter in range(1, max_iter + 1):
-        Phi, dphi, Q, R, QhY, res, cost = state
+        Phi, dphi, Q, R, QhY, cost = state
         C = np.linalg.solve(R, QhY)  # (n_b, n_ch)
         E = dphi - Q @ (Q.conj().T @ dphi)  # projected basis derivatives, (n_freq, n_theta)
         Cm = C[mode_of]  # (n_theta, n_ch): the coefficient multiplying each derivative
@@ -404,7 +417,7 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
             lam *= 4
         if not accepted:
             small = converged_here or rel_step < step_tol
-            converged = bool(small or cost <= 1e-28 * np.vdot(Y, Y).real)
+            converged = bool(small or cost <= 1e-28 * y_energy)
             break
         params, state = trial, new_state
         if max_damping is not None:
@@ -414,11 +427,11 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
                 break
         lam = max(lam / 3, 1e-12)
         flat = cost - new_state[-1] <= 1e-13 * cost  # no decrease left above rounding
-        if rel_step < step_tol or flat or new_state[-1] <= 1e-30 * np.vdot(Y, Y).real:
+        if rel_step < step_tol or flat or new_state[-1] <= 1e-30 * y_energy:
             converged = True
             break
 
-    Phi, dphi, Q, R, QhY, res, cost = state
+    Phi, dphi, Q, R, QhY, cost = state
     # back to every channel: one projection of the full data, channels first in the FRF's unit (no copy of
     # the data: BLAS reads ``rows`` transposed)
     projected = rows @ Q.conj()  # (Qᴴ Yᵀ)ᵀ, (n_ch, n_b)

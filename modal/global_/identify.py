@@ -26,7 +26,7 @@ from ..peaks import estimate_noise_std, find_modes
 from ..results import IdentificationResult
 from ..units import TWO_PI
 from .plscf import MAX_DAMPING, plscf_poles
-from .stabilisation import outside_band_poles, select_poles, stabilisation
+from .stabilisation import SelectedPole, outside_band_poles, select_poles, stabilisation
 
 __all__ = ["identify_global", "channel_grid", "mpc"]
 
@@ -196,32 +196,32 @@ def _fit_within(omega, H, power, wn, zeta, step_tol):
         wn, zeta = fit.omega_n[~wide], fit.damping_ratio[~wide]
 
 
-def _refine(omega, H, power, wn0, zeta0, noise):
-    """Joint refinement of the selected poles (rad/s, 1), with the significance test at the refined poles.
+def _refine(omega, H, power, wn0, zeta0, noise, step_tol=LOOSE_STEP_TOL):
+    """Joint refinement of the poles (rad/s, 1) to ``step_tol``, with the significance test at the refined
+    poles: the modes that only fit noise are dropped and the others refitted, until none is.
 
-    Two stages: to 1e-5 relative first, enough to test every mode's significance at its refined pole (a
-    pLSCF pole on the tail of a wide mode or near a band edge can pass the test at its pLSCF value, then
-    shrink onto a noise spike: 1 channel, 0.1 % noise: 1.9-9 against 13.8 after refinement), then, without
-    the modes that only fit noise, to 1e-9 relative: far below any standard error the data give (1e-6 at
-    best), far above rounding. A collapsing noise mode creeps for tens of iterations (its ζ shrinking by
-    ~20 % each); the first stage stops it early (benchmark case: 53 -> 24 iterations).
+    The search for missing modes refines to 1e-5 relative (:data:`LOOSE_STEP_TOL`), enough to test every
+    mode's significance at its refined pole (a pLSCF pole on the tail of a wide mode or near a band edge
+    can pass the test at its pLSCF value, then shrink onto a noise spike: 1 channel, 0.1 % noise: 1.9-9
+    against 13.8 after refinement); the final model, from there, to 1e-9 relative
+    (:data:`TIGHT_STEP_TOL`): far below any standard error the data give (1e-6 at best), far above
+    rounding. A collapsing noise mode creeps for tens of iterations (its ζ shrinking by ~20 % each); the
+    loose stages stop it early (benchmark case: 53 -> 24 iterations).
     Returns the fit and the frequencies (Hz) of the poles dropped.
     """
     n_ch = H.shape[0]
-    fit, dropped = _fit_within(omega, H, power, wn0, zeta0, LOOSE_STEP_TOL)
-    tight = False
+    fit, dropped = _fit_within(omega, H, power, wn0, zeta0, step_tol)
     for _ in range(3):
         statistic = _significance(omega, H, power, fit.omega_n, fit.damping_ratio, noise)
         weak = np.zeros(fit.omega_n.size, bool) if statistic is None else statistic <= _significance_threshold(n_ch)
         if weak.all():
             weak[:] = False  # nothing explains more than the noise: keep the model, its flags say so
         weak = _spare_duplicates(fit.omega_n, weak, statistic)
-        dropped += [float(w / TWO_PI) for w in fit.omega_n[weak]]
-        if tight and not weak.any():
+        if not weak.any():
             break
-        fit, removed = _fit_within(omega, H, power, fit.omega_n[~weak], fit.damping_ratio[~weak], TIGHT_STEP_TOL)
+        dropped += [float(w / TWO_PI) for w in fit.omega_n[weak]]
+        fit, removed = _fit_within(omega, H, power, fit.omega_n[~weak], fit.damping_ratio[~weak], step_tol)
         dropped += removed
-        tight = True
     return fit, dropped
 
 
@@ -382,7 +382,6 @@ def identify_global(frf: FRF, *, modes_hz=None, order: int | None = None, max_or
     diagram = stabilisation(packs)
     if order is not None and modes_hz is None:
         last = packs[-1]
-        from .stabilisation import SelectedPole
         selected = [SelectedPole(float(w), float(z), l, 1, 1) for w, z, l in
                     zip(last.omega_n, last.damping_ratio, last.participation)]
     else:
@@ -402,8 +401,15 @@ def identify_global(frf: FRF, *, modes_hz=None, order: int | None = None, max_or
     if not selected:
         raise IdentificationError(f"{src}: no pole of the stabilisation diagram explains more than the noise; "
                                   "give modes_hz hints or check the data")
-    wn0 = np.array([p.omega_n for p in selected])
-    zeta0 = np.array([p.damping_ratio for p in selected])
+    # modes just outside the lines, weakly seen by pLSCF, enter last, with the modes in the lines in place:
+    # their damping is barely determined and, started together with poles still moving, they wandered
+    # widely (into the lines as wide poles); the refinement and its significance test decide
+    inside = [p for p in selected if omega[0] <= p.omega_n <= omega[-1]] or selected
+    outside = [p for p in selected if not any(p is q for q in inside)]
+    if modes_hz is None and order is None:
+        outside += outside_band_poles(packs, diagram, work.frequency_hz[0], work.frequency_hz[-1], selected)
+    wn0 = np.array([p.omega_n for p in inside])
+    zeta0 = np.array([p.damping_ratio for p in inside])
     fit, removed = _refine(omega, H, power, wn0, zeta0, noise)
     dropped += removed
     coef, misfit = _lsfd(omega, H, power, fit.omega_n, fit.damping_ratio)
@@ -412,16 +418,13 @@ def identify_global(frf: FRF, *, modes_hz=None, order: int | None = None, max_or
         if removed is None:
             break
         dropped += removed
-    if modes_hz is None and order is None:
-        # modes just outside the lines, weakly seen by pLSCF, enter last, with the modes in the lines in place:
-        # their damping is barely determined and, started together with poles still moving, they wandered
-        # widely (into the lines as wide poles); the refinement and its significance test decide
-        outside = outside_band_poles(packs, diagram, work.frequency_hz[0], work.frequency_hz[-1], selected)
-        if outside:
-            fit, removed = _refine(omega, H, power, np.concatenate([fit.omega_n, [p.omega_n for p in outside]]),
-                                   np.concatenate([fit.damping_ratio, [p.damping_ratio for p in outside]]), noise)
-            dropped += removed
-            coef, misfit = _lsfd(omega, H, power, fit.omega_n, fit.damping_ratio)
+    if outside:
+        fit, removed = _refine(omega, H, power, np.concatenate([fit.omega_n, [p.omega_n for p in outside]]),
+                               np.concatenate([fit.damping_ratio, [p.damping_ratio for p in outside]]), noise)
+        dropped += removed
+    fit, removed = _refine(omega, H, power, fit.omega_n, fit.damping_ratio, noise, TIGHT_STEP_TOL)
+    dropped += removed
+    coef, misfit = _lsfd(omega, H, power, fit.omega_n, fit.damping_ratio)
     residuals = coef[-2:].T  # (n_ch, 2): upper, lower: the residual terms in physical form
 
     spacing = float(np.median(np.diff(work.frequency_hz)))
@@ -432,10 +435,16 @@ def identify_global(frf: FRF, *, modes_hz=None, order: int | None = None, max_or
     for r in range(m):
         ref_of_channel[index[:, r]] = r
     single = frf.response.ndim == 1
+    pool = inside + outside
+    pool_wn = np.array([p.omega_n for p in pool])
     estimates = []
     for r in order_of:
         wn, zeta = float(fit.omega_n[r]), float(fit.damping_ratio[r])
-        pole = selected[int(np.argmin(np.abs(wn0 - wn)))]
+        # the stabilisation's evidence for the mode: the chain of the pole it was started from; a mode found
+        # in the residual has none there (its evidence is the significance test and the misfit it removes)
+        pole = pool[int(np.argmin(np.abs(pool_wn - wn)))] if pool else None
+        if pole is not None and abs(pole.omega_n / wn - 1) > 0.01:
+            pole = SelectedPole(wn, zeta, np.full(m, np.nan), 0, 0, found_in_residual=True)
         cov = fit.mode_cov[r]
         const = fit.modal_constant[r]
         flags: set[str] = set()
@@ -448,7 +457,8 @@ def identify_global(frf: FRF, *, modes_hz=None, order: int | None = None, max_or
             flags.add("model_inadequate")
         s_wn = float(np.sqrt(max(cov[0, 0, 0], 0))) if np.isfinite(cov[0, 0, 0]) else np.nan
         s_z = float(np.sqrt(max(cov[0, 1, 1], 0))) if np.isfinite(cov[0, 1, 1]) else np.nan
-        if pole.n_stable_orders < WEAK_FRACTION * pole.n_orders or (pole.hinted and pole.n_stable_orders < 3):
+        weak = pole.n_stable_orders < WEAK_FRACTION * pole.n_orders or (pole.hinted and pole.n_stable_orders < 3)
+        if weak and not pole.found_in_residual:
             flags.add("weak_evidence")
         fn = wn / TWO_PI
         # a half-power bandwidth under the line spacing (or about it): the fit still places the pole from the

@@ -59,6 +59,8 @@ class SelectedPole:
     n_stable_orders: int
     n_orders: int
     hinted: bool = False
+    found_in_residual: bool = False
+    # found_in_residual: a mode the joint fit found in its residual, not in the diagram (no evidence there).
     # n_stable_orders counts the orders of the upper half of the sweep that hold the pole stable in
     # frequency, out of n_orders (the upper half's size)
 
