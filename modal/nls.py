@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["NLSFit", "RowResidual", "fit_modes", "truncation_shift"]
+__all__ = ["NLSFit", "RowResidual", "fit_modes", "orthonormal_factor", "truncation_shift"]
 
 
 @dataclass(frozen=True)
@@ -195,11 +195,11 @@ def _compress(rows: np.ndarray, scale: np.ndarray, probes: np.ndarray) -> np.nda
     randomised range finder of 20 columns with a power iteration, five products
     with Y, stayed within 3e-3). Modal constants and noise levels are computed
     afterwards on the full data. Both products read ``rows`` as they are (BLAS takes
-    the transpose): no scaled copy of every channel. Both bases by :func:`_orthonormal` (CholeskyQR2 where
+    the transpose): no scaled copy of every channel. Both bases by :func:`orthonormal_factor` (CholeskyQR2 where
     the columns are well apart, 3x faster than Householder's QR with its explicit Q here).
     """
-    basis, _ = _orthonormal(probes)
-    V, _ = _orthonormal((rows @ basis.conj()).conj() * scale[:, None])  # (n_ch, k) orthonormal: of (Q₀ᴴY)ᴴ
+    basis, _ = orthonormal_factor(probes)
+    V, _ = orthonormal_factor((rows @ basis.conj()).conj() * scale[:, None])  # (n_ch, k) orthonormal: of (Q₀ᴴY)ᴴ
     return rows.T @ (V * scale[:, None])
 
 
@@ -209,7 +209,7 @@ def _compress(rows: np.ndarray, scale: np.ndarray, probes: np.ndarray) -> np.nda
 CHOLESKY_QR_RATIO = 1e-6
 
 
-def _orthonormal(Phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def orthonormal_factor(Phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Q (n_freq, n_b) orthonormal and R upper triangular with Q R = ``Phi``.
 
     CholeskyQR2: the Gram matrix of the columns scaled to unit norm, its Cholesky factor, Q = Φ R⁻¹,
@@ -230,18 +230,20 @@ def _orthonormal(Phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
                 return Q @ np.linalg.inv(second), (second @ first) * norms
         except np.linalg.LinAlgError:
             pass
+        Q, R = np.linalg.qr(scaled)  # columns of very different size (receptance: 1/ω² against 1) stay apart
+        return np.ascontiguousarray(Q), R * norms
     Q, R = np.linalg.qr(Phi)
     return np.ascontiguousarray(Q), R
 
 
 def _project(Phi, Y, y_energy):
-    """Q, R of ``Phi`` (:func:`_orthonormal`), QᴴY and the residual sum of squares ‖Y − Q QᴴY‖².
+    """Q, R of ``Phi`` (:func:`orthonormal_factor`), QᴴY and the residual sum of squares ‖Y − Q QᴴY‖².
 
     The sum is ‖Y‖² − ‖QᴴY‖² (``y_energy`` is ‖Y‖²; Q orthonormal): no residual of every line and column
     is formed, where that difference keeps :data:`RSS_BY_DIFFERENCE` of ‖Y‖² (above the two sums' rounding
     by 1e11); below (near-exact data) the residual is formed and summed.
     """
-    Q, R = _orthonormal(Phi)
+    Q, R = orthonormal_factor(Phi)
     QhY = Q.conj().T @ Y
     parts = QhY.view(float)
     cost = y_energy - float(np.einsum("ij,ij->", parts, parts))

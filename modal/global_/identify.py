@@ -15,13 +15,14 @@
 from __future__ import annotations
 
 import numpy as np
+from scipy.linalg import solve_triangular
 
 from ..assemble import ModeEstimate, assemble_modes, driving_points
 from ..errors import IdentificationError
 from ..flags import MPC_LIMIT, RIGID_BODY_RATIO, WEAK_FRACTION, lines_near_mode, model_inadequate
 from ..frf import FRF, KIND_POWER
 from ..model import mode_basis, solve_linear
-from ..nls import fit_modes
+from ..nls import fit_modes, orthonormal_factor
 from ..peaks import estimate_noise_std, find_modes
 from ..results import IdentificationResult
 from ..units import TWO_PI
@@ -99,18 +100,20 @@ def _significance(omega, H, power, wn, zeta, noise):
     """
     if not np.all(np.isfinite(noise)) or np.any(noise <= 0):
         return None
-    kind = (1j * omega) ** power
-    design = np.hstack([mode_basis(omega, wn, zeta, power).T, kind[:, None], -(kind / omega**2)[:, None]])
-    norms = np.linalg.norm(design, axis=0)
-    norms[norms == 0] = 1.0
-    scaled = design / norms
-    coef, *_ = np.linalg.lstsq(scaled, H.T, rcond=None)
+    Q, R = orthonormal_factor(_lsfd_design(omega, power, wn, zeta))
     try:
-        inv_diag = np.real(np.diag(np.linalg.inv(scaled.conj().T @ scaled)))
+        Rinv = np.linalg.inv(R)
     except np.linalg.LinAlgError:
         return None
+    if not np.all(np.isfinite(Rinv)):
+        return None
+    coef = Rinv @ (Q.conj().T @ H.T)
+    inv_diag = np.sum(np.abs(Rinv) ** 2, axis=1)  # diag (DᴴD)⁻¹ = diag R⁻¹R⁻ᴴ
     n_modes = wn.size
-    gain = np.abs(coef[:n_modes]) ** 2 / inv_diag[:n_modes, None] / noise[None, :] ** 2
+    with np.errstate(divide="ignore", invalid="ignore"):
+        gain = np.abs(coef[:n_modes]) ** 2 / inv_diag[:n_modes, None] / noise[None, :] ** 2
+    if not np.all(np.isfinite(gain)):
+        return None
     return gain.sum(axis=1)
 
 
@@ -225,14 +228,23 @@ def _refine(omega, H, power, wn0, zeta0, noise, step_tol=LOOSE_STEP_TOL):
     return fit, dropped
 
 
+def _lsfd_design(omega, power, wn, zeta):
+    """The modes' columns at the poles, then the upper and lower residual terms, (n_freq, n_modes + 2)."""
+    kind_factor = (1j * omega) ** power
+    return np.hstack([mode_basis(omega, wn, zeta, power).T, kind_factor[:, None], -(kind_factor / omega**2)[:, None]])
+
+
 def _lsfd(omega, H, power, wn, zeta):
     """One linear fit (LSFD) of every channel at the poles with the residual terms: the coefficients
     (n_modes + 2, n_ch: the modal constants, then the upper and lower residual) and the misfit H − model."""
-    kind_factor = (1j * omega) ** power
-    design = np.hstack([mode_basis(omega, wn, zeta, power).T, kind_factor[:, None],
-                        -(kind_factor / omega**2)[:, None]])
-    coef = solve_linear(design, H.T)  # (n_modes + 2, n_ch)
-    return coef, H - (design @ coef).T
+    design = _lsfd_design(omega, power, wn, zeta)
+    Q, R = orthonormal_factor(design)
+    diagonal = np.abs(np.diag(R))
+    if not diagonal.min() > 1e-12 * diagonal.max():  # two poles at one frequency: the least-norm solution
+        coef = solve_linear(design, H.T)
+        return coef, H - (design @ coef).T
+    projected = Q.conj().T @ H.T  # (n_modes + 2, n_ch)
+    return solve_triangular(R, projected), H - (Q @ projected).T
 
 
 def _residual_peaks(omega, H, misfit, noise, omega_n):

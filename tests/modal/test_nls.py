@@ -53,16 +53,16 @@ def test_orthonormal_factor_of_the_design_matches_householder():
     # Q orthonormal and Q R = Φ to rounding (a few ulp times the column count), like Householder's; a design
     # with two equal columns (two poles at one frequency) is beyond it and takes Householder's QR, whose R
     # then has a zero on its diagonal
-    from modal.nls import _orthonormal
+    from modal.nls import orthonormal_factor
 
     omega = np.linspace(20, 400, 2001) / 100
     basis = np.column_stack([1 / (w**2 - omega**2 + 2j * 0.01 * w * omega) for w in (0.5, 1.2, 2.5, 3.1)])
     design = np.hstack([basis, (-omega**2)[:, None], np.ones((omega.size, 1))])
-    Q, R = _orthonormal(design)
+    Q, R = orthonormal_factor(design)
     assert np.abs(Q.conj().T @ Q - np.eye(6)).max() < 1e-14
     assert np.abs(Q @ R - design).max() < 1e-14 * np.abs(design).max()
     np.testing.assert_allclose(np.abs(np.diag(R)), np.abs(np.diag(np.linalg.qr(design)[1])), rtol=1e-12)
     twice = np.hstack([basis, basis[:, :1]])
-    Q, R = _orthonormal(twice)
+    Q, R = orthonormal_factor(twice)
     assert abs(R[-1, -1]) < 1e-12 * np.abs(R).max()
     assert np.abs(Q @ R - twice).max() < 1e-14 * np.abs(twice).max()
