@@ -253,11 +253,51 @@ def _project(Phi, Y, y_energy):
     return Q, R, QhY, cost
 
 
+def _fill_covariance(mode_cov, dphi, Q, R, Cm, noise_var) -> None:
+    """Covariance of (ωn, ζ, Re c, Im c) per mode and channel, in the fit's units, into ``mode_cov``
+    (n_modes, n_ch, 4, 4): the poles' from their Fisher information (the Schur complement, by the projected
+    Jacobian), the constants' from the linear fit's plus their sensitivity to the poles."""
+    n_theta = dphi.shape[1]
+    n_modes = n_theta // 2
+    E = dphi - Q @ (Q.conj().T @ dphi)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        weights = np.where(noise_var > 0, 1.0 / noise_var, np.inf)
+        # a channel fitted exactly (residual 0) has infinite weight: F is then not finite and
+        # the covariance is zero (below); inf·0 inside the product is expected, not an error
+        F = 2 * np.real((E.conj().T @ E) * ((Cm.conj() * weights) @ Cm.T))
+    cov_theta = np.full((n_theta, n_theta), np.nan)
+    if np.all(np.isfinite(F)):
+        cov_theta = _pole_covariance(F)
+    elif np.all(noise_var == 0):
+        cov_theta = np.zeros((n_theta, n_theta))
+    # sensitivity of the linear coefficients to the poles: G_j = −Φ⁺ ∂Φ/∂θ_j C
+    Rinv = np.linalg.inv(R)
+    H = Rinv @ (Q.conj().T @ dphi)  # (n_b, n_theta)
+    lin_var = np.sum(np.abs(Rinv) ** 2, axis=1)  # diag (ΦᴴΦ)⁻¹
+    for r in range(n_modes):
+        G = -H[r][:, None] * Cm  # (n_theta, n_ch): ∂c_r/∂θ_j per channel
+        g_re, g_im = G.real, G.imag
+        blk = mode_cov[r]
+        idx = [2 * r, 2 * r + 1]
+        blk[:, :2, :2] = cov_theta[2 * r:2 * r + 2, 2 * r:2 * r + 2]
+        cross_re = cov_theta[idx] @ g_re  # (2, n_ch)
+        cross_im = cov_theta[idx] @ g_im
+        blk[:, :2, 2] = cross_re.T
+        blk[:, :2, 3] = cross_im.T
+        blk[:, 2, :2] = cross_re.T
+        blk[:, 3, :2] = cross_im.T
+        lin = noise_var / 2 * lin_var[r]
+        spread_re, spread_im = cov_theta @ g_re, cov_theta @ g_im  # (n_theta, n_ch): gᵀ Σ g per channel below
+        blk[:, 2, 2] = lin + np.einsum("jc,jc->c", g_re, spread_re)
+        blk[:, 3, 3] = lin + np.einsum("jc,jc->c", g_im, spread_im)
+        blk[:, 2, 3] = blk[:, 3, 2] = np.einsum("jc,jc->c", g_re, spread_im)
+
+
 def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, damping_ratio0,
               region: np.ndarray | None = None, max_iter: int = 200, step_tol: float = 1e-13,
               background_powers: tuple[int, ...] = (0,), residual_terms: bool = False,
               line_weight: np.ndarray | None = None, channel_scale: np.ndarray | None = None,
-              max_damping: float | None = None) -> NLSFit:
+              max_damping: float | None = None, errors: bool = True) -> NLSFit:
     """Fit poles and modal constants of several modes to many channels at once.
 
     Parameters
@@ -302,6 +342,8 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
         first accepted step that takes such a pole past it and marks it in ``escaped``, for the caller to
         drop. Outside the lines a pole's damping is barely determined and a pole on its way to a mode
         there may pass through wide ones: it is left to go on (the caller judges where it converges).
+    errors : bool
+        Compute ``mode_cov`` (False: NaN; a fit whose poles only start another needs none).
     """
     omega = np.asarray(omega, float)
     rows = np.ascontiguousarray(np.atleast_2d(np.asarray(response, complex)))  # (n_ch, n_freq), the FRF's unit
@@ -453,40 +495,10 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
     rss *= inverse_scale**2
     dof = n_freq - n_b - n_theta / (2 * n_ch)
     noise_var = rss / dof if dof > 0 else np.full(n_ch, np.nan)
-    # Fisher information of the poles (Schur complement via the projected Jacobian)
-    E = dphi - Q @ (Q.conj().T @ dphi)
     Cm = C[mode_of]
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        weights = np.where(noise_var > 0, 1.0 / noise_var, np.inf)
-        # a channel fitted exactly (residual 0) has infinite weight: F is then not finite and
-        # the covariance is zero (below); inf·0 inside the product is expected, not an error
-        F = 2 * np.real((E.conj().T @ E) * ((Cm.conj() * weights) @ Cm.T))
-    cov_theta = np.full((n_theta, n_theta), np.nan)
-    if np.all(np.isfinite(F)):
-        cov_theta = _pole_covariance(F)
-    elif np.all(noise_var == 0):
-        cov_theta = np.zeros((n_theta, n_theta))
-    # sensitivity of the linear coefficients to the poles: G_j = −Φ⁺ ∂Φ/∂θ_j C
-    Rinv = np.linalg.inv(R)
-    H = Rinv @ (Q.conj().T @ dphi)  # (n_b, n_theta)
-    lin_var = np.sum(np.abs(Rinv) ** 2, axis=1)  # diag (ΦᴴΦ)⁻¹
-    mode_cov = np.empty((n_modes, n_ch, 4, 4))
-    for r in range(n_modes):
-        G = -H[r][:, None] * Cm  # (n_theta, n_ch): ∂c_r/∂θ_j per channel
-        g_re, g_im = G.real, G.imag
-        blk = mode_cov[r]
-        idx = [2 * r, 2 * r + 1]
-        blk[:, :2, :2] = cov_theta[2 * r:2 * r + 2, 2 * r:2 * r + 2]
-        cross_re = cov_theta[idx] @ g_re  # (2, n_ch)
-        cross_im = cov_theta[idx] @ g_im
-        blk[:, :2, 2] = cross_re.T
-        blk[:, :2, 3] = cross_im.T
-        blk[:, 2, :2] = cross_re.T
-        blk[:, 3, :2] = cross_im.T
-        lin = noise_var / 2 * lin_var[r]
-        blk[:, 2, 2] = lin + np.einsum("jc,jk,kc->c", g_re, cov_theta, g_re)
-        blk[:, 3, 3] = lin + np.einsum("jc,jk,kc->c", g_im, cov_theta, g_im)
-        blk[:, 2, 3] = blk[:, 3, 2] = np.einsum("jc,jk,kc->c", g_re, cov_theta, g_im)
+    mode_cov = np.full((n_modes, n_ch, 4, 4), np.nan)
+    if errors:
+        _fill_covariance(mode_cov, dphi, Q, R, Cm, noise_var)
     # back to physical units: x → ω = x w_ref; c → A = c · ch_scale · w_ref^(2−p)
     a_scale = ch_scale * w_ref ** (2 - power)  # (n_ch,)
     unit = np.empty((n_ch, 4))  # each channel's (ωn, ζ, Re A, Im A) per fitted unit

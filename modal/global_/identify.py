@@ -15,7 +15,6 @@
 from __future__ import annotations
 
 import numpy as np
-from scipy.linalg import solve_triangular
 
 from ..assemble import ModeEstimate, assemble_modes, driving_points
 from ..errors import IdentificationError
@@ -188,8 +187,9 @@ def _fit_within(omega, H, power, wn, zeta, step_tol):
     removed: list[float] = []
     while True:
         with np.errstate(all="ignore"):
+            # standard errors only for the final model (the loose fits only start others)
             fit = fit_modes(omega, H, power, wn, zeta, region=None, residual_terms=True, step_tol=step_tol,
-                            max_damping=MAX_DAMPING)
+                            max_damping=MAX_DAMPING, errors=step_tol <= TIGHT_STEP_TOL)
         # a pole outside the lines may pass through wide ones on its way to a mode there: only where it
         # converges does its damping say it is background
         wide = fit.escaped | (fit.damping_ratio > MAX_DAMPING)
@@ -244,7 +244,7 @@ def _lsfd(omega, H, power, wn, zeta):
         coef = solve_linear(design, H.T)
         return coef, H - (design @ coef).T
     projected = Q.conj().T @ H.T  # (n_modes + 2, n_ch)
-    return solve_triangular(R, projected), H - (Q @ projected).T
+    return np.linalg.solve(R, projected), H - (Q @ projected).T
 
 
 def _residual_peaks(omega, H, misfit, noise, omega_n):
