@@ -17,10 +17,11 @@ count of in-band modes missed (none within 0.3 %) and of modes reported that mat
 (in band, or above it within 4 of their standard errors), and the median of |error|/σ_CR, σ_CR the
 Cramér–Rao standard error of the full model as the joint refinement reports it.
 
-``--scaling``: time and peak memory (each point in a fresh process, Linux: the peak resident memory of the call,
-VmHWM reset before it, above the resident memory before it, with the FRF and every module loaded) of ``identify(frf, "global")`` over channels × lines × references up to 999
-channels (333 outputs × 3 references) × 8192 lines, with the slope of log time against log(channels × lines),
-and a plot of time against problem size (``--plot``).
+``--scaling``: time and peak memory of ``identify(frf, "global")`` over channels × lines × references up to 999
+channels (333 outputs × 3 references) × 8192 lines, each point in a fresh process (Linux: the peak resident
+memory of the call, VmHWM reset before it, above the resident memory before it, with the FRF and every module
+loaded), with the slope of log time against log(channels × lines), and a plot of time against problem size
+(``--plot``).
 """
 from __future__ import annotations
 

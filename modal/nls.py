@@ -129,15 +129,14 @@ def _design(x, numerator, x_squared, params, out, dphi):
     """
     n_modes = params.size // 2
     xr, zeta = params[0::2], params[1::2]
-    damping = (2j * x)[:, None] * zeta  # (n_freq, n_modes): 2iζx
-    denom = damping * xr
-    denom += xr * xr
-    denom -= x_squared[:, None]  # xr² − x² + 2iζ xr x
+    # the operations of each element in the same order as ever (archived results are reproduced bit for bit)
+    damping = (2j * zeta) * x[:, None]  # (n_freq, n_modes): 2iζx
+    denom = (xr * xr - x_squared[:, None]) + damping * xr  # xr² − x² + 2iζ xr x
     phi = numerator[:, None] / denom
     out[:, :n_modes] = phi
     slope = np.divide(phi, denom, out=phi)  # ∂φ/∂denom = −φ/denom
     np.multiply(slope, -(2 * xr + damping), out=dphi[:, 0::2])
-    np.multiply(slope, (-2j * x)[:, None] * xr, out=dphi[:, 1::2])
+    np.multiply(slope, -((2j * xr) * x[:, None]), out=dphi[:, 1::2])
     return out, dphi
 
 
@@ -210,6 +209,8 @@ def _compress(rows: np.ndarray, scale: np.ndarray, probes: np.ndarray) -> np.nda
 #: about 1/sqrt(eps)·1e-1 (its Cholesky factor's diagonal spread below this): there its Q is orthonormal and
 #: Q R = Φ to rounding, as Householder's (Yamamoto et al. 2015). Beyond, Householder QR
 CHOLESKY_QR_RATIO = 1e-6
+#: ... and while it has at least this many elements (1000 lines × 10 columns)
+CHOLESKY_QR_MIN_SIZE = 10_000
 
 
 def orthonormal_factor(Phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -219,10 +220,12 @@ def orthonormal_factor(Phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     and the same once more on Q to restore orthogonality to rounding. Two products with Φ of
     n_b² n_freq each, where Householder's QR with its explicit Q takes a dozen passes (16 ms against
     1 ms on 4000 lines × 17 columns). A design too ill-conditioned for it (two poles at one
-    frequency, a column of zeros) takes Householder's.
+    frequency, a column of zeros) takes Householder's, and so does a small one (below
+    :data:`CHOLESKY_QR_MIN_SIZE` elements, where Householder's costs little): small fits are
+    reproduced bit for bit as before CholeskyQR2 (an archived identification is).
     """
     norms = np.sqrt(np.einsum("ij,ij->j", Phi.real, Phi.real) + np.einsum("ij,ij->j", Phi.imag, Phi.imag))
-    if np.all(np.isfinite(norms)) and np.all(norms > 0):
+    if Phi.size >= CHOLESKY_QR_MIN_SIZE and np.all(np.isfinite(norms)) and np.all(norms > 0):
         scaled = Phi / norms
         try:
             first = np.linalg.cholesky(scaled.conj().T @ scaled).conj().T
@@ -233,27 +236,16 @@ def orthonormal_factor(Phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
                 return Q @ np.linalg.inv(second), (second @ first) * norms
         except np.linalg.LinAlgError:
             pass
-        Q, R = np.linalg.qr(scaled)  # columns of very different size (receptance: 1/ω² against 1) stay apart
-        return np.ascontiguousarray(Q), R * norms
     Q, R = np.linalg.qr(Phi)
     return np.ascontiguousarray(Q), R
 
 
-def _project(Phi, Y, y_energy):
-    """Q, R of ``Phi`` (:func:`orthonormal_factor`), QᴴY and the residual sum of squares ‖Y − Q QᴴY‖².
-
-    The sum is ‖Y‖² − ‖QᴴY‖² (``y_energy`` is ‖Y‖²; Q orthonormal): no residual of every line and column
-    is formed, where that difference keeps :data:`RSS_BY_DIFFERENCE` of ‖Y‖² (above the two sums' rounding
-    by 1e11); below (near-exact data) the residual is formed and summed.
-    """
+def _project(Phi, Y):
+    """Q, R of ``Phi`` (:func:`orthonormal_factor`), QᴴY and the residual sum of squares ‖Y − Q QᴴY‖²."""
     Q, R = orthonormal_factor(Phi)
     QhY = Q.conj().T @ Y
-    parts = QhY.view(float)
-    cost = y_energy - float(np.einsum("ij,ij->", parts, parts))
-    if not cost >= RSS_BY_DIFFERENCE * y_energy:
-        res = Y - Q @ QhY
-        cost = float(np.vdot(res, res).real)
-    return Q, R, QhY, cost
+    res = Y - Q @ QhY
+    return Q, R, QhY, float(np.vdot(res, res).real)
 
 
 def _fill_covariance(mode_cov, dphi, Q, R, Cm, noise_var) -> None:
@@ -290,10 +282,9 @@ def _fill_covariance(mode_cov, dphi, Q, R, Cm, noise_var) -> None:
         blk[:, 2, :2] = cross_re.T
         blk[:, 3, :2] = cross_im.T
         lin = noise_var / 2 * lin_var[r]
-        spread_re, spread_im = cov_theta @ g_re, cov_theta @ g_im  # (n_theta, n_ch): gᵀ Σ g per channel below
-        blk[:, 2, 2] = lin + np.einsum("jc,jc->c", g_re, spread_re)
-        blk[:, 3, 3] = lin + np.einsum("jc,jc->c", g_im, spread_im)
-        blk[:, 2, 3] = blk[:, 3, 2] = np.einsum("jc,jc->c", g_re, spread_im)
+        blk[:, 2, 2] = lin + np.einsum("jc,jk,kc->c", g_re, cov_theta, g_re)
+        blk[:, 3, 3] = lin + np.einsum("jc,jk,kc->c", g_im, cov_theta, g_im)
+        blk[:, 2, 3] = blk[:, 3, 2] = np.einsum("jc,jk,kc->c", g_re, cov_theta, g_im)
 
 
 def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, damping_ratio0,
@@ -402,7 +393,7 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
 
     def evaluate(p):
         Phi, dphi = design(p)
-        Q, R, QhY, cost = _project(Phi, Y, y_energy)
+        Q, R, QhY, cost = _project(Phi, Y)
         return Phi, dphi, Q, R, QhY, cost
 
     state = evaluate(params)

@@ -99,7 +99,10 @@ def _significance(omega, H, power, wn, zeta, noise):
     """
     if not np.all(np.isfinite(noise)) or np.any(noise <= 0):
         return None
-    Q, R = orthonormal_factor(_lsfd_design(omega, power, wn, zeta))
+    design = _lsfd_design(omega, power, wn, zeta)
+    norms = np.linalg.norm(design, axis=0)
+    norms[norms == 0] = 1.0
+    Q, R = orthonormal_factor(design / norms)  # the ratio below does not depend on the columns' scale
     try:
         Rinv = np.linalg.inv(R)
     except np.linalg.LinAlgError:
@@ -238,13 +241,16 @@ def _lsfd(omega, H, power, wn, zeta):
     """One linear fit (LSFD) of every channel at the poles with the residual terms: the coefficients
     (n_modes + 2, n_ch: the modal constants, then the upper and lower residual) and the misfit H − model."""
     design = _lsfd_design(omega, power, wn, zeta)
-    Q, R = orthonormal_factor(design)
+    norms = np.linalg.norm(design, axis=0)
+    norms[norms == 0] = 1.0
+    # columns scaled to unit norm: receptance's 1/ω² and the residual terms' 1 differ by 1e16 at 1e8 rad/s
+    Q, R = orthonormal_factor(design / norms)
     diagonal = np.abs(np.diag(R))
     if not diagonal.min() > 1e-12 * diagonal.max():  # two poles at one frequency: the least-norm solution
         coef = solve_linear(design, H.T)
         return coef, H - (design @ coef).T
     projected = Q.conj().T @ H.T  # (n_modes + 2, n_ch)
-    return np.linalg.solve(R, projected), H - (Q @ projected).T
+    return np.linalg.solve(R, projected) / norms[:, None], H - (Q @ projected).T
 
 
 def _residual_peaks(omega, H, misfit, noise, omega_n):
@@ -425,7 +431,8 @@ def identify_global(frf: FRF, *, modes_hz=None, order: int | None = None, max_or
     fit, removed = _refine(omega, H, power, wn0, zeta0, noise)
     dropped += removed
     coef, misfit = _lsfd(omega, H, power, fit.omega_n, fit.damping_ratio)
-    for _ in range(MISSING_ROUNDS):
+    # with hints or one order the user chose the modes: none is added
+    for _ in range(MISSING_ROUNDS if modes_hz is None and order is None else 0):
         fit, misfit, coef, removed = _add_missing(omega, H, power, fit, misfit, coef, noise)
         if removed is None:
             break
