@@ -187,3 +187,10 @@ from .synthetic_time import (  # noqa: E402
 )
 
 __all__ += ["DigitalModes", "SyntheticRecord", "hammer_force", "impact_record", "random_record"]
+
+# ------------------------------------------------------------ ambient (output-only) records
+from .synthetic_ambient import (  # noqa: E402
+    AmbientRecord, ambient_modal_response, ambient_response, chain_matrices,
+)
+
+__all__ += ["AmbientRecord", "ambient_response", "ambient_modal_response", "chain_matrices"]
