@@ -81,6 +81,14 @@ FLAG_TEXT = {
                     "least-squares refinement of the same modes (the method's own bias: line spacing, noise at the "
                     "peak, a neighbouring mode); its standard errors include the difference, method 'nls' gives the "
                     "refined values"),
+    # operational (output-only) analysis
+    "harmonic": ("operational: the mode lies on a harmonic k x rotor_speed_hz of the running speed (within 3 of its "
+                 "standard errors and 0.5 %), where a machine tone may bias its frequency and damping"),
+    "scaling_uncertain": ("mass-change scaling: the frequency shift is below 3 of its standard errors, or the scale "
+                          "factor's standard error exceeds 10 % of it (too little added mass, or added where the mode "
+                          "barely moves): the mass-normalised shape and k, c, m are poorly determined"),
+    "missing_in_setup": ("merged setups: the mode was not found in every setup; the shape entries of the setups "
+                         "without it are NaN"),
 }
 
 
@@ -138,6 +146,9 @@ FLAG_ACTION = {
     "rigid_body": "nothing to do for flexible modes; do not use it as a structural mode",
     "complex_shape": "check for close modes or noise; k, c, m and shape comparisons are approximate",
     "method_bias": "use the nls (or global) values, which the half-power and circle estimates start from",
+    "harmonic": "check the running speed; measure at another speed to move the tone off the mode",
+    "scaling_uncertain": "add more mass (a frequency shift of 2-5 %), where the mode moves most",
+    "missing_in_setup": "excite the mode better in that setup, or leave its channels out of the merged shape",
 }
 
 #: Flags of an estimate the line spacing limits: its error includes the grid's quantisation

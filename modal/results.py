@@ -31,6 +31,8 @@ class ModeStd:
     stiffness_n_per_m: np.ndarray | float
     damping_n_s_per_m: np.ndarray | float
     mass_kg: np.ndarray | float
+    #: operational modes: standard error of each entry of ``mode_shape``, sqrt(var Re + var Im)
+    mode_shape: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -160,6 +162,8 @@ class IdentificationResult:
     residuals: np.ndarray | None = None
     stabilisation: Any = None
     settings: dict = field(default_factory=dict)
+    #: operational analysis: frequencies (Hz) of the machine tones found, listed apart from the modes
+    harmonics_hz: tuple[float, ...] = ()
 
     def archive_units(self) -> dict[str, str]:
         """Units of the fields whose names do not say them (for :mod:`modal.archive`)."""
@@ -237,7 +241,8 @@ class IdentificationResult:
                 }
                 for name in names:
                     row[name] = complex(pick(getattr(mode, name))) if name == "modal_constant" else float(pick(getattr(mode, name)))
-                row["std"] = {f.name: float(pick(getattr(mode.std, f.name))) for f in fields(ModeStd)}
+                row["std"] = {f.name: float(pick(getattr(mode.std, f.name))) for f in fields(ModeStd)
+                              if getattr(mode.std, f.name) is not None}
                 row["driving_point"] = bool(pick(mode.driving_point))
                 row["flags"] = channel_flags(mode.flags, row["driving_point"])  # only those that apply here
                 row["band_hz"] = [float(b) for b in mode.band_hz]

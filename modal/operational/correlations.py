@@ -1,0 +1,158 @@
+"""Output correlations of an ambient record: decimation to the band, reference channels, and the
+correlation functions by FFT, kept per block of the record for the error bars.
+
+The correlation ``R_k = E[y(t + kΔt) y_ref(t)ᵀ]`` (outputs × references) is estimated from segments
+of the record: each segment of ``n_seg`` samples of the references is correlated, by one FFT product,
+with the same stretch of every output extended by the longest lag (overlap-save), so that every pair
+of samples up to the longest lag is counted exactly once. The cross-spectra are summed over the
+segments of a block with one matrix product per frequency line; the block sums, transformed back,
+are the blocks' unbiased correlations and their mean the record's.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ParameterError
+
+__all__ = ["Correlations", "correlations", "decimation_factor", "decimate", "choose_references"]
+
+#: after decimation the band's upper edge lies at or below this fraction of the new Nyquist frequency
+BAND_FRACTION_OF_NYQUIST = 0.5
+#: the record is cut into this many blocks for the error bars (fewer when it is short)
+MAX_BLOCKS = 100
+
+
+@dataclass(frozen=True)
+class Correlations:
+    """Correlation functions of a record, for lags 0…``max_lag``.
+
+    Attributes
+    ----------
+    blocks : ndarray, shape (n_blocks, max_lag + 1, n_outputs, n_references)
+        Each block's unbiased correlation estimate (units² of the signals).
+    weights : ndarray, shape (n_blocks,)
+        Samples per block (the record's estimate is their weighted mean).
+    sample_rate_hz : float
+        Rate of the (decimated) signals.
+    references : tuple of int
+        Output channels used as references (projection channels).
+    """
+
+    blocks: np.ndarray
+    weights: np.ndarray
+    sample_rate_hz: float
+    references: tuple[int, ...]
+
+    @property
+    def mean(self) -> np.ndarray:
+        """The record's correlation, shape (max_lag + 1, n_outputs, n_references)."""
+        return np.tensordot(self.weights / self.weights.sum(), self.blocks, axes=1)
+
+    @property
+    def max_lag(self) -> int:
+        return self.blocks.shape[1] - 1
+
+    def grouped(self, n_groups: int) -> tuple[np.ndarray, np.ndarray]:
+        """The blocks merged into ``n_groups`` contiguous groups: (correlations, weights)."""
+        n = self.blocks.shape[0]
+        n_groups = int(min(max(n_groups, 1), n))
+        edges = np.linspace(0, n, n_groups + 1).round().astype(int)
+        weights = np.add.reduceat(self.weights, edges[:-1])
+        sums = np.add.reduceat(self.blocks * self.weights[:, None, None, None], edges[:-1], axis=0)
+        return sums / weights[:, None, None, None], weights
+
+
+def decimation_factor(sample_rate_hz: float, high_hz: float) -> int:
+    """The largest integer factor that keeps ``high_hz`` below :data:`BAND_FRACTION_OF_NYQUIST` of the new
+    Nyquist frequency (1: no decimation)."""
+    return max(1, int(np.floor(sample_rate_hz * BAND_FRACTION_OF_NYQUIST / (2.0 * high_hz))))
+
+
+def decimate(signals: np.ndarray, factor: int) -> np.ndarray:
+    """Low-pass filter (linear-phase FIR, polyphase) and keep every ``factor``-th sample."""
+    if factor <= 1:
+        return signals
+    from scipy.signal import resample_poly
+
+    return resample_poly(signals, 1, factor, axis=1)
+
+
+def _segment_length(max_lag: int, n_samples: int) -> int:
+    """Samples per segment: a fast FFT length of at least 8 lags (the extension by the longest lag then
+    costs at most an eighth more), at least 1024, at most the record."""
+    from scipy.fft import next_fast_len
+
+    n_seg = next_fast_len(max(8 * max_lag, 1024), real=True) - max_lag
+    return int(max(min(n_seg, n_samples - max_lag), max_lag + 1))
+
+
+def correlations(signals: np.ndarray, sample_rate_hz: float, references, max_lag: int,
+                 max_blocks: int = MAX_BLOCKS) -> Correlations:
+    """Correlations ``R_k``, k = 0…``max_lag``, of every output with the references, per block.
+
+    Parameters
+    ----------
+    signals : ndarray, shape (n_outputs, n_samples)
+        Zero-mean signals.
+    sample_rate_hz : float
+    references : sequence of int
+        Reference channels (indices into the outputs).
+    max_lag : int
+        Longest lag, samples.
+    max_blocks : int
+        At most this many blocks (each of whole segments).
+
+    Returns
+    -------
+    Correlations
+    """
+    from scipy import fft as sfft
+
+    refs = np.asarray(references, int)
+    n_out, n = signals.shape
+    n_seg = _segment_length(max_lag, n)
+    n_fft = sfft.next_fast_len(n_seg + max_lag, real=True)
+    n_segments = (n - max_lag) // n_seg
+    if n_segments < 1:
+        raise ParameterError(f"{n} samples hold no segment of {n_seg} samples plus the longest lag {max_lag}")
+    n_blocks = int(min(max_blocks, n_segments))
+    edges = np.linspace(0, n_segments, n_blocks + 1).round().astype(int)
+    # float32 FFTs: their rounding (1e-7 relative) lies far below the estimates' scatter (1/√samples)
+    data = np.ascontiguousarray(signals, dtype=np.float32)
+    windows = np.lib.stride_tricks.sliding_window_view(data, n_seg + max_lag, axis=1)
+    spectra = np.empty((n_blocks, n_fft // 2 + 1, n_out, refs.size), complex)
+    for b in range(n_blocks):
+        ext = windows[:, edges[b] * n_seg:(edges[b + 1] - 1) * n_seg + 1:n_seg]  # (n_out, segs, n_seg + lag)
+        future = sfft.rfft(ext, n=n_fft, axis=-1)  # every output, extended by the longest lag
+        past = sfft.rfft(ext[refs, :, :n_seg], n=n_fft, axis=-1)  # the references' segments, zero-padded
+        # Σ over the block's segments of Y_o(f) conj(X_r(f)): one (outputs × segments)(segments × refs)
+        # product per line
+        spectra[b] = np.matmul(future.transpose(2, 0, 1), past.conj().transpose(2, 1, 0))
+    lagged = sfft.irfft(spectra, n=n_fft, axis=1)[:, :max_lag + 1]  # (blocks, lags, n_out, refs)
+    weights = (np.diff(edges) * n_seg).astype(float)
+    return Correlations(lagged / weights[:, None, None, None], weights, float(sample_rate_hz),
+                        tuple(int(r) for r in refs))
+
+
+def choose_references(signals: np.ndarray, n_references: int, probe_lags: int = 8) -> tuple[int, ...]:
+    """The channels that best span the outputs' correlations, for projection.
+
+    Each channel is scaled to unit RMS; the correlations of every channel with every other
+    over a few lags (from at most 2¹⁶ samples) form the columns of one matrix, and a
+    column-pivoted QR picks the ``n_references`` channels that are the most independent and
+    carry the most correlated (not white) signal: white measurement noise only enters lag 0,
+    which is left out.
+    """
+    from scipy.linalg import qr
+
+    n_out, n = signals.shape
+    if n_references >= n_out:
+        return tuple(range(n_out))
+    piece = signals[:, : min(n, 1 << 16)]
+    piece = piece / np.sqrt(np.mean(piece**2, axis=1, keepdims=True))
+    corr = correlations(piece, 1.0, range(n_out), probe_lags, max_blocks=1).mean[1:]  # (lags, n_out, n_out)
+    columns = np.moveaxis(corr, 2, 0).reshape(n_out, -1).T  # one column per candidate reference
+    _, _, pivots = qr(columns, mode="economic", pivoting=True)
+    return tuple(sorted(int(p) for p in pivots[:n_references]))

@@ -1,0 +1,154 @@
+"""Checking and preparing an ambient record: one place for the errors a user sees about the input.
+
+Every problem is one :class:`~modal.errors.ParameterError` naming the record (the file, when it
+came from one), the field and what was expected.
+"""
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ParameterError
+from .correlations import decimate, decimation_factor
+
+__all__ = ["Prepared", "prepare", "check_band", "check_channels"]
+
+#: a channel whose standard deviation is below this fraction of the largest channel's is constant
+CONSTANT_CHANNEL = 1e-12
+#: the record must hold at least this many times the longest correlation lag
+MIN_LAGS_IN_RECORD = 40
+
+
+@dataclass(frozen=True)
+class Prepared:
+    """A record ready for correlation: zero-mean channels of unit RMS, decimated to the band.
+
+    Attributes
+    ----------
+    signals : ndarray, shape (n_channels, n_samples)
+    sample_rate_hz : float
+        After decimation.
+    scale : ndarray, shape (n_channels,)
+        Each channel's RMS in the input's units (shapes are scaled back by it).
+    band_hz : (float, float)
+    decimation : int
+    original_rate_hz : float
+    quantity : str or None
+    names : tuple of str
+    source : str
+    """
+
+    signals: np.ndarray
+    sample_rate_hz: float
+    scale: np.ndarray
+    band_hz: tuple[float, float]
+    decimation: int
+    original_rate_hz: float
+    quantity: str | None
+    names: tuple[str, ...]
+    source: str
+
+    @property
+    def n_channels(self) -> int:
+        return self.signals.shape[0]
+
+    @property
+    def duration_s(self) -> float:
+        return self.signals.shape[1] / self.sample_rate_hz
+
+
+def _record(data, sample_rate_hz):
+    """(signals, rate, quantity, names, source) from an array, a TimeRecord or a path."""
+    from ..io.timedata import TimeRecord, read_time
+
+    if isinstance(data, (str, os.PathLike)):
+        data = read_time(data)
+    if isinstance(data, TimeRecord):
+        if sample_rate_hz is not None and not np.isclose(float(sample_rate_hz), data.sample_rate_hz):
+            raise ParameterError(f"{data.source}: sample_rate_hz={sample_rate_hz!r} contradicts the file's "
+                                 f"{data.sample_rate_hz:g} Hz; leave it out")
+        quantities = {q for q in data.quantities if q is not None}
+        if "force" in quantities:
+            forces = ", ".join(str(k + 1) for k in data.force_channels())
+            raise ParameterError(f"{data.source}: channel(s) {forces} measured force; expected responses only "
+                                 "(with a force channel, estimate FRFs: python -m modal fit)")
+        quantity = quantities.pop() if len(quantities) == 1 else None
+        return np.asarray(data.signals, float), data.sample_rate_hz, quantity, tuple(data.names), data.source
+    arr = np.asarray(data)
+    if arr.dtype.kind not in "biuf":
+        raise ParameterError(f"<array>: 'data' has dtype {arr.dtype}; expected real numbers (n_channels, n_samples)")
+    if sample_rate_hz is None:
+        raise ParameterError("<array>: 'sample_rate_hz' is missing; expected the sampling rate in Hz for an array")
+    names = tuple(str(k) for k in range(arr.shape[0])) if arr.ndim == 2 else ()
+    return arr.astype(float), float(sample_rate_hz), None, names, "<array>"
+
+
+def check_band(band_hz, nyquist_hz: float, src: str) -> tuple[float, float]:
+    """The band as two floats with 0 ≤ low < high ≤ Nyquist (default: up to 80 % of Nyquist)."""
+    if band_hz is None:
+        return 0.0, 0.8 * nyquist_hz
+    try:
+        low, high = (float(v) for v in band_hz)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{src}: 'band_hz' is {band_hz!r}; expected two frequencies (FMIN, FMAX) in Hz") from None
+    if not (np.isfinite(low) and np.isfinite(high) and 0 <= low < high <= nyquist_hz):
+        raise ParameterError(f"{src}: 'band_hz' is ({low:g}, {high:g}); expected 0 <= FMIN < FMAX <= "
+                             f"{nyquist_hz:g} Hz (the Nyquist frequency)")
+    return low, high
+
+
+def check_channels(signals: np.ndarray, src: str, names=()) -> None:
+    """Two or more channels of finite samples, none constant."""
+    if signals.ndim != 2:
+        raise ParameterError(f"{src}: 'data' has shape {signals.shape}; expected (n_channels, n_samples)")
+    if signals.shape[0] < 2:
+        raise ParameterError(f"{src}: {signals.shape[0]} channel; operational modal analysis needs at least 2 "
+                             "response channels (data of shape (n_channels, n_samples))")
+    bad = ~np.isfinite(signals)
+    if bad.any():
+        ch, i = (int(v) for v in np.argwhere(bad)[0])
+        raise ParameterError(f"{src}: channel {ch + 1}{_name(names, ch)}, sample {i}: {signals[ch, i]}; expected "
+                             f"finite samples ({int(bad.sum())} are not)")
+    spread = signals.std(axis=1)
+    constant = np.flatnonzero(spread <= CONSTANT_CHANNEL * spread.max())
+    if constant.size:
+        listing = ", ".join(f"{k + 1}{_name(names, k)}" for k in constant)
+        raise ParameterError(f"{src}: channel(s) {listing} constant; expected a varying response on every channel "
+                             "(drop dead channels)")
+
+
+def _name(names, ch) -> str:
+    return f" ({names[ch]})" if names and ch < len(names) and names[ch] != str(ch) else ""
+
+
+def prepare(data, sample_rate_hz=None, band_hz=None, quantity: str | None = None) -> Prepared:
+    """Check a record and bring it to zero mean, unit RMS per channel and a rate suited to the band.
+
+    Parameters
+    ----------
+    data : ndarray (n_channels, n_samples), TimeRecord or path
+    sample_rate_hz : float, optional
+        Required for an array; taken from a record or file.
+    band_hz : (float, float), optional
+        Band of interest, Hz (default: 0 to 80 % of the Nyquist frequency). The record is decimated
+        (linear-phase FIR) so that the band's upper edge lies at or below half of the new Nyquist frequency.
+    quantity : str, optional
+        What the channels measured, for an array (a record says it itself).
+    """
+    signals, rate, file_quantity, names, src = _record(data, sample_rate_hz)
+    if not (np.isfinite(rate) and rate > 0):
+        raise ParameterError(f"{src}: 'sample_rate_hz' is {rate!r}; expected a positive number of samples per second")
+    check_channels(signals, src, names)
+    low, high = check_band(band_hz, rate / 2, src)
+    factor = decimation_factor(rate, high)
+    centred = signals - signals.mean(axis=1, keepdims=True)
+    work = decimate(centred, factor)
+    if work.shape[1] < 2:
+        raise ParameterError(f"{src}: {signals.shape[1]} samples; too short a record for the band up to {high:g} Hz")
+    scale = np.sqrt(np.mean(work**2, axis=1))
+    if np.any(scale <= 0):
+        check_channels(work, src, names)
+    return Prepared(work / scale[:, None], rate / factor, scale, (low, high), factor, rate,
+                    quantity or file_quantity, names, src)

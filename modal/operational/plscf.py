@@ -1,0 +1,162 @@
+"""Poly-reference LSCF on output half-spectra: an estimator independent of SSI, for cross-checks.
+
+The half-spectrum ``S⁺(ω) = ½R₀ + Σ_{k≥1} w_k R_k e^{−iωkΔt}`` of the correlations (outputs ×
+references) is a sum of modal terms with the system's poles, as an FRF is (Peeters & Van der
+Auweraer, IMAC 2005): the pLSCF of :mod:`modal.global_.plscf` fits its denominator over a sweep of
+orders. The exponential lag window ``w_k = e^{−βkΔt}`` (1 % at the last lag) adds exactly β to every
+pole's decay rate, which is taken off again. Shapes come from a least-squares fit of the
+half-spectra's residues at the chosen poles (z-domain LSFD), the dominant direction of each residue
+matrix. Error bars: the poles and shapes are recomputed from the half-spectra moved by each block's
+deviation (central differences: first order, as for SSI).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..global_.plscf import plscf_poles
+from .correlations import correlations
+from .inputs import MIN_LAGS_IN_RECORD, Prepared
+from .modes import error_blocks, estimates_from_clusters
+from .selection import stabilise
+from .ssi import PoleSet
+
+__all__ = ["plscf", "half_spectra"]
+
+#: the lag window falls to this fraction at the last lag
+WINDOW_END = 0.01
+#: polynomial orders 1…this many (each gives up to order × references poles)
+MAX_POLY_ORDER = 24
+#: lags of the half-spectra: this many periods of the lowest frequency of interest (at least 4 × the order)
+PERIODS = 4.0
+
+
+def half_spectra(R: np.ndarray, sample_rate_hz: float, frequency_hz: np.ndarray):
+    """Half-spectra (outputs, references, lines) of correlations R (..., lags, outputs, references) and the
+    decay rate β (1/s) the lag window adds."""
+    n_lags = R.shape[-3]
+    dt = 1.0 / sample_rate_hz
+    beta = -np.log(WINDOW_END) / (n_lags * dt)
+    k = np.arange(n_lags)
+    w = np.exp(-beta * k * dt)
+    w[0] = 0.5
+    kernel = np.exp(-1j * np.outer(2 * np.pi * frequency_hz * dt, k)) * w[None, :]  # (lines, lags)
+    S = np.tensordot(kernel, R, axes=([1], [-3]))  # (lines, ..., outputs, references)
+    return np.moveaxis(S, 0, -1), beta
+
+
+def _unwindow(omega_n, zeta, beta):
+    """Poles with the window's decay β taken off: (complex poles λ, rad/s)."""
+    s = -zeta * omega_n + 1j * omega_n * np.sqrt(np.maximum(1 - zeta**2, 0.0))
+    return s + beta
+
+
+def _lsfd_shapes(S, omega, poles_windowed, dt, n_picked):
+    """Shapes (outputs, n_picked) from the residues of the half-spectra at the first ``n_picked`` of the given
+    (windowed) poles, z-domain; the other poles (the rest of the order's) are in the fit so that their
+    modes and tones do not leak into these residues."""
+    z = np.exp(1j * omega * dt)
+    mu = np.exp(poles_windowed * dt)
+    basis = np.column_stack([1.0 / (z - mu[r]) for r in range(mu.size)]
+                            + [1.0 / (z - mu[r].conj()) for r in range(mu.size)]
+                            + [np.ones_like(z), 1.0 / z])
+    n_out, m, n_f = S.shape
+    coef, *_ = np.linalg.lstsq(basis, S.reshape(n_out * m, n_f).T, rcond=None)
+    shapes = np.empty((n_out, n_picked), complex)
+    for r in range(n_picked):
+        residue = coef[r].reshape(n_out, m)
+        u, _, _ = np.linalg.svd(residue, full_matrices=False)
+        shapes[:, r] = u[:, 0]
+    lead = np.argmax(np.abs(shapes), axis=0)
+    return shapes / shapes[lead, np.arange(n_picked)][None, :]
+
+
+def _with_shapes(estimates, S, omega, beta, dt, blocks_dS, scale):
+    """The estimates with shapes from one residue fit at all their poles together (LSFD: only the poles the
+    stabilisation kept, so that no spurious pole of an order takes a share of a mode's residue), and the
+    shapes' errors from the fit repeated on the half-spectra and poles moved by each block's deviation."""
+    from dataclasses import replace
+
+    from .modes import _physical_shape
+
+    if not estimates:
+        return estimates
+    poles = np.array([e.pole for e in estimates])
+    unit = _lsfd_shapes(S, omega, poles - beta, dt, poles.size)
+    d_unit = None
+    if blocks_dS is not None and all(e.pole_deviation is not None for e in estimates):
+        d_pole = np.column_stack([e.pole_deviation for e in estimates])  # (blocks, modes)
+        d_unit = np.empty((d_pole.shape[0],) + unit.shape, complex)
+        for b in range(d_pole.shape[0]):
+            plus = _lsfd_shapes(S + blocks_dS[b], omega, poles + d_pole[b] - beta, dt, poles.size)
+            minus = _lsfd_shapes(S - blocks_dS[b], omega, poles - d_pole[b] - beta, dt, poles.size)
+            d_unit[b] = (plus - minus) / 2
+    out = []
+    for r, estimate in enumerate(estimates):
+        shape, shape_std = _physical_shape(unit[:, r], None if d_unit is None else d_unit[:, :, r], scale)
+        out.append(replace(estimate, shape=shape, std_shape=shape_std))
+    return out
+
+
+def _poles_of_order(omega, S, order, beta):
+    packs = plscf_poles(omega, S, [order], max_damping=0.5)
+    if not packs:
+        return np.zeros(0, complex), np.zeros((S.shape[1], 0), complex)
+    pack = packs[0]
+    return _unwindow(pack.omega_n, pack.damping_ratio, beta), pack.participation.T
+
+
+def plscf(prepared: Prepared, refs, max_order=None):
+    """Poles over the polynomial orders, stabilisation, clusters and estimates (see the module docstring).
+
+    Returns the same tuple as the SSI path of :func:`modal.operational.oma`.
+    """
+    from .inputs import check_band  # noqa: F401  (the band was checked by prepare)
+
+    fs = prepared.sample_rate_hz
+    low, high = prepared.band_hz
+    m = len(refs)
+    top = int(min(MAX_POLY_ORDER, max(16, np.ceil(2 * (max_order or 80) / m))))
+    n_lags = int(max(np.ceil(PERIODS * fs / max(low, high / 10)), 4 * top))
+    n_samples = prepared.signals.shape[1]
+    if n_samples < MIN_LAGS_IN_RECORD * n_lags:
+        from ..errors import ParameterError
+
+        raise ParameterError(f"{prepared.source}: the record lasts {n_samples / fs:.4g} s; the half-spectra over "
+                             f"{n_lags} lags need at least {MIN_LAGS_IN_RECORD * n_lags / fs:.4g} s")
+    corr = correlations(prepared.signals, fs, refs, n_lags - 1)
+    spacing = fs / (2 * n_lags)
+    lines = np.arange(max(low, spacing), high + spacing / 2, spacing)
+    omega = 2 * np.pi * lines
+    S, beta = half_spectra(corr.mean, fs, lines)
+    orders = list(range(1, top + 1))
+    sets = []
+    for p in orders:
+        poles, participation = _poles_of_order(omega, S, p, beta)
+        sets.append(PoleSet(p, poles, participation))
+    flat, stable, clusters = stabilise(sets, low, high)
+    perturb, blocks_dS = None, None
+    if clusters:
+        medians = np.array([np.median(flat.pole[c.members]) for c in clusters])
+        n_blocks = error_blocks(prepared.duration_s, medians, corr.blocks.shape[0])
+        if n_blocks >= 2:
+            blocks, weights = corr.grouped(n_blocks)
+            w = weights / weights.sum()
+            scale = w * np.sqrt(n_blocks / (n_blocks - 1.0))
+            blocks_dS = (half_spectra(blocks, fs, lines)[0] - S[None]) * scale[:, None, None, None]
+
+            def perturb(order, indices):
+                base_poles, _ = _poles_of_order(omega, S, order, beta)
+                picked = base_poles[np.asarray(indices, int)]
+                d_pole = np.zeros((n_blocks, picked.size), complex)
+                for b in range(n_blocks):
+                    moved = []
+                    for sign in (1.0, -1.0):
+                        poles_b, _ = _poles_of_order(omega, S + sign * blocks_dS[b], order, beta)
+                        moved.append(poles_b[np.argmin(np.abs(poles_b[None, :] - picked[:, None]), axis=1)]
+                                     if poles_b.size else picked)
+                    d_pole[b] = (moved[0] - moved[1]) / 2
+                return {"pole": d_pole, "shape": None}
+    estimates, chosen, kept = estimates_from_clusters(flat, clusters, perturb, len(orders), prepared.scale)
+    estimates = _with_shapes(estimates, S, omega, beta, 1.0 / fs, blocks_dS, prepared.scale)
+    settings = {"orders": [orders[0], orders[-1]], "lags": n_lags, "window_decay_per_s": float(beta)}
+    return estimates, chosen, kept, flat, stable, corr, settings

@@ -1,0 +1,199 @@
+"""Covariance-driven stochastic subspace identification (SSI-cov) over a sweep of model orders, with
+first-order error bars.
+
+The correlations ``R_k = C A^{k−1} G`` of the outputs with the references fill a block Hankel
+matrix ``H = O Γ`` (``s + 1`` block rows of lags 1…2s): its leading left singular vectors span the
+observability matrix O, whose shift invariance ``O_down = O_up A`` gives the system matrix A of any
+order ``n`` by least squares. One SVD serves every order, and so does one QR: the first ``n``
+columns of ``U_up`` are ``Q[:, :n] R[:n, :n]`` for the QR of all its columns, so that
+``A_n = R[:n, :n]⁻¹ (Qᵀ U_down)[:n, :n]`` costs an n × n solve per order. Lag 0, where white
+measurement noise lives, is not used.
+
+Error bars (Reynders, Pintelon & De Roeck 2008; Döhler & Mevel 2013): the record is cut into
+blocks whose Hankel matrices scatter about the record's; each block's deviation is carried to
+first order through the SVD (only the part leaving the signal subspace changes the eigenvalues),
+the least squares and the eigenvalue problem. The covariance of any result is the sample
+covariance of these linear images over the blocks.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import IdentificationError
+
+__all__ = ["SubspaceModel", "PoleSet", "subspace_model", "hankel", "poles_at", "Perturbation", "continuous"]
+
+
+@dataclass(frozen=True)
+class PoleSet:
+    """The poles of one model order.
+
+    Attributes
+    ----------
+    order : int
+        Model order (states).
+    poles : ndarray, shape (n,)
+        Continuous-time poles λ, rad/s (all eigenvalues of the order, conjugates included).
+    shapes : ndarray, shape (n_outputs, n), complex
+        Observed shape of each pole, largest-magnitude entry 1.
+    participation : ndarray, shape (n_references, n) or None
+        The reference side of each pole (for the stability check of methods without shapes).
+    """
+
+    order: int
+    poles: np.ndarray
+    shapes: np.ndarray
+    participation: np.ndarray | None = None
+
+
+@dataclass(frozen=True)
+class SubspaceModel:
+    """The SVD of the Hankel matrix and the QR of its upper block rows, for every order up to ``max_order``."""
+
+    U: np.ndarray
+    singular_values: np.ndarray
+    V: np.ndarray
+    Q: np.ndarray
+    R: np.ndarray
+    QtU_down: np.ndarray
+    n_outputs: int
+    block_rows: int
+    sample_rate_hz: float
+    max_order: int
+    hankel: np.ndarray
+
+
+def hankel(R: np.ndarray, block_rows: int) -> np.ndarray:
+    """Block Hankel matrix of lags 1…2s: block (a, b) = R[a + b + 1], a = 0…s, b = 0…s−1.
+
+    ``R`` has shape (..., lags, n_outputs, n_references); the result (..., n_outputs (s+1), n_references s).
+    """
+    s = block_rows
+    a = np.arange(s + 1)[:, None]
+    b = np.arange(s)[None, :]
+    blocks = R[..., a + b + 1, :, :]  # (..., s+1, s, l, r)
+    lead = blocks.shape[:-4]
+    l, r = blocks.shape[-2:]
+    return np.swapaxes(blocks, -3, -2).reshape(*lead, (s + 1) * l, s * r)
+
+
+def subspace_model(R: np.ndarray, block_rows: int, max_order: int, sample_rate_hz: float) -> SubspaceModel:
+    """SVD of the Hankel matrix of ``R`` (lags, outputs, references) and the QR its orders share."""
+    l = R.shape[1]
+    H = hankel(R, block_rows)
+    p, q = H.shape
+    max_order = int(min(max_order, q, l * block_rows))
+    if max_order < 2:
+        raise IdentificationError(f"the Hankel matrix ({p} × {q}) supports no model order above 1")
+    U, sv, Vt = np.linalg.svd(H, full_matrices=False)
+    Q, Rr = np.linalg.qr(U[: l * block_rows, :max_order])
+    return SubspaceModel(U, sv, Vt.T, Q, Rr, Q.T @ U[l:, :max_order], l, block_rows, float(sample_rate_hz),
+                         max_order, H)
+
+
+def continuous(mu: np.ndarray, sample_rate_hz: float) -> np.ndarray:
+    """Continuous poles λ = ln(μ)·fs of discrete eigenvalues μ."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.log(mu.astype(complex)) * sample_rate_hz
+
+
+def _system(model: SubspaceModel, order: int):
+    """(A, eigenvalues μ, right eigenvectors Ψ) of one order, in the basis of the first ``order`` left singular
+    vectors."""
+    n = order
+    A = np.linalg.solve(model.R[:n, :n], model.QtU_down[:n, :n])
+    mu, psi = np.linalg.eig(A)
+    return A, mu, psi
+
+
+def _normalised(shapes: np.ndarray):
+    """Shapes (columns) scaled so that the largest-magnitude entry is 1; returns (shapes, lead index, lead value)."""
+    lead = np.argmax(np.abs(shapes), axis=0)
+    value = shapes[lead, np.arange(shapes.shape[1])]
+    value = np.where(value != 0, value, 1.0)
+    return shapes / value[None, :], lead, value
+
+
+def poles_at(model: SubspaceModel, order: int) -> PoleSet:
+    """All poles and observed shapes of one order."""
+    _, mu, psi = _system(model, order)
+    shapes, _, _ = _normalised(model.U[: model.n_outputs, :order] @ psi)
+    return PoleSet(order, continuous(mu, model.sample_rate_hz), shapes)
+
+
+class Perturbation:
+    """First-order deviations of the poles and shapes of any order, one per block of the record.
+
+    The block Hankel deviations enter only through ``ΔH V`` and ``Uᵀ ΔH V``, computed once for all orders;
+    each order then costs products of the size of its subspace.
+
+    Parameters
+    ----------
+    model : SubspaceModel
+        Built from the weighted mean of ``block_R``.
+    block_R : ndarray, shape (n_blocks, lags, n_outputs, n_references)
+        Each block's correlations.
+    weights : ndarray, shape (n_blocks,)
+        Samples per block.
+    """
+
+    def __init__(self, model: SubspaceModel, block_R: np.ndarray, weights: np.ndarray):
+        self.model = model
+        n_blocks = block_R.shape[0]
+        if n_blocks < 2:
+            raise IdentificationError("error bars need at least 2 blocks of the record")
+        w = weights / weights.sum()
+        self.scale = w * np.sqrt(n_blocks / (n_blocks - 1.0))  # var of the weighted mean from the blocks' scatter
+        dH = hankel(block_R, model.block_rows) - model.hankel[None]  # (blocks, p, q)
+        self.G = dH @ model.V  # (blocks, p, k): ΔH V
+        self.B = model.U.T @ self.G  # (blocks, k, k): Uᵀ ΔH V
+        self.E = self.G - model.U @ self.B  # the part of ΔH V outside the range of H
+
+    def at(self, order: int, indices) -> dict[str, np.ndarray]:
+        """Deviations of the poles ``indices`` of :func:`poles_at` (``order``).
+
+        Returns
+        -------
+        dict
+            ``"pole"`` (n_blocks, n_poles) complex, rad/s; ``"shape"`` (n_blocks, n_outputs, n_poles) complex,
+            of the shapes normalised as in :func:`poles_at`. For any real function g of the results,
+            var g ≈ Σ_b (∂g · δ_b)² over these samples δ_b.
+        """
+        model = self.model
+        idx = np.asarray(indices, int)
+        n, l = order, model.n_outputs
+        U, sv = model.U, model.singular_values
+        s1, s2 = sv[:n], sv[n:]
+        B = self.B
+        with np.errstate(divide="ignore", invalid="ignore"):
+            gap = s1[None, :] ** 2 - s2[:, None] ** 2  # (k − n, n)
+            inside = (B[:, n:, :n] * s1[None, None, :] + s2[None, :, None] * np.swapaxes(B[:, :n, n:], 1, 2)) / gap
+        inside = np.where(np.isfinite(inside), inside, 0.0)
+        # each perturbed singular vector's part outside the signal subspace (the part inside only rotates the
+        # basis, which leaves the eigenvalues and the observed shapes as they are)
+        dU1 = U[:, n:] @ inside + self.E[:, :, :n] / s1[None, None, :]
+        A, mu, psi = _system(model, order)
+        Rn, Qn = model.R[:n, :n], model.Q[:, :n]
+        rows = l * model.block_rows
+        U1 = U[:, :n]
+        resid = U1[l:] - U1[:rows] @ A
+        d_up, d_down = dU1[:, :rows], dU1[:, l:]
+        dA = np.linalg.solve(Rn, Qn.T @ (d_down - d_up @ A))
+        dA = dA + np.linalg.solve(Rn, np.linalg.solve(Rn.T, np.swapaxes(d_up, 1, 2) @ resid))
+        Wm = np.linalg.solve(psi, dA @ psi)  # (blocks, n, n): Ψ⁻¹ ΔA Ψ
+        picks = np.arange(idx.size)
+        d_mu = Wm[:, idx, idx]
+        d_lam = d_mu / mu[idx][None, :] * model.sample_rate_hz
+        # eigenvectors: Δψ_i = Σ_{k≠i} ψ_k W_ki / (μ_i − μ_k)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            coupling = Wm[:, :, idx] / (mu[idx][None, None, :] - mu[None, :, None])  # (blocks, n, picks)
+        coupling[:, idx, picks] = 0.0
+        coupling = np.where(np.isfinite(coupling), coupling, 0.0)
+        C = U1[:l]
+        raw = C @ psi[:, idx]
+        d_raw = dU1[:, :l] @ psi[:, idx] + C @ (psi @ coupling)  # (blocks, l, picks)
+        shapes, lead, value = _normalised(raw)
+        d_shape = (d_raw - shapes[None] * d_raw[:, lead, picks][:, None, :]) / value[None, None, :]
+        return {"pole": d_lam * self.scale[:, None], "shape": d_shape * self.scale[:, None, None]}

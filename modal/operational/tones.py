@@ -1,0 +1,118 @@
+"""Machine tones told apart from structural modes.
+
+A running machine's harmonics are sinusoids in every channel: the identification finds them as
+poles of (nearly) zero damping, as stable over the orders as any mode. Three pieces of evidence
+say that a pole is a tone (Brincker, Andersen & Møller, IMAC 2000; Jacobsen 2006):
+
+* its damping is nearly zero: below :data:`TONE_DAMPING` with its error (ζ + 3σ_ζ), where few
+  structures are;
+* the response band-passed around it is not Gaussian: a sinusoid's kurtosis is 1.5 where a
+  structural mode driven by random forces gives 3 (:data:`KURTOSIS_LIMIT`);
+* it lies on a harmonic ``k × f₀`` of the running speed (``rotor_speed_hz``, or the fundamental
+  that the tones found by the first two pieces of evidence share).
+
+A pole with two of them is a tone; a mode on a harmonic without further evidence stays a mode,
+flagged ``harmonic``.
+"""
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from .inputs import Prepared
+from .result import ModeEstimate
+
+__all__ = ["separate_tones", "nearly_undamped", "band_kurtosis", "harmonic_of", "KURTOSIS_LIMIT", "TONE_DAMPING"]
+
+#: a pole whose damping ratio is below this with its error (ζ + 3σ_ζ) has nearly zero damping
+TONE_DAMPING = 0.002
+ZERO_DAMPING_SIGMAS = 3.0
+#: kurtosis of the band-passed response below which it holds a sinusoid: 3 for Gaussian narrow-band
+#: response, 1.5 for a pure tone; the estimate of 3 scatters by √(24/N) with N = B·T independent
+#: samples, B·T ≥ :data:`MIN_BANDWIDTH_TIME` making that at most 0.35, so the limit lies 3 of those below 3
+KURTOSIS_LIMIT = 1.95
+#: the band-pass spans at least this many over the record's duration (Hz·s), and 4 half-power widths
+MIN_BANDWIDTH_TIME = 200.0
+#: a pole lies on a harmonic k·f₀ when within this fraction of it (speed variation)...
+HARMONIC_TOLERANCE = 0.005
+#: ... or within this many of its standard errors
+HARMONIC_SIGMAS = 3.0
+
+
+def band_kurtosis(signal: np.ndarray, sample_rate_hz: float, centre_hz: float, bandwidth_hz: float) -> float:
+    """Kurtosis E[x⁴]/E[x²]² of ``signal`` band-passed (ideal, by FFT) to ``centre_hz ± bandwidth_hz/2``."""
+    spectrum = np.fft.rfft(signal)
+    f = np.fft.rfftfreq(signal.size, 1.0 / sample_rate_hz)
+    spectrum[np.abs(f - centre_hz) > bandwidth_hz / 2] = 0.0
+    x = np.fft.irfft(spectrum, n=signal.size)
+    power = np.mean(x**2)
+    return float(np.mean(x**4) / power**2) if power > 0 else float("nan")
+
+
+def harmonic_of(frequency_hz: float, std_hz: float, fundamental_hz: float) -> int:
+    """The harmonic number k ≥ 1 when ``frequency_hz`` lies on k·``fundamental_hz`` (see :data:`HARMONIC_TOLERANCE`),
+    else 0."""
+    k = int(round(frequency_hz / fundamental_hz))
+    if k < 1:
+        return 0
+    allowed = max(HARMONIC_TOLERANCE * frequency_hz, HARMONIC_SIGMAS * (std_hz if np.isfinite(std_hz) else 0.0))
+    return k if abs(frequency_hz - k * fundamental_hz) <= allowed else 0
+
+
+def _fundamental(tones_hz: list[float], stds: list[float]) -> float | None:
+    """The running speed that explains the most of two or more tones as its harmonics (the lowest such),
+    or None."""
+    if len(tones_hz) < 2:
+        return None
+    best = None
+    for f in tones_hz:
+        for k in range(1, 5):
+            f0 = f / k
+            hits = sum(harmonic_of(g, s, f0) > 0 for g, s in zip(tones_hz, stds))
+            if hits >= 2 and (best is None or hits > best[0] or (hits == best[0] and f0 > best[1])):
+                best = (hits, f0)
+    return None if best is None else best[1]
+
+
+def nearly_undamped(estimate: ModeEstimate) -> bool:
+    """Whether a pole's damping ratio lies below :data:`TONE_DAMPING` with its error (ζ + 3σ_ζ)."""
+    s_zeta = estimate.std_damping_ratio
+    return estimate.damping_ratio + ZERO_DAMPING_SIGMAS * (s_zeta if np.isfinite(s_zeta) else 0.0) < TONE_DAMPING
+
+
+def _evidence(estimate: ModeEstimate, prepared: Prepared) -> tuple[bool, bool]:
+    """(nearly zero damping, band-passed response non-Gaussian) for one estimate."""
+    zeta = estimate.damping_ratio if np.isfinite(estimate.damping_ratio) else 0.0
+    undamped = nearly_undamped(estimate)
+    f = estimate.natural_frequency_hz
+    channel = int(np.argmax(np.abs(estimate.shape) / prepared.scale))  # where it is strongest against the rest
+    width = max(4 * max(zeta, 0.0) * f, MIN_BANDWIDTH_TIME / prepared.duration_s)
+    kurtosis = band_kurtosis(prepared.signals[channel], prepared.sample_rate_hz, f, width)
+    return bool(undamped), bool(np.isfinite(kurtosis) and kurtosis < KURTOSIS_LIMIT)
+
+
+def separate_tones(estimates: list[ModeEstimate], prepared: Prepared, rotor_speed_hz: float | None):
+    """Which estimates are machine tones, and the modes left on a harmonic flagged ``harmonic``.
+
+    Returns
+    -------
+    (is_tone, estimates) : (list of bool, list of ModeEstimate)
+        The estimates in the same order, those on a harmonic that are not tones with the flag added.
+    """
+    evidence = [_evidence(e, prepared) for e in estimates]
+    fundamental = rotor_speed_hz
+    if fundamental is None:
+        # the tones the data show clearly: nearly undamped and non-Gaussian (or non-Gaussian where the method
+        # measures no damping)
+        clear = [(e.natural_frequency_hz, e.std_frequency_hz) for e, (a, b) in zip(estimates, evidence)
+                 if b and (a or not e.damping_known)]
+        fundamental = _fundamental([f for f, _ in clear], [s for _, s in clear])
+    is_tone, out = [], []
+    for estimate, (undamped, peaky) in zip(estimates, evidence):
+        on_comb = fundamental is not None and harmonic_of(estimate.natural_frequency_hz,
+                                                          estimate.std_frequency_hz, fundamental) > 0
+        tone = undamped + peaky + on_comb >= 2
+        is_tone.append(tone)
+        out.append(replace(estimate, flags=estimate.flags | {"harmonic"}) if on_comb and not tone else estimate)
+    return is_tone, out

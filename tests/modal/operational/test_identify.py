@@ -1,0 +1,158 @@
+"""modal.oma: every mode once, no tone or spurious pole as a mode, errors that cover the truth, clear
+errors for bad input."""
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+import modal
+from modal.errors import ParameterError
+from modal.operational.selection import OMAStabilisation, shape_mac
+from modal.synthetic import ambient_modal_response, ambient_response, chain_matrices
+from support.ambient import FN, TONES, ZETA, anchor_record, anchor_shapes
+
+#: a fixed seed's estimate lies within this many of its standard errors of the truth (for calibrated
+#: Gaussian errors, one of the 12 values of a case exceeds it with probability 12 · 6e-5 < 0.1 %)
+SIGMAS = 4.0
+
+
+def _oma(*args, **kwargs):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return modal.oma(*args, **kwargs)
+
+
+def _match(result, fn):
+    """Index of the result's mode within 0.5 % of each true frequency (asserting exactly one each)."""
+    found = []
+    for f in fn:
+        near = [i for i, m in enumerate(result) if abs(m.natural_frequency_hz / f - 1) < 0.005]
+        assert len(near) == 1, (f, [m.natural_frequency_hz for m in result])
+        found.append(near[0])
+    return found
+
+
+@pytest.mark.parametrize("seed, noise, tones", [(11, 0.05, True), (12, 0.2, True), (13, 0.1, False)])
+def test_anchor_case_every_mode_once_within_its_errors(seed, noise, tones):
+    rec = anchor_record(seed, noise=noise, tones=tones)
+    result = _oma(rec.signals, rec.sample_rate_hz, band_hz=(1.0, 30.0))
+    assert result.method == "ssi"
+    found = _match(result, FN)
+    assert len(result) == len(FN)  # nothing else: no tone, no spurious pole among the modes
+    for k, i in enumerate(found):
+        mode = result[i]
+        assert abs(mode.natural_frequency_hz - FN[k]) < SIGMAS * mode.std.natural_frequency_hz
+        assert abs(mode.damping_ratio - ZETA[k]) < SIGMAS * mode.std.damping_ratio
+        assert shape_mac(mode.mode_shape, rec.mode_shape[:, k]) >= 0.98
+        assert mode.mode_shape.shape == (8,) and np.iscomplexobj(mode.mode_shape)
+        assert np.all(np.isnan(mode.mass_kg)) and np.all(np.isnan(mode.stiffness_n_per_m))
+        assert mode.std.mode_shape.shape == (8,) and np.all(np.isfinite(mode.std.mode_shape))
+    if tones:
+        assert len(result.harmonics_hz) == 3
+        assert np.allclose(sorted(result.harmonics_hz), TONES, atol=0.01)
+    else:
+        assert result.harmonics_hz == ()
+
+
+def test_shape_errors_cover_the_truth():
+    rec = anchor_record(14, noise=0.1, tones=False)
+    result = _oma(rec.signals, rec.sample_rate_hz, band_hz=(1.0, 30.0))
+    z = []
+    for k, i in enumerate(_match(result, FN)):
+        mode = result[i]
+        lead = int(np.argmax(np.abs(mode.mode_shape)))  # the estimate's entry 1 (error 0 by definition)
+        err = mode.mode_shape - rec.mode_shape[:, k] / rec.mode_shape[lead, k]
+        ok = np.arange(8) != lead
+        z.append(np.abs(err[ok]) / mode.std.mode_shape[ok])
+    z = np.concatenate(z)
+    # |error|/σ of a complex entry is Rayleigh-like: its RMS is 1 when the errors are calibrated
+    assert 0.6 < np.sqrt(np.mean(z**2)) < 1.6
+
+
+def test_weakly_excited_mode_is_found():
+    # mode 5 of the anchor case is driven by a tenth of the others' force: 1 % of their response power
+    rec = anchor_record(15, noise=0.1, tones=True)
+    result = _oma(rec.signals, rec.sample_rate_hz, band_hz=(1.0, 30.0))
+    i = _match(result, FN)[4]
+    assert abs(result[i].natural_frequency_hz - FN[4]) < SIGMAS * result[i].std.natural_frequency_hz
+
+
+def test_chain_with_forces_at_two_masses():
+    M, C, K = chain_matrices([2.0, 1.0, 1.5, 1.0], [8e3, 5e3, 6e3, 4e3], 0.02)
+    rec = ambient_response(M, C, K, 200.0, 200_000, force_dofs=[1, 3], quantity="displacement", noise=0.1, seed=2)
+    result = _oma(rec.signals, 200.0, band_hz=(1.0, 60.0), quantity="displacement")
+    assert result.kind == "receptance"
+    found = _match(result, rec.natural_frequency_hz)
+    assert len(result) == 4
+    for k, i in enumerate(found):
+        assert abs(result[i].damping_ratio - 0.02) < SIGMAS * result[i].std.damping_ratio
+        assert shape_mac(result[i].mode_shape, rec.mode_shape[:, k]) >= 0.98
+
+
+def test_rotor_speed_flags_a_mode_on_a_harmonic():
+    # a structural mode at 2 × 5.6 Hz and tones at 1× and 3×: the tones go to harmonics_hz, the mode
+    # on the second harmonic stays a mode, flagged
+    shapes = anchor_shapes()[:, :3]
+    rec = ambient_modal_response([3.1, 11.2, 20.0], [0.015, 0.01, 0.02], shapes, 100.0, 100_000, noise=0.1,
+                                 tones_hz=[5.6, 16.8], tone_rms=0.5, seed=3)
+    result = _oma(rec.signals, 100.0, band_hz=(1.0, 30.0), rotor_speed_hz=5.6)
+    on_harmonic = [m for m in result if abs(m.natural_frequency_hz - 11.2) < 0.05]
+    assert len(on_harmonic) == 1 and "harmonic" in on_harmonic[0].flags
+    assert np.allclose(sorted(result.harmonics_hz), [5.6, 16.8], atol=0.01)
+    assert all("harmonic" not in m.flags for m in result if abs(m.natural_frequency_hz - 11.2) > 0.05)
+
+
+def test_stabilisation_diagram_is_kept():
+    rec = anchor_record(16, noise=0.1, tones=True)
+    result = _oma(rec.signals, rec.sample_rate_hz, band_hz=(1.0, 30.0))
+    diagram = result.stabilisation
+    assert isinstance(diagram, OMAStabilisation)
+    assert diagram.chosen[diagram.cluster >= 0].sum() == len(result)
+    assert (diagram.chosen & diagram.tone).sum() == len(result.harmonics_hz) == 3
+    for k, mode in enumerate(result):
+        pick = diagram.chosen & (diagram.cluster == k)
+        assert pick.sum() == 1
+        assert diagram.frequency_hz[pick][0] == pytest.approx(mode.natural_frequency_hz, rel=1e-9)
+    # the tones' poles are marked, and are no mode's
+    assert np.all(diagram.cluster[diagram.tone] == -1)
+    assert np.any(np.abs(diagram.frequency_hz[diagram.tone] - 4.8) < 0.01)
+
+
+def test_time_record_and_path_give_the_rate(tmp_path):
+    from modal.io.timedata import TimeRecord
+
+    rec = anchor_record(17, noise=0.1, tones=False, duration_s=600.0)
+    record = TimeRecord(rec.signals, rec.sample_rate_hz, tuple(f"{k + 1}+Z" for k in range(8)),
+                        ("acceleration",) * 8, ("m/s^2",) * 8, "anchor.h5")
+    result = _oma(record, band_hz=(1.0, 30.0))
+    assert result.settings["sample_rate_hz"] == 100.0
+    assert result.settings["channel_names"][0] == "1+Z"
+    assert len(result) == 6
+
+
+def _record(n_channels=3, n=20_000, seed=0):
+    shapes = anchor_shapes(n_channels)[:, :2]
+    return ambient_modal_response([5.0, 12.0], [0.02, 0.02], shapes, 100.0, n, seed=seed).signals
+
+
+@pytest.mark.parametrize("data, kwargs, message", [
+    (_record(n_channels=1), {}, "1 channel; operational modal analysis needs at least 2"),
+    (np.vstack([_record(2), np.full(20_000, 3.0)]), {}, r"channel\(s\) 3 constant"),
+    (np.where(np.arange(20_000) == 77, np.nan, _record(3)), {}, "channel 1, sample 77: nan"),
+    (_record(n=1500), {}, "the record lasts 15 s"),
+    (_record(), {"band_hz": (1.0, 80.0)}, r"FMAX <= 50 Hz"),
+    (_record(), {"band_hz": (10.0, 5.0)}, "0 <= FMIN < FMAX"),
+    (_record(), {"reference_channels": [0, 7]}, "reference_channels"),
+    (_record(), {"method": "magic"}, "'method' is 'magic'"),
+    (_record(), {"sample_rate_hz": None}, "'sample_rate_hz' is missing"),
+    (_record(), {"rotor_speed_hz": -3.0}, "rotor_speed_hz"),
+    (_record(), {"band_hz": (0.1, 2.0)}, "the record lasts 200 s; the band from 0.2 Hz"),
+    (_record(), {"max_order": 4000}, "the record lasts 200 s; .* model order 4000"),
+])
+def test_bad_input_is_one_clear_error(data, kwargs, message):
+    kwargs = {"sample_rate_hz": 100.0, **kwargs}
+    with pytest.raises(ParameterError, match=message) as info:
+        _oma(data, **kwargs)
+    assert "\n" not in str(info.value)

@@ -1,0 +1,72 @@
+"""SSI-cov: the order sweep from one SVD and one QR, and the first-order deviations of the poles."""
+from __future__ import annotations
+
+import numpy as np
+
+from modal.operational.correlations import correlations
+from modal.operational.ssi import Perturbation, hankel, poles_at, subspace_model
+from modal.synthetic import ambient_modal_response
+from support.ambient import anchor_shapes
+
+FS = 100.0
+
+
+def _model(block_rows=20, max_order=30, n=60_000, seed=1):
+    rec = ambient_modal_response([5.0, 12.0, 21.0], [0.02, 0.015, 0.01], anchor_shapes(4)[:, :3], FS, n,
+                                 noise=0.1, seed=seed)
+    y = rec.signals - rec.signals.mean(axis=1, keepdims=True)
+    corr = correlations(y, FS, [0, 1, 2, 3], 2 * block_rows, max_blocks=12)
+    return rec, corr, subspace_model(corr.mean, block_rows, max_order, FS)
+
+
+def test_each_order_equals_its_own_least_squares():
+    # the shared QR gives, for every order n, the least-squares A of the first n singular vectors
+    _, _, model = _model()
+    l = model.n_outputs
+    for n in (6, 14, 30):
+        U = model.U[:, :n]
+        A, *_ = np.linalg.lstsq(U[: l * model.block_rows], U[l:], rcond=None)
+        direct = np.sort_complex(np.log(np.linalg.eigvals(A).astype(complex)) * FS)
+        assert np.allclose(np.sort_complex(poles_at(model, n).poles), direct, rtol=1e-9, atol=1e-9)
+
+
+def test_true_order_poles_are_the_modes():
+    rec, _, model = _model(n=100_000)
+    poles = poles_at(model, 6).poles
+    found = np.sort(np.abs(poles[poles.imag > 0])) / (2 * np.pi)
+    # 1000 s of record: frequencies to well within 0.2 % (their errors here are ~0.05 %)
+    assert np.allclose(found, rec.natural_frequency_hz, rtol=2e-3)
+
+
+def test_first_order_deviations_match_finite_differences():
+    # each block's deviation carried through SVD, least squares and eigenvalues to first order, against the
+    # poles recomputed from the perturbed Hankel matrix (step 1e-4 of the block's deviation)
+    _, corr, model = _model()
+    blocks, weights = corr.grouped(6)
+    order = 10
+    ps = poles_at(model, order)
+    picks = np.flatnonzero((ps.poles.imag > 0) & (np.abs(ps.poles) < 2 * np.pi * 30))
+    dev = Perturbation(model, blocks, weights).at(order, picks)
+    scale = weights / weights.sum() * np.sqrt(6 / 5)
+    step = 1e-4
+    for b in range(blocks.shape[0]):
+        R = corr.mean + step * (blocks[b] - np.tensordot(weights / weights.sum(), blocks, axes=1))
+        moved = poles_at(subspace_model(R, model.block_rows, model.max_order, FS), order)
+        for j, i in enumerate(picks):
+            k = np.argmin(np.abs(moved.poles - ps.poles[i]))
+            numeric = (moved.poles[k] - ps.poles[i]) / step * scale[b]
+            assert abs(numeric - dev["pole"][b, j]) < 1e-3 * abs(dev["pole"][b, j]) + 1e-9
+            # the normalised shape too
+            lead = np.argmax(np.abs(ps.shapes[:, i]))
+            assert abs(moved.shapes[lead, k] - 1) < 1e-12  # the same lead entry
+            d_shape = (moved.shapes[:, k] - ps.shapes[:, i]) / step * scale[b]
+            assert np.allclose(d_shape, dev["shape"][b, :, j], rtol=1e-3, atol=1e-3 * np.abs(d_shape).max())
+
+
+def test_hankel_blocks():
+    R = np.arange(7 * 2 * 1, dtype=float).reshape(7, 2, 1)  # lags 0..6, 2 outputs, 1 reference
+    H = hankel(R, 3)
+    assert H.shape == (8, 3)
+    for a in range(4):
+        for b in range(3):
+            assert np.array_equal(H[2 * a:2 * a + 2, b], R[a + b + 1, :, 0])
