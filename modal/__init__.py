@@ -28,10 +28,10 @@ from .geometry import Geometry, line_geometry  # noqa: E402
 from .io.geometry import read_geometry  # noqa: E402
 # operational (output-only) analysis: the package is modal.operational, so that the name modal.oma is the
 # function (a package modal/oma/ would be bound to that attribute on its first import, over the function)
-from .operational import oma  # noqa: E402
+from .operational import merge_setups, oma, scale_by_mass_change  # noqa: E402
 
 __all__ = [
-    "FRF", "FRF_KINDS", "identify", "oma", "estimate_frf", "EstimatedFRF", "read_frf", "write_frf", "METHODS", "IdentificationResult", "ModeResult", "ModeStd",
+    "FRF", "FRF_KINDS", "identify", "oma", "scale_by_mass_change", "merge_setups", "estimate_frf", "EstimatedFRF", "read_frf", "write_frf", "METHODS", "IdentificationResult", "ModeResult", "ModeStd",
     "FLAG_TEXT", "physical_parameters", "Geometry", "line_geometry", "read_geometry", "modal_frf", "matrix_frf", "sdof_frf", "add_noise",
     "DigitalModes", "impact_record", "random_record",
     "errors", "units", "ModalError", "FRFValidationError", "FormatError", "IdentificationError",

@@ -10,7 +10,8 @@ from ..errors import QualityWarning, warn
 from ..flags import FLAG_TEXT
 from ..results import IdentificationResult, ModeResult, ModeStd
 
-__all__ = ["ModeEstimate", "KIND_OF_QUANTITY", "mode_result", "oma_result", "REL_STD_LIMIT", "MPC_LIMIT",
+__all__ = ["ModeEstimate", "KIND_OF_QUANTITY", "mode_result", "oma_result", "scaled_mode", "scaled_result",
+           "merged_result", "REL_STD_LIMIT", "MPC_LIMIT",
            "OVERLAP_LIMIT", "WEAK_FRACTION"]
 
 #: what an FRF of each measured quantity is called (the result's ``kind``)
@@ -113,3 +114,72 @@ def oma_result(estimates: list[ModeEstimate], *, method: str, quantity: str | No
     return IdentificationResult(tuple(modes), method, kind, n_ch, noise_std=np.zeros(0), residuals=None,
                                 stabilisation=stabilisation, settings=settings,
                                 harmonics_hz=tuple(float(f) for f in harmonics_hz))
+
+
+def scaled_mode(mode: ModeResult, psi, jac_psi, inputs_sd, *, uncertain: bool) -> ModeResult:
+    """``mode`` with a mass-normalised shape ψ (1/√kg, per channel) and each channel as a driving point:
+    modal constant ψ² (1/kg), m = 1/ψ², k = m ωn², c = 2 ζ m ωn, their standard errors and correlation.
+
+    ``jac_psi`` (channels × inputs) is ψ's gradient over the inputs whose standard errors are ``inputs_sd``
+    (independent), the first the natural frequency (rad/s) and the last the damping ratio. ``psi`` None:
+    the mode could not be scaled (flagged ``scaling_uncertain``, its k, c, m NaN).
+    """
+    from dataclasses import replace
+
+    from ..results import correlation_of
+
+    flags = set(mode.flags) | ({"scaling_uncertain"} if uncertain else set())
+    if psi is None:
+        return replace(mode, flags=tuple(sorted(flags)))
+    psi = np.asarray(psi, float)
+    wn, zeta = mode.omega_n_rad_s, mode.damping_ratio
+    n_in = len(inputs_sd)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        m = 1.0 / psi**2
+        k, c = m * wn**2, 2 * zeta * m * wn
+        e_w, e_z = np.eye(n_in)[0], np.eye(n_in)[-1]
+        jac = np.empty((psi.size, 3, n_in))  # rows k, c, m
+        jac[:, 2] = (-2.0 / psi**3)[:, None] * jac_psi
+        jac[:, 0] = wn**2 * jac[:, 2] + (2 * m * wn)[:, None] * e_w[None, :]
+        jac[:, 1] = (2 * zeta * wn) * jac[:, 2] + (2 * m * wn)[:, None] * e_z[None, :] \
+            + (2 * zeta * m)[:, None] * e_w[None, :]
+        cov = jac * np.asarray(inputs_sd, float) ** 2 @ np.swapaxes(jac, 1, 2)
+        sd = np.sqrt(np.maximum(np.diagonal(cov, axis1=1, axis2=2), 0.0))
+        s_psi = np.sqrt(np.sum((jac_psi * np.asarray(inputs_sd, float)) ** 2, axis=1))
+    std = ModeStd(mode.std.natural_frequency_hz, mode.std.damping_ratio, 2 * np.abs(psi) * s_psi, sd[:, 0], sd[:, 1],
+                  sd[:, 2], mode_shape=s_psi)
+    return replace(mode, modal_constant=(psi**2).astype(complex), stiffness_n_per_m=k, damping_n_s_per_m=c, mass_kg=m,
+                   std=std, flags=tuple(sorted(flags)), mode_shape=psi.astype(complex),
+                   driving_point=np.ones(psi.size, bool), kcm_correlation=correlation_of(cov))
+
+
+def scaled_result(before: IdentificationResult, modes: list[ModeResult], settings: dict) -> IdentificationResult:
+    """``before`` with its modes replaced by the scaled ones; a warning per mode that could not be scaled."""
+    from dataclasses import replace
+
+    for mode in modes:
+        if "scaling_uncertain" in mode.flags:
+            warn(f"mode near {mode.natural_frequency_hz:.6g} Hz: scaling_uncertain: {FLAG_TEXT['scaling_uncertain']}",
+                 QualityWarning)
+    return replace(before, modes=tuple(modes), settings=settings)
+
+
+def merged_result(first: IdentificationResult, merged, settings: dict, harmonics_hz) -> IdentificationResult:
+    """Merged setups as one result: each entry of ``merged`` is (the first setup's mode, shape, shape's standard
+    error, (frequency, its error), (damping ratio, its error), missing in a setup)."""
+    from dataclasses import replace
+
+    modes = []
+    for mode, shape, shape_std, (f, sf), (z, sz), missing in merged:
+        flags = set(mode.flags) | ({"missing_in_setup"} if missing else set())
+        if missing:
+            warn(f"mode near {f:.6g} Hz: missing_in_setup: {FLAG_TEXT['missing_in_setup']}", QualityWarning)
+        n = shape.size
+        nan = np.full(n, np.nan)
+        std = ModeStd(sf, sz, nan.copy(), nan.copy(), nan.copy(), nan.copy(), mode_shape=shape_std)
+        modes.append(replace(mode, natural_frequency_hz=f, damping_ratio=z, mode_shape=shape,
+                             modal_constant=np.full(n, np.nan + 0j), stiffness_n_per_m=nan.copy(),
+                             damping_n_s_per_m=nan.copy(), mass_kg=nan.copy(), std=std, flags=tuple(sorted(flags)),
+                             driving_point=np.zeros(n, bool), kcm_correlation=None))
+    return replace(first, modes=tuple(modes), n_channels=int(settings["n_channels"]), settings=settings,
+                   harmonics_hz=tuple(harmonics_hz), stabilisation=None)

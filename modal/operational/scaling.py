@@ -1,0 +1,150 @@
+"""Mass-normalised shapes from two operational tests: before and after adding known masses.
+
+Adding masses ΔM lowers each mode's frequency from ω₀ to ω₁; with both records' shapes φ₀, φ₁
+(normalised alike and phase-aligned) the scale factor of the first record's shape is
+(Brincker & Andersen 2003; López-Aenlle et al. 2010, the form with both shapes)::
+
+    α² = (ω₀² − ω₁²) / (ω₁² φ₀ᵀ ΔM φ₁),    ψ = α φ₀  (ψᵀ M ψ = 1)
+
+Per channel j, the mode then is a driving point of modal constant ψ_j² (1/kg): mass 1/ψ_j²,
+stiffness ω₀²/ψ_j², damping 2ζω₀/ψ_j², as :func:`modal.identify` gives them for an impact
+test's driving point. Standard errors follow to first order from those of both records'
+frequencies, damping and shapes (independent records).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import ParameterError
+from ..results import IdentificationResult
+from .result import scaled_mode, scaled_result
+from .selection import shape_mac
+
+__all__ = ["scale_by_mass_change", "MIN_SHIFT_SIGMAS", "MAX_SCALE_ERROR", "PAIR_MAC"]
+
+#: the frequency shift must exceed this many of its standard errors ...
+MIN_SHIFT_SIGMAS = 3.0
+#: ... and the scale factor's relative standard error stay below this, else ``scaling_uncertain``
+MAX_SCALE_ERROR = 0.1
+#: a mode of the second record is the same mode when its shape has at least this MAC with the first's
+PAIR_MAC = 0.8
+#: the added mass lowers a mode's frequency by at most this fraction (and raises it by none beyond its errors)
+MAX_SHIFT = 0.3
+
+
+def _masses(added_mass_kg, result: IdentificationResult) -> np.ndarray:
+    n = result.n_channels
+    names = list(result.settings.get("channel_names") or [])
+    if not isinstance(added_mass_kg, dict) or not added_mass_kg:
+        raise ParameterError(f"'added_mass_kg' is {added_mass_kg!r}; expected a dict {{channel: kg}} with at least "
+                             "one channel")
+    dm = np.zeros(n)
+    for key, kg in added_mass_kg.items():
+        if isinstance(key, (int, np.integer)) and 0 <= int(key) < n:
+            ch = int(key)
+        elif str(key) in names:
+            ch = names.index(str(key))
+        else:
+            raise ParameterError(f"'added_mass_kg' names channel {key!r}; expected a 0-based index in [0, {n}) or "
+                                 f"a channel name ({', '.join(names) or 'none given'})")
+        if not (np.isfinite(kg) and kg > 0):
+            raise ParameterError(f"'added_mass_kg' gives {kg!r} kg at channel {key!r}; expected a positive mass")
+        dm[ch] += float(kg)
+    return dm
+
+
+def _aligned(reference: np.ndarray, shape: np.ndarray) -> np.ndarray:
+    """``shape`` turned in phase so that ``referenceᴴ shape`` is real and positive."""
+    inner = np.vdot(reference, shape)
+    return shape * (np.conj(inner) / abs(inner)) if abs(inner) > 0 else shape
+
+
+def _pair(mode, after: IdentificationResult):
+    """The mode of ``after`` that is ``mode`` with mass added: highest MAC among those not far above it."""
+    best, best_mac = None, PAIR_MAC
+    for other in after:
+        limit = 3 * np.hypot(mode.std.natural_frequency_hz, other.std.natural_frequency_hz)
+        shift = other.natural_frequency_hz / mode.natural_frequency_hz - 1
+        if not (-MAX_SHIFT <= shift and other.natural_frequency_hz <= mode.natural_frequency_hz + np.nan_to_num(limit)):
+            continue
+        mac = shape_mac(mode.mode_shape, other.mode_shape)
+        if mac >= best_mac:
+            best, best_mac = other, mac
+    return best
+
+
+def _scale(mode, other, dm):
+    """α, ψ and the Jacobian of (α², ψ) with respect to (ω₀, ω₁, φ₀, φ₁), and the input standard errors."""
+    w0, w1 = 2 * np.pi * mode.natural_frequency_hz, 2 * np.pi * other.natural_frequency_hz
+    phi0 = np.asarray(mode.mode_shape, complex)
+    phi1 = _aligned(phi0, np.asarray(other.mode_shape, complex))
+    p0, p1 = phi0.real, phi1.real  # normal-mode form (the complex part is flagged complex_shape where large)
+    D = w1**2 * np.sum(dm * p0 * p1)
+    N = w0**2 - w1**2
+    alpha2 = N / D if D != 0 else np.nan
+    n = p0.size
+    grad = np.zeros(2 + 2 * n)  # d α² / d (ω0, ω1, φ0, φ1)
+    grad[0] = 2 * w0 / D
+    grad[1] = -2 * w1 / D - 2 * alpha2 / w1
+    grad[2:2 + n] = -alpha2 * w1**2 * dm * p1 / D
+    grad[2 + n:] = -alpha2 * w1**2 * dm * p0 / D
+    sd = np.concatenate([[2 * np.pi * mode.std.natural_frequency_hz, 2 * np.pi * other.std.natural_frequency_hz],
+                         _shape_std(mode, n), _shape_std(other, n)])
+    return alpha2, p0, grad, sd
+
+
+def _shape_std(mode, n):
+    s = getattr(mode.std, "mode_shape", None)
+    return np.zeros(n) if s is None else np.nan_to_num(np.asarray(s, float))
+
+
+def scale_by_mass_change(before: IdentificationResult, after: IdentificationResult,
+                         added_mass_kg: dict) -> IdentificationResult:
+    """The first record's modes with mass-normalised shapes and per-channel k, c, m.
+
+    Parameters
+    ----------
+    before, after : IdentificationResult
+        Operational results (:func:`modal.oma`) of the same channels without and with the added masses.
+    added_mass_kg : dict
+        ``{channel: kg}``: the masses added at measured channels (0-based index or channel name).
+
+    Returns
+    -------
+    IdentificationResult
+        ``before``'s modes with ``mode_shape`` mass-normalised (1/√kg), ``modal_constant`` ψ_j² (1/kg)
+        and ``mass_kg``, ``stiffness_n_per_m``, ``damping_n_s_per_m`` per channel, with standard errors
+        and their correlation; a mode without a partner in ``after`` (MAC ≥ 0.8, lower frequency), or whose
+        frequency shift or scale is not determined, is flagged ``scaling_uncertain``.
+    """
+    if before.n_channels != after.n_channels:
+        raise ParameterError(f"'before' has {before.n_channels} channels and 'after' {after.n_channels}; expected "
+                             "records of the same channels")
+    dm = _masses(added_mass_kg, before)
+    modes = []
+    for mode in before:
+        other = _pair(mode, after)
+        if other is None:
+            modes.append(scaled_mode(mode, None, None, None, uncertain=True))
+            continue
+        alpha2, p0, grad, sd = _scale(mode, other, dm)
+        n = p0.size
+        var_alpha2 = float(np.sum((grad * sd) ** 2))
+        shift_sd = np.hypot(mode.std.natural_frequency_hz, other.std.natural_frequency_hz)
+        shift = mode.natural_frequency_hz - other.natural_frequency_hz
+        if not (np.isfinite(alpha2) and alpha2 > 0):
+            modes.append(scaled_mode(mode, None, None, None, uncertain=True))
+            continue
+        alpha = np.sqrt(alpha2)
+        # ψ_j = α φ0_j: gradient over (ω0, ω1, φ0, φ1) and the damping ratio (for c)
+        d_alpha = grad / (2 * alpha)
+        jac_psi = np.outer(p0, d_alpha)
+        jac_psi[np.arange(n), 2 + np.arange(n)] += alpha
+        inputs_sd = np.concatenate([sd, [mode.std.damping_ratio]])
+        jac_psi = np.hstack([jac_psi, np.zeros((n, 1))])
+        uncertain = (not shift > MIN_SHIFT_SIGMAS * np.nan_to_num(shift_sd)
+                     or not np.sqrt(var_alpha2) / alpha2 / 2 <= MAX_SCALE_ERROR)
+        modes.append(scaled_mode(mode, alpha * p0, jac_psi, inputs_sd, uncertain=uncertain))
+    settings = {**before.settings, "added_mass_kg": {str(k): float(v) for k, v in added_mass_kg.items()},
+                "scaled_by": "mass_change"}
+    return scaled_result(before, modes, settings)

@@ -1,0 +1,129 @@
+"""Several setups merged into one set of shapes: roving sensors with shared references.
+
+Each setup is identified on its own (:func:`modal.oma`); a mode of the first setup is found in each
+further setup as the mode nearest in frequency (within :data:`FREQ_TOL` or three combined standard
+errors) whose shape at the reference channels has a MAC of at least :data:`REF_MAC` with the first
+setup's. Each further setup's shape is rescaled by the least-squares factor that maps its reference
+entries onto the first setup's, ``a = φ_refᴴ φ₁,ref / φ_refᴴ φ_ref`` (post-identification rescaling,
+PoSER-style), and its other channels appended. Frequencies and damping ratios are the
+inverse-variance weighted means over the setups that hold the mode.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import ParameterError
+from ..results import IdentificationResult
+from .result import merged_result
+from .selection import shape_mac
+
+__all__ = ["merge_setups", "FREQ_TOL", "REF_MAC"]
+
+#: a mode of another setup lies within this relative frequency difference (or 3 combined standard errors)
+FREQ_TOL = 0.01
+#: ... and its reference entries have at least this MAC with the first setup's
+REF_MAC = 0.8
+
+
+def _references(reference_channels, results) -> list[np.ndarray]:
+    try:
+        refs = [np.asarray(r, int) for r in reference_channels]
+        if all(r.ndim == 0 for r in refs):
+            refs = [np.asarray(reference_channels, int)] * len(results)
+    except (TypeError, ValueError):
+        raise ParameterError(f"'reference_channels' is {reference_channels!r}; expected 0-based channel indices "
+                             "(one list for every setup, or one list per setup)") from None
+    if len(refs) != len(results):
+        raise ParameterError(f"'reference_channels' gives {len(refs)} lists for {len(results)} setups; expected one "
+                             "per setup (or one list for all)")
+    sizes = {r.size for r in refs}
+    for k, (r, res) in enumerate(zip(refs, results)):
+        if r.ndim != 1 or r.size == 0 or np.any(r < 0) or np.any(r >= res.n_channels) or np.unique(r).size != r.size:
+            raise ParameterError(f"'reference_channels' of setup {k + 1} is {r.tolist()}; expected distinct indices in "
+                                 f"[0, {res.n_channels})")
+    if len(sizes) != 1:
+        raise ParameterError("'reference_channels' lists differ in length; expected the same references, in the same "
+                             "order, in every setup")
+    return refs
+
+
+def _find(mode, ref0, result, ref):
+    """The mode of ``result`` that is ``mode`` (see the module docstring), or None."""
+    best, best_key = None, np.inf
+    for other in result:
+        gap = abs(other.natural_frequency_hz - mode.natural_frequency_hz)
+        allowed = max(FREQ_TOL * mode.natural_frequency_hz,
+                      3 * np.nan_to_num(np.hypot(mode.std.natural_frequency_hz, other.std.natural_frequency_hz)))
+        if gap > allowed:
+            continue
+        if ref.size > 1 and shape_mac(mode.mode_shape[ref0], other.mode_shape[ref]) < REF_MAC:
+            continue
+        if gap < best_key:
+            best, best_key = other, gap
+    return best
+
+
+def merge_setups(results, reference_channels) -> IdentificationResult:
+    """Merge operational results of several setups into shapes over all their channels.
+
+    Parameters
+    ----------
+    results : sequence of IdentificationResult
+        One per setup (:func:`modal.oma`), the first defining the modes.
+    reference_channels : sequence of int, or sequence of sequences of int
+        Each setup's reference channels (0-based), in the same order for every setup; one list serves
+        all setups when their references sit at the same indices.
+
+    Returns
+    -------
+    IdentificationResult
+        The first setup's modes; each shape holds the first setup's channels, then each further setup's
+        non-reference channels in order. A mode missing from a setup has NaN there and the flag
+        ``missing_in_setup``.
+    """
+    results = list(results)
+    if len(results) < 2:
+        raise ParameterError(f"merge_setups needs at least 2 setups, got {len(results)}")
+    refs = _references(reference_channels, results)
+    others = [np.setdiff1d(np.arange(r.n_channels), ref) for r, ref in zip(results, refs)]
+    merged = []
+    for mode in results[0]:
+        shape = [np.asarray(mode.mode_shape, complex)]
+        shape_std = [np.asarray(mode.std.mode_shape if mode.std.mode_shape is not None
+                                else np.full(mode.mode_shape.size, np.nan), float)]
+        f, sf, z, sz = [mode.natural_frequency_hz], [mode.std.natural_frequency_hz], [mode.damping_ratio], \
+            [mode.std.damping_ratio]
+        missing = False
+        for result, ref, rest in zip(results[1:], refs[1:], others[1:]):
+            other = _find(mode, refs[0], result, ref)
+            if other is None:
+                missing = True
+                shape.append(np.full(rest.size, np.nan + 0j))
+                shape_std.append(np.full(rest.size, np.nan))
+                continue
+            phi = np.asarray(other.mode_shape, complex)
+            a = np.vdot(phi[ref], mode.mode_shape[refs[0]]) / np.vdot(phi[ref], phi[ref])
+            shape.append(a * phi[rest])
+            s = other.std.mode_shape
+            shape_std.append(abs(a) * (np.asarray(s, float)[rest] if s is not None else np.full(rest.size, np.nan)))
+            f.append(other.natural_frequency_hz), sf.append(other.std.natural_frequency_hz)
+            z.append(other.damping_ratio), sz.append(other.std.damping_ratio)
+        merged.append((mode, np.concatenate(shape), np.concatenate(shape_std), _mean(f, sf), _mean(z, sz), missing))
+    names = []
+    for k, (result, rest) in enumerate(zip(results, others)):
+        own = list(result.settings.get("channel_names") or range(result.n_channels))
+        picked = range(result.n_channels) if k == 0 else rest
+        names += [f"setup{k + 1}:{own[i]}" for i in picked]
+    settings = {**results[0].settings, "setups": len(results), "reference_channels": [r.tolist() for r in refs],
+                "channel_names": names, "n_channels": len(names)}
+    harmonics = sorted({round(h, 6) for r in results for h in r.harmonics_hz})
+    return merged_result(results[0], merged, settings, harmonics)
+
+
+def _mean(values, stds):
+    """Inverse-variance weighted mean and its standard error (plain mean when an error is missing)."""
+    v, s = np.asarray(values, float), np.asarray(stds, float)
+    if np.all(np.isfinite(s) & (s > 0)):
+        w = 1.0 / s**2
+        return float(np.sum(w * v) / np.sum(w)), float(1.0 / np.sqrt(np.sum(w)))
+    return float(np.mean(v)), float("nan")
