@@ -102,8 +102,10 @@ def build_parser(prog: str = "python -m modal") -> argparse.ArgumentParser:
     report.add_argument("--method", metavar="METHOD",
                         help="--gif: the result whose mode is animated (default the archive's first)")
     from .batch.cli import add_batch_parser
+    from .cli_oma import add_oma_parser
 
     add_batch_parser(sub, add_fit_options)
+    add_oma_parser(sub)
     return parser
 
 
@@ -272,6 +274,10 @@ def main(argv: list[str] | None = None) -> int:
             return _frf(args)
         if args.command == "report":
             return _report(args)
+        if args.command == "oma":
+            from .cli_oma import run_oma
+
+            return run_oma(args)
     except ModalError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 1

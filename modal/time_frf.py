@@ -110,8 +110,11 @@ def plan_time_frf(record, args, report: Callable[[str], None] | None = None,
             listing = ", ".join(f"{k + 1}={n} ({q or 'unknown'})"
                                 for k, (n, q) in enumerate(zip(record.names, record.quantities)))
             what = "no channel" if not inputs else f"{len(inputs)} channels"
+            responses_only = not inputs and all(q not in (None, "force") for q in record.quantities)
+            hint = (f"; the record holds responses only: for operational (output-only) modal analysis use "
+                    f"python -m modal oma {src}" if responses_only else "")
             raise FormatError(f"{src}: {what} marked as force ({listing}); expected one: name the force channel "
-                              f"with {option('excitation')} (an FRF needs an excitation)")
+                              f"with {option('excitation')} (an FRF needs an excitation){hint}")
     if args.response:
         outputs = [record.channel_index(r) for r in args.response]
     else:

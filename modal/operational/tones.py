@@ -4,8 +4,8 @@ A running machine's harmonics are sinusoids in every channel: the identification
 poles of (nearly) zero damping, as stable over the orders as any mode. Three pieces of evidence
 say that a pole is a tone (Brincker, Andersen & Møller, IMAC 2000; Jacobsen 2006):
 
-* its damping is nearly zero: below :data:`TONE_DAMPING` with its error (ζ + 3σ_ζ), where few
-  structures are;
+* its damping is nearly zero: below :data:`TONE_DAMPING` (where few structures are) either with its
+  error (ζ + 3σ_ζ) or indistinguishable from zero (ζ < 3σ_ζ);
 * the response band-passed around it is not Gaussian: a sinusoid's kurtosis is 1.5 where a
   structural mode driven by random forces gives 3 (:data:`KURTOSIS_LIMIT`);
 * it lies on a harmonic ``k × f₀`` of the running speed (``rotor_speed_hz``, or the fundamental
@@ -76,9 +76,11 @@ def _fundamental(tones_hz: list[float], stds: list[float]) -> float | None:
 
 
 def nearly_undamped(estimate: ModeEstimate) -> bool:
-    """Whether a pole's damping ratio lies below :data:`TONE_DAMPING` with its error (ζ + 3σ_ζ)."""
-    s_zeta = estimate.std_damping_ratio
-    return estimate.damping_ratio + ZERO_DAMPING_SIGMAS * (s_zeta if np.isfinite(s_zeta) else 0.0) < TONE_DAMPING
+    """Whether a pole's damping ratio lies below :data:`TONE_DAMPING`, with its error (ζ + 3σ_ζ) or
+    indistinguishable from zero (ζ < 3σ_ζ)."""
+    zeta = estimate.damping_ratio
+    margin = ZERO_DAMPING_SIGMAS * (estimate.std_damping_ratio if np.isfinite(estimate.std_damping_ratio) else 0.0)
+    return bool(zeta < TONE_DAMPING and (zeta + margin < TONE_DAMPING or zeta < margin))
 
 
 def _evidence(estimate: ModeEstimate, prepared: Prepared) -> tuple[bool, bool]:
