@@ -21,7 +21,7 @@ from .inputs import MIN_LAGS_IN_RECORD, Prepared, prepare
 from .modes import error_blocks, estimates_from_clusters, resolved
 from .tones import nearly_undamped, separate_tones
 from .result import oma_result
-from .selection import OMAStabilisation, stabilise
+from .selection import OMAStabilisation, mpc, stabilise
 
 __all__ = ["oma", "OMA_METHODS"]
 
@@ -156,8 +156,28 @@ def oma(data, sample_rate_hz: float | None = None, *, band_hz=None, method: str 
         from .plscf import plscf
 
         estimates, chosen, clusters, flat, stable, corr, settings = plscf(prepared, refs, max_order)
-    # noise poles (frequency not determined within their bandwidth) are dropped, except poles of nearly zero
-    # damping, which go to the tone test first (a tone's first-order frequency error is erratic)
+    estimates, tones, dropped, diagram = _sort_out(estimates, chosen, clusters, flat, stable, prepared,
+                                                   rotor_speed_hz, method)
+    if not estimates and not tones:
+        raise IdentificationError(f"{prepared.source}: no stable pole in the band {prepared.band_hz[0]:g}-"
+                                  f"{prepared.band_hz[1]:g} Hz (orders {settings['orders'][0]}-"
+                                  f"{settings['orders'][1]}); widen the band or raise max_order")
+    settings = {**settings, "band_hz": list(prepared.band_hz), "reference_channels": list(refs),
+                "sample_rate_hz": prepared.original_rate_hz, "decimation": prepared.decimation,
+                "duration_s": prepared.duration_s, "rotor_speed_hz": rotor_speed_hz,
+                "channel_names": list(prepared.names), "n_channels": prepared.n_channels,
+                "dropped_unresolved_hz": dropped}
+    return oma_result(estimates, method=method, quantity=prepared.quantity, band_hz=prepared.band_hz,
+                      stabilisation=diagram, settings=settings, harmonics_hz=tones, source=prepared.source)
+
+
+def _sort_out(estimates, chosen, clusters, flat, stable, prepared: Prepared, rotor_speed_hz, method: str):
+    """Modes, tones (Hz), dropped noise poles (Hz) and the stabilisation diagram from the method's estimates.
+
+    Noise poles (frequency not determined within their bandwidth) are dropped, except poles of nearly zero
+    damping, which go to the tone test first (a tone's first-order frequency error is erratic); then the
+    tones are told apart, and the noise poles among what is left dropped.
+    """
     keep = [resolved(e, prepared.duration_s) or nearly_undamped(e) for e in estimates]
     dropped = [e.natural_frequency_hz for e, k in zip(estimates, keep) if not k]
     estimates, clusters = ([x for x, k in zip(seq, keep) if k] for seq in (estimates, clusters))
@@ -177,24 +197,7 @@ def oma(data, sample_rate_hz: float | None = None, *, band_hz=None, method: str 
         else:
             cluster[members.members] = len(modes)
             modes.append(estimate)
-    estimates = modes
     diagram = OMAStabilisation(flat.order, flat.frequency_hz, flat.damping_ratio,
-                               np.array([_mpc(flat.shape[:, i]) for i in range(n_poles)]), stable, cluster,
+                               np.array([mpc(flat.shape[:, i]) for i in range(n_poles)]), stable, cluster,
                                np.isin(np.arange(n_poles), chosen), tone, method)
-    if not estimates and not tones:
-        raise IdentificationError(f"{prepared.source}: no stable pole in the band {prepared.band_hz[0]:g}-"
-                                  f"{prepared.band_hz[1]:g} Hz (orders {settings['orders'][0]}-"
-                                  f"{settings['orders'][1]}); widen the band or raise max_order")
-    settings = {**settings, "band_hz": list(prepared.band_hz), "reference_channels": list(refs),
-                "sample_rate_hz": prepared.original_rate_hz, "decimation": prepared.decimation,
-                "duration_s": prepared.duration_s, "rotor_speed_hz": rotor_speed_hz,
-                "channel_names": list(prepared.names), "n_channels": prepared.n_channels,
-                "dropped_unresolved_hz": dropped}
-    return oma_result(estimates, method=method, quantity=prepared.quantity, band_hz=prepared.band_hz,
-                      stabilisation=diagram, settings=settings, harmonics_hz=tones, source=prepared.source)
-
-
-def _mpc(shape):
-    from .selection import mpc
-
-    return mpc(shape)
+    return modes, tones, dropped, diagram

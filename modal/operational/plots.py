@@ -39,7 +39,7 @@ def plot_stabilisation(result: IdentificationResult, spectrum=None, figure: Figu
     if spectrum is not None:
         twin = ax.twinx()
         twin.semilogy(spectrum[0], spectrum[1], color="k", lw=0.8, alpha=0.7)
-        twin.set_ylabel("first singular value of the half-spectra [units² of the signals / Hz]")
+        twin.set_ylabel("first singular value of the half-spectra (channels at unit RMS)")
     lo, hi = result.settings.get("band_hz", [np.min(diagram.frequency_hz), np.max(diagram.frequency_hz)])
     ax.set_xlim(lo, hi)
     ax.legend(loc="upper left", fontsize="small", ncols=3)

@@ -187,18 +187,19 @@ def _same_mode(fa, sa, fb, sb, freq_tol, mac_tol) -> bool:
 def _merge(flat: _Flat, chains: list[np.ndarray], freq_tol: float, mac_tol: float) -> list[np.ndarray]:
     """Join chains of one mode broken at some order; drop a chain running beside a longer one of the same mode."""
     chains = sorted(chains, key=lambda c: -np.unique(flat.order[c]).size)
-    kept: list[np.ndarray] = []
+    kept: list[list] = []  # [members, (median frequency, top shape, orders)]
     for chain in chains:
         fc, sc, oc = _summary(flat, chain)
-        for k, other in enumerate(kept):
-            fo, so, oo = _summary(flat, other)
+        for entry in kept:
+            fo, so, oo = entry[1]
             if _same_mode(fc, sc, fo, so, freq_tol, mac_tol):
-                if not (oc & oo):
-                    kept[k] = np.concatenate([other, chain])  # the same mode, at other orders
+                if not (oc & oo):  # the same mode, at other orders
+                    entry[0] = np.concatenate([entry[0], chain])
+                    entry[1] = _summary(flat, entry[0])
                 break  # a duplicate beside a longer chain: dropped
         else:
-            kept.append(chain)
-    return kept
+            kept.append([chain, (fc, sc, oc)])
+    return [entry[0] for entry in kept]
 
 
 def stabilise(sets: list[PoleSet], low_hz: float, high_hz: float, *, freq_tol: float = FREQ_TOL,

@@ -139,17 +139,21 @@ class Perturbation:
         Samples per block.
     """
 
-    def __init__(self, model: SubspaceModel, block_R: np.ndarray, weights: np.ndarray):
+    def __init__(self, model: SubspaceModel, block_R: np.ndarray, weights: np.ndarray, max_order: int | None = None):
         self.model = model
         n_blocks = block_R.shape[0]
         if n_blocks < 2:
             raise IdentificationError("error bars need at least 2 blocks of the record")
         w = weights / weights.sum()
         self.scale = w * np.sqrt(n_blocks / (n_blocks - 1.0))  # var of the weighted mean from the blocks' scatter
+        top = int(min(max_order or model.max_order, model.max_order))
+        self.top = top
+        U, V = model.U, model.V
         dH = hankel(block_R, model.block_rows) - model.hankel[None]  # (blocks, p, q)
-        self.G = dH @ model.V  # (blocks, p, k): ΔH V
-        self.B = model.U.T @ self.G  # (blocks, k, k): Uᵀ ΔH V
-        self.E = self.G - model.U @ self.B  # the part of ΔH V outside the range of H
+        G = dH @ V[:, :top]  # (blocks, p, top): ΔH V₁ for every order up to top
+        self.B_right = np.swapaxes(U.T @ G, 1, 2)  # (blocks, top, k): (Uᵀ ΔH V₁)ᵀ
+        self.E = G - U @ np.swapaxes(self.B_right, 1, 2)  # the part of ΔH V₁ outside the range of H
+        self.B_left = (np.swapaxes(U[:, :top], 0, 1) @ dH) @ V  # (blocks, top, k): U₁ᵀ ΔH V
 
     def at(self, order: int, indices) -> dict[str, np.ndarray]:
         """Deviations of the poles ``indices`` of :func:`poles_at` (``order``).
@@ -164,12 +168,16 @@ class Perturbation:
         model = self.model
         idx = np.asarray(indices, int)
         n, l = order, model.n_outputs
+        if n > self.top:
+            raise IdentificationError(f"perturbations were prepared up to order {self.top}, not {n}")
         U, sv = model.U, model.singular_values
         s1, s2 = sv[:n], sv[n:]
-        B = self.B
+        # U₂ᵀ ΔH V₁ and (U₁ᵀ ΔH V₂)ᵀ, each (blocks, k − n, n)
+        left = np.swapaxes(self.B_right[:, :n, n:], 1, 2)
+        right = np.swapaxes(self.B_left[:, :n, n:], 1, 2)
         with np.errstate(divide="ignore", invalid="ignore"):
             gap = s1[None, :] ** 2 - s2[:, None] ** 2  # (k − n, n)
-            inside = (B[:, n:, :n] * s1[None, None, :] + s2[None, :, None] * np.swapaxes(B[:, :n, n:], 1, 2)) / gap
+            inside = (left * s1[None, None, :] + s2[None, :, None] * right) / gap
         inside = np.where(np.isfinite(inside), inside, 0.0)
         # each perturbed singular vector's part outside the signal subspace (the part inside only rotates the
         # basis, which leaves the eigenvalues and the observed shapes as they are)
@@ -180,9 +188,21 @@ class Perturbation:
         U1 = U[:, :n]
         resid = U1[l:] - U1[:rows] @ A
         d_up, d_down = dU1[:, :rows], dU1[:, l:]
-        dA = np.linalg.solve(Rn, Qn.T @ (d_down - d_up @ A))
-        dA = dA + np.linalg.solve(Rn, np.linalg.solve(Rn.T, np.swapaxes(d_up, 1, 2) @ resid))
-        Wm = np.linalg.solve(psi, dA @ psi)  # (blocks, n, n): Ψ⁻¹ ΔA Ψ
+        # ΔA = R⁻¹ [Qᵀ (ΔO_down − ΔO_up A) + R⁻ᵀ ΔO_upᵀ (O_down − O_up A)], R upper triangular: two
+        # triangular solves for all blocks at once
+        from scipy.linalg import solve_triangular
+
+        n_blocks = dU1.shape[0]
+
+        def flat(x):  # (blocks, n, m) -> (n, blocks·m)
+            return np.swapaxes(x, 0, 1).reshape(n, -1)
+
+        def unflat(x):
+            return np.swapaxes(x.reshape(n, n_blocks, -1), 0, 1)
+
+        inner = unflat(solve_triangular(Rn, flat(np.swapaxes(d_up, 1, 2) @ resid), trans="T"))
+        dA = unflat(solve_triangular(Rn, flat(Qn.T @ (d_down - d_up @ A) + inner)))
+        Wm = np.linalg.inv(psi) @ dA @ psi  # (blocks, n, n): Ψ⁻¹ ΔA Ψ
         picks = np.arange(idx.size)
         d_mu = Wm[:, idx, idx]
         d_lam = d_mu / mu[idx][None, :] * model.sample_rate_hz

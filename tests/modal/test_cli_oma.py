@@ -73,3 +73,20 @@ def test_fit_on_a_response_only_record_points_to_oma():
     # an accelerometer named as the excitation: refused by the record's role check, not divided by
     done = _run("fit", REAL, "--excitation", 1)
     assert done.returncode == 1 and "named as the excitation but measured acceleration" in done.stderr
+
+
+def test_readme_real_record_as_written(tmp_path):
+    """The README's command on the shipped ambient record, run as written, prints the table the README shows."""
+    import shlex
+
+    text = (ROOT / "README.md").read_text()
+    section = text.split("### The shipped ambient record", 1)[1].split("\n## ", 1)[0]
+    command = section.split("```sh\n", 1)[1].split("```", 1)[0].strip()
+    shown = section.split("```text\n", 1)[1].split("```", 1)[0].strip()
+    words = shlex.split(command.replace("out/", f"{tmp_path.as_posix()}/"))
+    assert words[0] == ".venv/bin/python"
+    done = subprocess.run([sys.executable, *words[1:]], capture_output=True, text=True, cwd=ROOT, timeout=600)
+    assert done.returncode == 0, done.stderr
+    table = done.stdout.strip().splitlines()[1:]  # the first line names the file
+    assert table == shown.splitlines()
+    assert (tmp_path / "oma_real.png").stat().st_size > 10_000

@@ -1,0 +1,208 @@
+"""Operational modal analysis against koma-python and pyOMA-2: time and error on the same ambient records.
+
+Run ``python -m benchmarks.bench_oma [--records N] [--calibration N] [--speed]``.
+
+The records are the anchor case of ``tests/support/ambient.py`` (six modes, eight sensors, a pair 1.9 %
+apart, a weakly excited mode, machine tones at 1×/2×/3× of 4.8 Hz, 10 % noise, 1000 s at 100 Hz), seeds
+9000+ (not used by any test). Each record goes to the three tools in turn, the order rotating from record
+to record (interleaved); the times are medians over the records.
+
+* modalbal: ``modal.oma(signals, 100, band_hz=(1, 30))`` (SSI-cov, automatic selection, tones apart).
+* koma-python: ``covssi`` (i = 30 block rows, orders 2-80), ``find_stable_poles`` (s = 2, 5 % frequency,
+  20 % damping, 0.3 MAC, band 1-30 Hz, ζ < 0.2), ``PoleClusterer`` (HDBSCAN, min_samples = min_cluster_size
+  = 20) and ``group_clusters``, a mode per cluster at its median: the example of its documentation.
+* pyOMA-2: ``SSI(method="cov", br=30, ordmax=80)`` on a ``SingleSetup`` and the automatic clustering
+  ``Clustering(quick="Kvaale", freqlim=(1, 30))``.
+
+A reported mode within 0.5 % of a true mode is that mode (a second one is a duplicate); one within 0.5 %
+of a tone is a tone reported as a mode; any other is spurious. Errors: the largest relative frequency and
+damping errors over the modes found.
+
+``--calibration N``: z = error / reported standard error of modalbal's frequency and damping per mode
+over N records (seeds 5000+, as the stress test), the table of their means and SDs.
+``--speed``: modalbal's time on larger records (samples × channels).
+"""
+from __future__ import annotations
+
+import argparse
+import contextlib
+import io
+import statistics
+import sys
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))  # the shared ambient cases
+
+import modal  # noqa: E402
+from support.ambient import FN, TONES, ZETA, anchor_record  # noqa: E402
+
+BAND = (1.0, 30.0)
+
+
+def run_ours(signals, fs):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        result = modal.oma(signals, fs, band_hz=BAND)
+    return [(m.natural_frequency_hz, m.damping_ratio) for m in result]
+
+
+def run_koma(signals, fs):
+    import koma.clustering
+    import koma.oma
+
+    orders = np.arange(2, 82, 2)
+    with contextlib.redirect_stdout(io.StringIO()), warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        lambd, phi, pole_orders = koma.oma.covssi(signals.T, fs, 30, orders, showinfo=False)
+        stab = koma.oma.find_stable_poles(lambd, phi, pole_orders, 2, stabcrit={"freq": 0.05, "damping": 0.2, "mac": 0.3},
+                                          valid_range={"freq": [2 * np.pi * BAND[0], 2 * np.pi * BAND[1]],
+                                                       "damping": [0, 0.2]}, indicator="freq")
+        lambd_stab, phi_stab, orders_stab = stab[0], stab[1], stab[2]
+        clusterer = koma.clustering.PoleClusterer(lambd_stab, phi_stab, orders_stab, min_cluster_size=20,
+                                                  min_samples=20)
+        args = clusterer.postprocess(prob_threshold=0.99, normalize_and_maxreal=True)
+        if len(args[0]) == 0:
+            return []
+        xi, omega_n, *_ = koma.clustering.group_clusters(*args)
+    return [(float(np.median(w)) / (2 * np.pi), float(np.median(z))) for w, z in zip(omega_n, xi)]
+
+
+def run_pyoma(signals, fs):
+    import logging
+
+    from pyoma2.algorithms import SSI
+    from pyoma2.algorithms.data.run_params import Clustering
+    from pyoma2.setup import SingleSetup
+
+    logging.disable(logging.CRITICAL)
+    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()), \
+            warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        setup = SingleSetup(signals.T.copy(), fs)
+        alg = SSI(name="ssicov", method="cov", br=30, ordmax=80)
+        setup.add_algorithms(alg)
+        setup.run_by_name("ssicov")
+        alg.add_clustering(Clustering(name="auto", quick="Kvaale", freqlim=BAND))
+        alg.run_clustering("auto")
+        res = alg.result.clustering_results["auto"]
+    return [(float(f), float(z)) for f, z in zip(np.atleast_1d(res.Fn), np.atleast_1d(res.Xi))]
+
+
+TOOLS = {"modalbal": run_ours, "koma-python": run_koma, "pyOMA-2": run_pyoma}
+
+
+def score(found):
+    """(modes found once, duplicates, spurious, tones as modes, max |df/f|, max |dζ/ζ|)."""
+    f = np.array([x[0] for x in found]) if found else np.zeros(0)
+    z = np.array([x[1] for x in found]) if found else np.zeros(0)
+    used = np.zeros(f.size, bool)
+    once = dup = 0
+    ferr, zerr = [], []
+    for fn, zeta in zip(FN, ZETA):
+        near = np.flatnonzero(np.abs(f / fn - 1) < 0.005)
+        used[near] = True
+        if near.size:
+            once += 1
+            dup += near.size - 1
+            best = near[np.argmin(np.abs(f[near] - fn))]
+            ferr.append(abs(f[best] / fn - 1))
+            zerr.append(abs(z[best] / zeta - 1))
+    tone = np.zeros(f.size, bool)
+    for t in TONES:
+        tone |= np.abs(f / t - 1) < 0.005
+    spurious = int(np.sum(~used & ~tone))
+    return once, dup, spurious, int(np.sum(tone & ~used)), max(ferr, default=np.nan), max(zerr, default=np.nan)
+
+
+def compare(n_records: int) -> str:
+    names = list(TOOLS)
+    times = {n: [] for n in names}
+    scores = {n: [] for n in names}
+    for r in range(n_records):
+        rec = anchor_record(9000 + r, noise=0.1, tones=True)
+        order = names[r % len(names):] + names[:r % len(names)]  # interleaved, rotating
+        for name in order:
+            t0 = time.perf_counter()
+            try:
+                found = TOOLS[name](rec.signals, rec.sample_rate_hz)
+            except Exception as exc:  # noqa: BLE001 - a peer failing is a result of the benchmark
+                print(f"{name} record {r}: failed ({type(exc).__name__}: {exc})", file=sys.stderr)
+                found = []
+            times[name].append(time.perf_counter() - t0)
+            scores[name].append(score(found))
+    lines = [f"{n_records} records (anchor case, 8 channels × 100 000 samples), interleaved; time = median",
+             "", "| tool | time per record [s] | modes found (of 6) | duplicates | spurious | tones as modes | "
+             "max freq. error | max damping error |", "|---|---|---|---|---|---|---|---|"]
+    for name in names:
+        s = np.array(scores[name], float)
+        lines.append(f"| {name} | {statistics.median(times[name]):.2f} | {s[:, 0].min():.0f}-{s[:, 0].max():.0f} | "
+                     f"{s[:, 1].sum():.0f} | {s[:, 2].sum():.0f} | {s[:, 3].sum():.0f} | "
+                     f"{np.nanmax(s[:, 4]) * 100:.2f} % | {np.nanmax(s[:, 5]) * 100:.1f} % |")
+    return "\n".join(lines)
+
+
+def calibration(n_records: int) -> str:
+    zf, zz = [], []
+    for seed in range(n_records):
+        rec = anchor_record(5000 + seed, noise=0.1, tones=True)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            result = modal.oma(rec.signals, rec.sample_rate_hz, band_hz=BAND)
+        row_f, row_z = [], []
+        for k, fn in enumerate(FN):
+            near = [m for m in result if abs(m.natural_frequency_hz / fn - 1) < 0.005]
+            m = near[0] if len(near) == 1 else None
+            row_f.append(np.nan if m is None else (m.natural_frequency_hz - fn) / m.std.natural_frequency_hz)
+            row_z.append(np.nan if m is None else (m.damping_ratio - ZETA[k]) / m.std.damping_ratio)
+        zf.append(row_f), zz.append(row_z)
+    zf, zz = np.array(zf), np.array(zz)
+    lines = [f"z = error / reported standard error over {n_records} records (anchor case, SSI)", "",
+             "| mode [Hz] | ζ | z(f) mean | z(f) SD | z(ζ) mean | z(ζ) SD |", "|---|---|---|---|---|---|"]
+    for k in range(FN.size):
+        lines.append(f"| {FN[k]:g} | {ZETA[k]:g} | {np.nanmean(zf[:, k]):+.2f} | {np.nanstd(zf[:, k]):.2f} | "
+                     f"{np.nanmean(zz[:, k]):+.2f} | {np.nanstd(zz[:, k]):.2f} |")
+    return "\n".join(lines)
+
+
+def speed() -> str:
+    from modal.synthetic import ambient_modal_response
+
+    lines = ["| samples × channels | band [Hz] | time [s] |", "|---|---|---|"]
+    for n, ch in ((100_000, 8), (100_000, 64), (1_000_000, 8), (1_000_000, 64)):
+        rng = np.random.default_rng(1)
+        shapes = rng.standard_normal((ch, 6))
+        rec = ambient_modal_response(FN, ZETA, shapes, 100.0, n, noise=0.1, seed=2)
+        runs = []
+        for _ in range(3):
+            t0 = time.perf_counter()
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                modal.oma(rec.signals, 100.0, band_hz=BAND)
+            runs.append(time.perf_counter() - t0)
+        lines.append(f"| {n} × {ch} | {BAND[0]:g}-{BAND[1]:g} | {statistics.median(runs):.2f} |")
+        del rec
+    return "\n".join(lines)
+
+
+def main(argv=None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--records", type=int, default=10)
+    parser.add_argument("--calibration", type=int, default=0)
+    parser.add_argument("--speed", action="store_true")
+    args = parser.parse_args(argv)
+    if args.records:
+        print(compare(args.records))
+    if args.calibration:
+        print()
+        print(calibration(args.calibration))
+    if args.speed:
+        print()
+        print(speed())
+
+
+if __name__ == "__main__":
+    main()
