@@ -26,7 +26,7 @@ MIN_ERROR_BLOCKS, MAX_ERROR_BLOCKS = 8, 50
 #: standard errors from the chain's medians (an under-fitted low order can hold a biased pole of small error)
 CONSENSUS_SIGMAS = 2.0
 #: the errors are computed at this many orders spread over the sweep
-PROBE_ORDERS = 5
+PROBE_ORDERS = 8
 #: a chain whose frequency error exceeds this fraction of its half-power bandwidth ζ·fn is a noise pole
 UNRESOLVED_FRACTION = 0.5
 #: a duplicate lies within this many combined standard errors in frequency and has a MAC above DUPLICATE_MAC
