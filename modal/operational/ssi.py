@@ -179,20 +179,26 @@ class Perturbation:
             gap = s1[None, :] ** 2 - s2[:, None] ** 2  # (k − n, n)
             inside = (left * s1[None, None, :] + s2[None, :, None] * right) / gap
         inside = np.where(np.isfinite(inside), inside, 0.0)
-        # each perturbed singular vector's part outside the signal subspace (the part inside only rotates the
-        # basis, which leaves the eigenvalues and the observed shapes as they are)
-        dU1 = U[:, n:] @ inside + self.E[:, :, :n] / s1[None, None, :]
+        # each perturbed singular vector's part outside the signal subspace, ΔU₁ = U₂ inside + E/σ₁ (the part
+        # inside only rotates the basis, which leaves the eigenvalues and the observed shapes as they are).
+        # ΔU₁ enters only projected: Qᵀ ΔO_down, Qᵀ ΔO_up, ΔO_upᵀ (O_down − O_up A) and its first l rows (ΔC),
+        # so U₂ is projected once per order rather than ΔU₁ formed per block
+        outside = self.E[:, :, :n] / s1[None, None, :]
         A, mu, psi = _system(model, order)
         Rn, Qn = model.R[:n, :n], model.Q[:, :n]
         rows = l * model.block_rows
-        U1 = U[:, :n]
+        U1, U2 = U[:, :n], U[:, n:]
         resid = U1[l:] - U1[:rows] @ A
-        d_up, d_down = dU1[:, :rows], dU1[:, l:]
+        q_down = Qn.T @ U2[l:] @ inside + Qn.T @ outside[:, l:]  # (blocks, n, n): Qᵀ ΔO_down
+        q_up = Qn.T @ U2[:rows] @ inside + Qn.T @ outside[:, :rows]  # Qᵀ ΔO_up
+        up_resid = np.swapaxes(inside, 1, 2) @ (U2[:rows].T @ resid) \
+            + np.swapaxes(outside[:, :rows], 1, 2) @ resid  # ΔO_upᵀ (O_down − O_up A)
+        d_C = U2[:l] @ inside + outside[:, :l]  # (blocks, l, n)
         # ΔA = R⁻¹ [Qᵀ (ΔO_down − ΔO_up A) + R⁻ᵀ ΔO_upᵀ (O_down − O_up A)], R upper triangular: two
         # triangular solves for all blocks at once
         from scipy.linalg import solve_triangular
 
-        n_blocks = dU1.shape[0]
+        n_blocks = inside.shape[0]
 
         def flat(x):  # (blocks, n, m) -> (n, blocks·m)
             return np.swapaxes(x, 0, 1).reshape(n, -1)
@@ -200,8 +206,8 @@ class Perturbation:
         def unflat(x):
             return np.swapaxes(x.reshape(n, n_blocks, -1), 0, 1)
 
-        inner = unflat(solve_triangular(Rn, flat(np.swapaxes(d_up, 1, 2) @ resid), trans="T"))
-        dA = unflat(solve_triangular(Rn, flat(Qn.T @ (d_down - d_up @ A) + inner)))
+        inner = unflat(solve_triangular(Rn, flat(up_resid), trans="T"))
+        dA = unflat(solve_triangular(Rn, flat(q_down - q_up @ A + inner)))
         Wm = np.linalg.inv(psi) @ dA @ psi  # (blocks, n, n): Ψ⁻¹ ΔA Ψ
         picks = np.arange(idx.size)
         d_mu = Wm[:, idx, idx]
@@ -213,7 +219,7 @@ class Perturbation:
         coupling = np.where(np.isfinite(coupling), coupling, 0.0)
         C = U1[:l]
         raw = C @ psi[:, idx]
-        d_raw = dU1[:, :l] @ psi[:, idx] + C @ (psi @ coupling)  # (blocks, l, picks)
+        d_raw = d_C @ psi[:, idx] + C @ (psi @ coupling)  # (blocks, l, picks)
         shapes, lead, value = _normalised(raw)
         d_shape = (d_raw - shapes[None] * d_raw[:, lead, picks][:, None, :]) / value[None, None, :]
         return {"pole": d_lam * self.scale[:, None], "shape": d_shape * self.scale[:, None, None]}
