@@ -58,7 +58,8 @@ def run_koma(signals, fs):
     with contextlib.redirect_stdout(io.StringIO()), warnings.catch_warnings():
         warnings.simplefilter("ignore")
         lambd, phi, pole_orders = koma.oma.covssi(signals.T, fs, 30, orders, showinfo=False)
-        stab = koma.oma.find_stable_poles(lambd, phi, pole_orders, 2, stabcrit={"freq": 0.05, "damping": 0.2, "mac": 0.3},
+        stab = koma.oma.find_stable_poles(lambd, phi, pole_orders, 2,
+                                          stabcrit={"freq": 0.05, "damping": 0.2, "mac": 0.3},
                                           valid_range={"freq": [2 * np.pi * BAND[0], 2 * np.pi * BAND[1]],
                                                        "damping": [0, 0.2]}, indicator="freq")
         lambd_stab, phi_stab, orders_stab = stab[0], stab[1], stab[2]

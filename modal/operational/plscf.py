@@ -110,8 +110,6 @@ def plscf(prepared: Prepared, refs, max_order=None):
 
     Returns the same tuple as the SSI path of :func:`modal.operational.oma`.
     """
-    from .inputs import check_band  # noqa: F401  (the band was checked by prepare)
-
     fs = prepared.sample_rate_hz
     low, high = prepared.band_hz
     m = len(refs)
@@ -144,7 +142,7 @@ def plscf(prepared: Prepared, refs, max_order=None):
             scale = w * np.sqrt(n_blocks / (n_blocks - 1.0))
             blocks_dS = (half_spectra(blocks, fs, lines)[0] - S[None]) * scale[:, None, None, None]
 
-            def perturb(order, indices):
+            def perturb_poles(order, indices):
                 base_poles, _ = _poles_of_order(omega, S, order, beta)
                 picked = base_poles[np.asarray(indices, int)]
                 d_pole = np.zeros((n_blocks, picked.size), complex)
@@ -156,6 +154,8 @@ def plscf(prepared: Prepared, refs, max_order=None):
                                      if poles_b.size else picked)
                     d_pole[b] = (moved[0] - moved[1]) / 2
                 return {"pole": d_pole, "shape": None}
+
+            perturb = perturb_poles
     estimates, chosen, kept = estimates_from_clusters(flat, clusters, perturb, len(orders), prepared.scale)
     estimates = _with_shapes(estimates, S, omega, beta, 1.0 / fs, blocks_dS, prepared.scale)
     settings = {"orders": [orders[0], orders[-1]], "lags": n_lags, "window_decay_per_s": float(beta)}

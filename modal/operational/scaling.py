@@ -65,7 +65,8 @@ def _pair(mode, after: IdentificationResult):
     for other in after:
         limit = 3 * np.hypot(mode.std.natural_frequency_hz, other.std.natural_frequency_hz)
         shift = other.natural_frequency_hz / mode.natural_frequency_hz - 1
-        if not (-MAX_SHIFT <= shift and other.natural_frequency_hz <= mode.natural_frequency_hz + np.nan_to_num(limit)):
+        above = other.natural_frequency_hz - mode.natural_frequency_hz
+        if not (-MAX_SHIFT <= shift and above <= np.nan_to_num(limit)):
             continue
         mac = shape_mac(mode.mode_shape, other.mode_shape)
         if mac >= best_mac:

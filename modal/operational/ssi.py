@@ -179,10 +179,10 @@ class Perturbation:
             gap = s1[None, :] ** 2 - s2[:, None] ** 2  # (k − n, n)
             inside = (left * s1[None, None, :] + s2[None, :, None] * right) / gap
         inside = np.where(np.isfinite(inside), inside, 0.0)
-        # each perturbed singular vector's part outside the signal subspace, ΔU₁ = U₂ inside + E/σ₁ (the part
-        # inside only rotates the basis, which leaves the eigenvalues and the observed shapes as they are).
-        # ΔU₁ enters only projected: Qᵀ ΔO_down, Qᵀ ΔO_up, ΔO_upᵀ (O_down − O_up A) and its first l rows (ΔC),
-        # so U₂ is projected once per order rather than ΔU₁ formed per block
+        # each perturbed singular vector's part outside the signal subspace, ΔU₁ = U₂ inside + E/σ₁ (the
+        # part inside only rotates the basis, which leaves the eigenvalues and the observed shapes as they
+        # are). ΔU₁ enters only projected: Qᵀ ΔO_down, Qᵀ ΔO_up, ΔO_upᵀ (O_down − O_up A) and its first l
+        # rows (ΔC), so U₂ is projected once per order rather than ΔU₁ formed per block
         outside = self.E[:, :, :n] / s1[None, None, :]
         A, mu, psi = _system(model, order)
         Rn, Qn = model.R[:n, :n], model.Q[:, :n]
