@@ -3,8 +3,9 @@
 For the anchor case (six modes, eight sensors, a close pair 1.9 % apart, a weakly excited mode, machine
 tones at 1×/2×/3×, 10 % noise), over independent records: z = (estimate − truth) / reported standard
 error, per mode, for frequency and damping ratio. For calibrated errors the SD of N standard normals
-has standard error 1/√(2N) (0.10 at N = 50); the issue's bound 1 ± 25 % is 2.5 of those. The mean's
-standard error is 1/√N (0.14); |mean| ≤ 0.6 is 4.2 of those. Every record: every mode once, no other
+has standard error 1/√(2N) (0.10 at N = 50); the issue's bound 1 ± 25 % is 2.5 of those (with fewer
+records, for a quick run, the bound widens to 2.5 of them). The mean's standard error is 1/√N (0.14);
+|mean| ≤ 0.6 is 4.2 of those (likewise). Every record: every mode once, no other
 mode, the three tones listed apart. About 2 minutes on two cores (~2 s per record).
 """
 from __future__ import annotations
@@ -62,5 +63,5 @@ def test_standard_errors_are_calibrated(method, quantity):
     zf, zz, _ = _trials(method)
     z = zf if quantity == "frequency" else zz
     sd, mean = np.nanstd(z, axis=0), np.nanmean(z, axis=0)
-    assert np.all(np.abs(sd - 1) <= 0.25), sd
-    assert np.all(np.abs(mean) <= 0.6), mean
+    assert np.all(np.abs(sd - 1) <= max(0.25, 2.5 / np.sqrt(2 * SEEDS))), sd
+    assert np.all(np.abs(mean) <= max(0.6, 4.2 / np.sqrt(SEEDS))), mean
