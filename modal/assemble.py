@@ -66,6 +66,9 @@ class ModeEstimate:
         bias exactly (see :func:`physical_with_flags`).
     mode_shape, participation, mpc
         As in :class:`~modal.results.ModeResult` (methods that give them).
+    std_mode_shape : ndarray, shape (n_channels,), or None
+        Standard error of each entry of ``mode_shape``, sqrt(var Re + var Im) (methods that give it:
+        the output-only ones).
     """
 
     omega_n: float
@@ -85,6 +88,7 @@ class ModeEstimate:
     mode_shape: np.ndarray | None = None
     participation: np.ndarray | None = None
     mpc: float = float("nan")
+    std_mode_shape: np.ndarray | None = None
 
 
 def driving_points(frf, driving_point=None) -> tuple[np.ndarray, bool]:
@@ -213,7 +217,7 @@ def assemble_modes(estimates: Sequence[ModeEstimate], *, method: str, source: st
             inputs = driving
         s_const = np.sqrt(np.maximum(cov[:, 2, 2] + cov[:, 3, 3], 0))
         sq = (lambda a: a.reshape(-1)[0].item()) if single else (lambda a: np.asarray(a))
-        std = ModeStd(s_wn / TWO_PI, s_z, sq(s_const), sq(sk), sq(sc), sq(sm))
+        std = ModeStd(s_wn / TWO_PI, s_z, sq(s_const), sq(sk), sq(sc), sq(sm), mode_shape=estimate.std_mode_shape)
         flags_t = tuple(sorted(flags))
         modes.append(ModeResult(
             natural_frequency_hz=float(wn / TWO_PI), damping_ratio=float(zeta), modal_constant=sq(const),

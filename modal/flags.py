@@ -11,7 +11,8 @@ import numpy as np
 from .frf import line_spacing
 
 __all__ = ["FLAG_TEXT", "FLAG_ACTION", "CHI2_LIMIT", "RELATIVE_MISFIT", "REL_STD_LIMIT", "OVERLAP_LIMIT", "BIAS_LIMIT",
-           "COMPLEX_PHASE_DEG", "MPC_LIMIT", "WEAK_FRACTION", "RIGID_BODY_RATIO", "GRID_FLAGS", "RESOLUTION_FLAGS",
+           "COMPLEX_PHASE_DEG", "MPC_LIMIT", "WEAK_FRACTION", "RIGID_BODY_RATIO", "HARMONIC_TOLERANCE",
+           "HARMONIC_SIGMAS", "MIN_SHIFT_SIGMAS", "MAX_SCALE_ERROR", "GRID_FLAGS", "RESOLUTION_FLAGS", "RULE_FLAGS",
            "INFORMATIONAL", "DRIVING_POINT_ONLY", "TRANSFER_ONLY", "lines_near_mode", "model_inadequate", "overlap",
            "channel_flags", "contradictions", "flags_markdown"]
 
@@ -41,6 +42,15 @@ MPC_LIMIT = 0.8
 WEAK_FRACTION = 0.5
 #: a mode below this fraction of the next mode's frequency counts as a rigid-body / suspension mode
 RIGID_BODY_RATIO = 0.1
+#: operational analysis: a pole lies on a harmonic k·f₀ of the running speed when within this fraction of it
+#: (the speed varies a little over a record)...
+HARMONIC_TOLERANCE = 0.005
+#: ... or within this many of its frequency's standard errors (flag harmonic)
+HARMONIC_SIGMAS = 3.0
+#: mass-change scaling: the frequency shift must exceed this many of its standard errors...
+MIN_SHIFT_SIGMAS = 3.0
+#: ... and the scale factor's relative standard error stay at or below this, else scaling_uncertain
+MAX_SCALE_ERROR = 0.1
 
 #: Every quality flag with the reason it is raised.
 FLAG_TEXT = {
@@ -69,24 +79,28 @@ FLAG_TEXT = {
     "window_damping_dominates": ("the exponential window's decay 1/tau is not below the mode's measured decay rate: "
                                  "all its damping may be the window's, so it was not removed; use a longer tau"),
     "weak_evidence": ("global: the pole is stable in fewer than half of the upper half of the model orders of the "
-                      "stabilisation diagram (or a modes_hz hint picked a pole stable in fewer than 3): a weakly "
-                      "excited mode or a noise pole; check the diagram and the shape before using it"),
+                      "stabilisation diagram (or a modes_hz hint picked a pole stable in fewer than 3); operational: "
+                      "in fewer than half of the orders swept: a weakly excited mode or a noise pole; check the "
+                      "diagram and the shape before using it"),
     "outside_band": ("global: the mode lies below the first resolvable lines or above the band: its parameters "
                      "are extrapolated; widen the band or treat it as a residual"),
     "rigid_body": ("global: the mode lies below a tenth of the next mode's frequency: a rigid-body or suspension "
                    "mode of a free structure, not a flexible mode"),
-    "complex_shape": (f"global: the modal constants are far from collinear in phase (MPC < {MPC_LIMIT:g}): a complex "
-                      "mode, or noise/close modes; k, c, m and shape comparisons are approximate"),
+    "complex_shape": (f"global and operational: the modal constants (the shape) are far from collinear in phase "
+                      f"(MPC < {MPC_LIMIT:g}): a complex mode, or noise/close modes; k, c, m and shape comparisons "
+                      "are approximate"),
     "method_bias": (f"half-power or circle estimate lies more than {BIAS_LIMIT:g} of its standard errors from the "
                     "least-squares refinement of the same modes (the method's own bias: line spacing, noise at the "
                     "peak, a neighbouring mode); its standard errors include the difference, method 'nls' gives the "
                     "refined values"),
     # operational (output-only) analysis
-    "harmonic": ("operational: the mode lies on a harmonic k x rotor_speed_hz of the running speed (within 3 of its "
-                 "standard errors and 0.5 %), where a machine tone may bias its frequency and damping"),
-    "scaling_uncertain": ("mass-change scaling: the frequency shift is below 3 of its standard errors, or the scale "
-                          "factor's standard error exceeds 10 % of it (too little added mass, or added where the mode "
-                          "barely moves): the mass-normalised shape and k, c, m are poorly determined"),
+    "harmonic": (f"operational: the mode lies on a harmonic k x f0 of the running speed (rotor_speed_hz, or the "
+                 f"fundamental the machine tones share), within {HARMONIC_SIGMAS:g} of its standard errors or "
+                 f"{100 * HARMONIC_TOLERANCE:g} %, where a machine tone may bias its frequency and damping"),
+    "scaling_uncertain": (f"mass-change scaling: the mode has no partner in the record with added mass, its frequency "
+                          f"shift is below {MIN_SHIFT_SIGMAS:g} of its standard errors, or the scale factor's standard "
+                          f"error exceeds {100 * MAX_SCALE_ERROR:g} % of it (too little added mass, or added where "
+                          "the mode barely moves): the mass-normalised shape and k, c, m are poorly determined"),
     "missing_in_setup": ("merged setups: the mode was not found in every setup; the shape entries of the setups "
                          "without it are NaN"),
 }
@@ -155,6 +169,10 @@ FLAG_ACTION = {
 GRID_FLAGS = frozenset({"resolution_limited", "missing_crossing", "too_few_points"})
 #: Flags raised with a :class:`~modal.errors.ResolutionWarning` (any other serious flag: a QualityWarning)
 RESOLUTION_FLAGS = GRID_FLAGS | {"outside_band"}
+#: Flags :func:`modal.assemble.assemble_modes` raises by its shared rules (a result assembled again, as by
+#: mass-change scaling or merging setups, starts from the method's own flags without these).
+RULE_FLAGS = frozenset({"high_uncertainty", "close_modes", "driving_point_assumed", "window_damping_dominates",
+                        "complex_mode", "non_positive_constant", "not_driving_point"})
 #: Flags that describe the setting, not a defect (``ModeResult.ok`` ignores them).
 INFORMATIONAL = frozenset({"driving_point_assumed", "not_driving_point"})
 #: Flags about a driving-point channel's constant (never on a transfer channel).

@@ -257,7 +257,6 @@ def chain_matrices(masses_kg, stiffnesses_n_per_m, damping_ratio: float | None =
     k = positive("stiffnesses_n_per_m", stiffnesses_n_per_m)
     if m.shape != k.shape:
         raise ParameterError(f"one spring per mass expected, got {m.size} masses and {k.size} springs")
-    n = m.size
     K = np.diag(k + np.append(k[1:], 0.0)) - np.diag(k[1:], 1) - np.diag(k[1:], -1)
     M = np.diag(m)
     if damping_ratio is None:

@@ -18,7 +18,8 @@ from ..errors import IdentificationError, ParameterError
 from .correlations import correlations
 from .inputs import MIN_LAGS_IN_RECORD, Prepared
 from .plscf import half_spectra
-from .result import ModeEstimate, oma_result
+from .pole import PoleEstimate
+from .result import oma_result
 from .selection import shape_mac
 
 __all__ = ["fdd", "singular_values"]
@@ -111,7 +112,7 @@ def fdd(prepared: Prepared, refs, *, enhanced: bool, rotor_speed_hz=None):
             found = _decay(lines, S, u_peak, vh[j, 0].conj(), bell, fs, beta)
             if found is not None:
                 pole, known = found, True
-        estimates.append(ModeEstimate(pole, shape, np.nan, np.nan, nan_shape, 1, 1, 0, damping_known=known))
+        estimates.append(PoleEstimate(pole, shape, np.nan, np.nan, nan_shape, 1, 1, 0, damping_known=known))
     is_tone, estimates = separate_tones(estimates, prepared, rotor_speed_hz)
     modes = [e for e, t in zip(estimates, is_tone) if not t]
     tones = [e.natural_frequency_hz for e, t in zip(estimates, is_tone) if t]
@@ -119,7 +120,7 @@ def fdd(prepared: Prepared, refs, *, enhanced: bool, rotor_speed_hz=None):
     settings = {"band_hz": list(prepared.band_hz), "reference_channels": list(refs),
                 "sample_rate_hz": prepared.original_rate_hz, "decimation": prepared.decimation,
                 "duration_s": prepared.duration_s, "rotor_speed_hz": rotor_speed_hz,
-                "channel_names": list(prepared.names), "n_channels": prepared.n_channels,
+                "channel_names": list(prepared.names), "n_channels": prepared.n_channels, "source": prepared.source,
                 "window_decay_per_s": float(beta), "line_spacing_hz": float(lines[1] - lines[0])}
     return oma_result(modes, method=method, quantity=prepared.quantity, band_hz=prepared.band_hz,
                       stabilisation=None, settings=settings, harmonics_hz=tones, source=prepared.source)

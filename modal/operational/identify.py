@@ -165,7 +165,7 @@ def oma(data, sample_rate_hz: float | None = None, *, band_hz=None, method: str 
     settings = {**settings, "band_hz": list(prepared.band_hz), "reference_channels": list(refs),
                 "sample_rate_hz": prepared.original_rate_hz, "decimation": prepared.decimation,
                 "duration_s": prepared.duration_s, "rotor_speed_hz": rotor_speed_hz,
-                "channel_names": list(prepared.names), "n_channels": prepared.n_channels,
+                "channel_names": list(prepared.names), "n_channels": prepared.n_channels, "source": prepared.source,
                 "dropped_unresolved_hz": dropped}
     return oma_result(estimates, method=method, quantity=prepared.quantity, band_hz=prepared.band_hz,
                       stabilisation=diagram, settings=settings, harmonics_hz=tones, source=prepared.source)

@@ -11,12 +11,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from .result import ModeEstimate
+from ..units import TWO_PI
+from .pole import PoleEstimate
 from .selection import Cluster, shape_mac
 
-__all__ = ["pole_errors", "estimates_from_clusters", "error_blocks", "resolved", "TWO_PI"]
+__all__ = ["pole_errors", "estimates_from_clusters", "error_blocks", "resolved"]
 
-TWO_PI = 2 * np.pi
 #: the blocks of the record used for the error bars last at least this many decay times 1/(ζω) of the
 #: slowest-decaying mode (their correlation estimates are then nearly independent)...
 DECAY_TIMES_PER_BLOCK = 10
@@ -69,7 +69,7 @@ def _physical_shape(unit_shape: np.ndarray, d_unit: np.ndarray | None, scale: np
 
 
 def estimates_from_clusters(flat, clusters: list[Cluster], perturb, n_orders_swept: int,
-                            scale: np.ndarray) -> tuple[list[ModeEstimate], list[int], list[Cluster]]:
+                            scale: np.ndarray) -> tuple[list[PoleEstimate], list[int], list[Cluster]]:
     """One estimate per cluster, from its member with the smallest frequency error among a few probed orders
     that agrees with the cluster's medians (:data:`CONSENSUS_SIGMAS`), with the representative
     member's index (into ``flat``) and its cluster. Duplicates within their errors are dropped.
@@ -130,7 +130,7 @@ def estimates_from_clusters(flat, clusters: list[Cluster], perturb, n_orders_swe
                          + abs(flat.damping_ratio[m] - z_mid) / max(abs(z_mid), 1e-3))
         sf, sz, d_unit, unit, d_pole = errors[member]
         shape, shape_std = _physical_shape(unit, d_unit, scale)
-        candidates.append((ModeEstimate(complex(flat.pole[member]), shape, float(sf), float(sz), shape_std,
+        candidates.append((PoleEstimate(complex(flat.pole[member]), shape, float(sf), float(sz), shape_std,
                                         cluster.n_orders, n_orders_swept, int(flat.order[member]),
                                         pole_deviation=d_pole), member, cluster))
     kept = []
@@ -149,7 +149,7 @@ def estimates_from_clusters(flat, clusters: list[Cluster], perturb, n_orders_swe
     return [k[0] for k in kept], [k[1] for k in kept], [k[2] for k in kept]
 
 
-def resolved(estimate: ModeEstimate, duration_s: float) -> bool:
+def resolved(estimate: PoleEstimate, duration_s: float) -> bool:
     """Whether an estimate's frequency is determined within :data:`UNRESOLVED_FRACTION` of its own half-power
     bandwidth, or of twice the record's resolution 2/T for a pole of (nearly) no damping such as a tone; True
     when the method gives no error bars."""

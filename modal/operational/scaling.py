@@ -16,16 +16,13 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ParameterError
+from ..flags import MAX_SCALE_ERROR, MIN_SHIFT_SIGMAS
 from ..results import IdentificationResult
-from .result import scaled_mode, scaled_result
+from .result import scaled_result
 from .selection import shape_mac
 
-__all__ = ["scale_by_mass_change", "MIN_SHIFT_SIGMAS", "MAX_SCALE_ERROR", "PAIR_MAC"]
+__all__ = ["scale_by_mass_change", "PAIR_MAC", "MAX_SHIFT"]
 
-#: the frequency shift must exceed this many of its standard errors ...
-MIN_SHIFT_SIGMAS = 3.0
-#: ... and the scale factor's relative standard error stay below this, else ``scaling_uncertain``
-MAX_SCALE_ERROR = 0.1
 #: a mode of the second record is the same mode when its shape has at least this MAC with the first's
 PAIR_MAC = 0.8
 #: the added mass lowers a mode's frequency by at most this fraction (and raises it by none beyond its errors)
@@ -95,8 +92,22 @@ def _scale(mode, other, dm):
 
 
 def _shape_std(mode, n):
-    s = getattr(mode.std, "mode_shape", None)
+    s = mode.std.mode_shape
     return np.zeros(n) if s is None else np.nan_to_num(np.asarray(s, float))
+
+
+def _driving_points(psi, jac_psi, inputs_sd):
+    """Standard errors of ψ and the covariance (channels, 4, 4) of (ωn, ζ, Re A, Im A) with A = ψ² per
+    channel, from ψ's gradient ``jac_psi`` (channels × inputs) over independent inputs of standard errors
+    ``inputs_sd``, the first the natural frequency (rad/s), the last the damping ratio."""
+    sd2 = np.asarray(inputs_sd, float) ** 2
+    n, n_in = jac_psi.shape
+    grad = np.zeros((n, 4, n_in))
+    grad[:, 0, 0] = 1.0
+    grad[:, 1, -1] = 1.0
+    grad[:, 2] = 2 * psi[:, None] * jac_psi  # ∂ψ²/∂inputs (Im A stays 0: a real shape)
+    cov = (grad * sd2) @ np.swapaxes(grad, 1, 2)
+    return np.sqrt(jac_psi**2 @ sd2), cov
 
 
 def scale_by_mass_change(before: IdentificationResult, after: IdentificationResult,
@@ -122,30 +133,31 @@ def scale_by_mass_change(before: IdentificationResult, after: IdentificationResu
         raise ParameterError(f"'before' has {before.n_channels} channels and 'after' {after.n_channels}; expected "
                              "records of the same channels")
     dm = _masses(added_mass_kg, before)
-    modes = []
+    scaled = []
     for mode in before:
         other = _pair(mode, after)
         if other is None:
-            modes.append(scaled_mode(mode, None, None, None, uncertain=True))
+            scaled.append((None, None, None, True))
             continue
         alpha2, p0, grad, sd = _scale(mode, other, dm)
+        if not (np.isfinite(alpha2) and alpha2 > 0):
+            scaled.append((None, None, None, True))
+            continue
         n = p0.size
         var_alpha2 = float(np.sum((grad * sd) ** 2))
         shift_sd = np.hypot(mode.std.natural_frequency_hz, other.std.natural_frequency_hz)
         shift = mode.natural_frequency_hz - other.natural_frequency_hz
-        if not (np.isfinite(alpha2) and alpha2 > 0):
-            modes.append(scaled_mode(mode, None, None, None, uncertain=True))
-            continue
         alpha = np.sqrt(alpha2)
         # ψ_j = α φ0_j: gradient over (ω0, ω1, φ0, φ1) and the damping ratio (for c)
-        d_alpha = grad / (2 * alpha)
-        jac_psi = np.outer(p0, d_alpha)
+        jac_psi = np.outer(p0, grad / (2 * alpha))
         jac_psi[np.arange(n), 2 + np.arange(n)] += alpha
-        inputs_sd = np.concatenate([sd, [mode.std.damping_ratio]])
         jac_psi = np.hstack([jac_psi, np.zeros((n, 1))])
+        inputs_sd = np.concatenate([sd, [mode.std.damping_ratio]])
+        psi = alpha * p0
+        psi_std, cov = _driving_points(psi, jac_psi, inputs_sd)
         uncertain = (not shift > MIN_SHIFT_SIGMAS * np.nan_to_num(shift_sd)
                      or not np.sqrt(var_alpha2) / alpha2 / 2 <= MAX_SCALE_ERROR)
-        modes.append(scaled_mode(mode, alpha * p0, jac_psi, inputs_sd, uncertain=uncertain))
+        scaled.append((psi, psi_std, cov, uncertain))
     settings = {**before.settings, "added_mass_kg": {str(k): float(v) for k, v in added_mass_kg.items()},
                 "scaled_by": "mass_change"}
-    return scaled_result(before, modes, settings)
+    return scaled_result(before, scaled, settings)

@@ -79,7 +79,10 @@ def shape_mac(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 def mpc(shape: np.ndarray) -> float:
-    """Modal phase collinearity (Pappa et al. 1993) of a complex vector: 1 for a real (normal) mode."""
+    """Modal phase collinearity (Pappa et al. 1993) of a complex vector: 1 for a real (normal) mode; NaN
+    entries (the channels of a setup that misses the mode) left out."""
+    shape = np.asarray(shape, complex)
+    shape = shape[np.isfinite(shape)]
     re, im = shape.real, shape.imag
     sxx, syy, sxy = re @ re, im @ im, re @ im
     total = sxx + syy

@@ -20,8 +20,9 @@ from dataclasses import replace
 
 import numpy as np
 
+from ..flags import HARMONIC_SIGMAS, HARMONIC_TOLERANCE
 from .inputs import Prepared
-from .result import ModeEstimate
+from .pole import PoleEstimate
 
 __all__ = ["separate_tones", "nearly_undamped", "band_kurtosis", "harmonic_of", "KURTOSIS_LIMIT", "TONE_DAMPING"]
 
@@ -34,10 +35,6 @@ ZERO_DAMPING_SIGMAS = 3.0
 KURTOSIS_LIMIT = 1.95
 #: the band-pass spans at least this many over the record's duration (Hz·s), and 4 half-power widths
 MIN_BANDWIDTH_TIME = 200.0
-#: a pole lies on a harmonic k·f₀ when within this fraction of it (speed variation)...
-HARMONIC_TOLERANCE = 0.005
-#: ... or within this many of its standard errors
-HARMONIC_SIGMAS = 3.0
 
 
 def band_kurtosis(spectrum: np.ndarray, n_samples: int, sample_rate_hz: float, centre_hz: float,
@@ -64,8 +61,8 @@ def band_kurtosis(spectrum: np.ndarray, n_samples: int, sample_rate_hz: float, c
 
 
 def harmonic_of(frequency_hz: float, std_hz: float, fundamental_hz: float) -> int:
-    """The harmonic number k ≥ 1 when ``frequency_hz`` lies on k·``fundamental_hz`` (see :data:`HARMONIC_TOLERANCE`),
-    else 0."""
+    """The harmonic number k ≥ 1 when ``frequency_hz`` lies on k·``fundamental_hz`` (within
+    :data:`modal.flags.HARMONIC_TOLERANCE` of it or :data:`modal.flags.HARMONIC_SIGMAS` of its errors), else 0."""
     k = int(round(frequency_hz / fundamental_hz))
     if k < 1:
         return 0
@@ -88,7 +85,7 @@ def _fundamental(tones_hz: list[float], stds: list[float]) -> float | None:
     return None if best is None else best[1]
 
 
-def nearly_undamped(estimate: ModeEstimate) -> bool:
+def nearly_undamped(estimate: PoleEstimate) -> bool:
     """Whether a pole's damping ratio lies below :data:`TONE_DAMPING`, with its error (ζ + 3σ_ζ) or
     indistinguishable from zero (ζ < 3σ_ζ)."""
     zeta = estimate.damping_ratio
@@ -96,7 +93,7 @@ def nearly_undamped(estimate: ModeEstimate) -> bool:
     return bool(zeta < TONE_DAMPING and (zeta + margin < TONE_DAMPING or zeta < margin))
 
 
-def _evidence(estimate: ModeEstimate, prepared: Prepared, spectra: dict) -> tuple[bool, bool]:
+def _evidence(estimate: PoleEstimate, prepared: Prepared, spectra: dict) -> tuple[bool, bool]:
     """(nearly zero damping, band-passed response non-Gaussian) for one estimate; ``spectra`` caches each
     channel's FFT."""
     zeta = estimate.damping_ratio if np.isfinite(estimate.damping_ratio) else 0.0
@@ -110,12 +107,12 @@ def _evidence(estimate: ModeEstimate, prepared: Prepared, spectra: dict) -> tupl
     return bool(undamped), bool(np.isfinite(kurtosis) and kurtosis < KURTOSIS_LIMIT)
 
 
-def separate_tones(estimates: list[ModeEstimate], prepared: Prepared, rotor_speed_hz: float | None):
+def separate_tones(estimates: list[PoleEstimate], prepared: Prepared, rotor_speed_hz: float | None):
     """Which estimates are machine tones, and the modes left on a harmonic flagged ``harmonic``.
 
     Returns
     -------
-    (is_tone, estimates) : (list of bool, list of ModeEstimate)
+    (is_tone, estimates) : (list of bool, list of PoleEstimate)
         The estimates in the same order, those on a harmonic that are not tones with the flag added.
     """
     spectra: dict = {}
