@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 
 import h5py
+import pytest
 import numpy as np
 
 from support.ambient import FN, anchor_record
@@ -53,7 +54,7 @@ def test_json_table_plot_and_archive(tmp_path):
 def test_setups_are_merged(tmp_path):
     one = _write(tmp_path / "s1.h5", anchor_record(52, noise=0.1, tones=False), [0, 5, 1, 2, 3])
     two = _write(tmp_path / "s2.h5", anchor_record(53, noise=0.1, tones=False), [0, 5, 4, 6, 7])
-    done = _run("oma", one, two, "--band", 1, 30, "--reference-channels", 0, 1, "--json")
+    done = _run("oma", one, two, "--band", 1, 30, "--reference-channels", 1, 2, "--json")
     assert done.returncode == 0, done.stderr
     doc = json.loads(done.stdout)
     assert doc["n_channels"] == 8 and all(len(m["mode_shape"]) == 8 for m in doc["modes"])
@@ -90,3 +91,50 @@ def test_readme_real_record_as_written(tmp_path):
     table = done.stdout.strip().splitlines()[1:]  # the first line names the file
     assert table == shown.splitlines()
     assert (tmp_path / "oma_real.png").stat().st_size > 10_000
+
+
+def test_mass_change_scales_to_k_c_m(tmp_path):
+    """--mass-change AFTER --added-mass-kg CH KG: the first record's modes mass-normalised, k, c, m at every
+    channel (as modal.scale_by_mass_change gives them; its accuracy is tested in operational/test_scaling.py)."""
+    from scipy.linalg import eigh
+
+    from modal.synthetic import ambient_response, chain_matrices
+
+    masses, springs, added = np.array([2.0, 1.5, 1.0, 1.2]), np.array([8e3, 6e3, 5e3, 4e3]), [0.2, 0.15, 0.1, 0.12]
+    M, C, K = chain_matrices(masses, springs, 0.01)
+    before = _write(tmp_path / "before.h5", ambient_response(M, C, K, 200.0, 300_000, noise=0.1, seed=1))
+    after = _write(tmp_path / "after.h5", ambient_response(M + np.diag(added), C, K, 200.0, 300_000, noise=0.1,
+                                                           seed=2))
+    masses_args = [a for ch, kg in enumerate(added, start=1) for a in (ch, kg)]
+    words = []
+    for k in range(0, len(masses_args), 2):
+        words += ["--added-mass-kg", *masses_args[k:k + 2]]
+    done = _run("oma", before, "--band", 1, 60, "--mass-change", after, *words, "--json")
+    assert done.returncode == 0, done.stderr
+    doc = json.loads(done.stdout)
+    assert len(doc["modes"]) == 4
+    w2, phi = eigh(K, M)
+    for k, mode in enumerate(doc["modes"]):
+        m = np.array(mode["mass_kg"])
+        # each channel a driving point of the mass-normalised shape: m_j = 1/psi_j^2 = 1/phi_j^2 (psi' M psi = 1);
+        # within 20 %: the shape's 10 % (test_scaling) squared
+        assert np.all(np.abs(m * phi[:, k] ** 2 - 1) < 0.2)
+        assert np.allclose(mode["stiffness_n_per_m"], m * (2 * np.pi * mode["natural_frequency_hz"]) ** 2)
+        assert all(s > 0 for s in mode["std"]["mass_kg"])
+    table = _run("oma", before, "--band", 1, 60, "--mass-change", after, *words)
+    assert table.returncode == 0 and "k [N/m]" in table.stdout
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--added-mass-kg", "1", "0.2"], "--added-mass-kg needs --mass-change"),
+    (["--mass-change", "{path}"], "no added mass given"),
+    (["--mass-change", "{path}", "--added-mass-kg", "9", "0.2"], "added_mass_kg: .*no channel '9'"),
+    (["--mass-change", "{path}", "--added-mass-kg", "1", "heavy"], "--added-mass-kg 1 heavy: expected a mass in kg"),
+    (["--reference-channels", "X"], "reference_channels: .*no channel 'X'"),
+])
+def test_bad_mass_change_and_channels_are_one_error_line(tmp_path, args, message):
+    import re
+
+    path = _write(tmp_path / "ambient.h5", anchor_record(55, noise=0.1, tones=False, duration_s=300))
+    done = _run("oma", path, "--band", 1, 30, *[a.format(path=path) for a in args])
+    assert done.returncode == 1 and done.stderr.count("\n") == 1 and re.search(message, done.stderr), done.stderr
