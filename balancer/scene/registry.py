@@ -62,6 +62,19 @@ def _fraction(v):
         raise ValueError("a fraction 0 <= f < 1")
     return v
 
+def _channel_name(v):
+    """A channel as ``modal oma`` names it: its number counted from 1 in the file's order, or its name."""
+    if isinstance(v, bool) or not isinstance(v, (int, str)) or (isinstance(v, int) and v < 1) or v == "":
+        raise ValueError("a channel number counted from 1, or a channel name")
+    return str(v)
+
+
+def _added_masses(v):
+    """``{channel: kg}``: the masses added for the second record of a mass-change test."""
+    if not isinstance(v, dict) or not v:
+        raise ValueError("a table {channel = kg, ...} of the added masses (channels numbered from 1, or names)")
+    return {_channel_name(k): POS(kg) for k, kg in v.items()}
+
 
 def _radius(v):
     return list_of(POS)(v) if isinstance(v, list) else POS(v)
@@ -168,6 +181,18 @@ REGISTRY: dict[str, Stage] = {stage.name: stage for stage in (
         }},
         figures=f"{_PLOTS}:identify_figures", plot_inputs=("frf", "identify"),
         plot_modules=("modal.plots", "modal.flags"),
+        digest=f"{_SUMMARY}:identify_digest", rows=f"{_SUMMARY}:identify_rows"),
+    Stage(
+        # an operational test (responses only): the options of `python -m modal oma` under the same names;
+        # scaled by mass change (mass_change, added_mass_kg) its modes give k, c, m as an impact test does
+        "oma", run=f"{_STAGES}:stage_oma", needs=("oma",), files=("oma.file", "oma.mass_change"),
+        prepare=f"{_STAGES}:check_oma",
+        config={"oma": {
+            "file": STR, "band_hz": list_of(NONNEG, length=2), "method": choice("ssi", "plscf", "fdd", "efdd"),
+            "reference_channels": list_of(_channel_name), "rotor_speed_hz": POS, "max_order": INT,
+            "mass_change": STR, "added_mass_kg": _added_masses, "channel": _channel_name, "accept_flagged": BOOL,
+        }},
+        required={"oma": ("file",)},
         digest=f"{_SUMMARY}:identify_digest", rows=f"{_SUMMARY}:identify_rows"),
     Stage(
         "drive", run=f"{_STAGES}:stage_drive", needs=("drive",),

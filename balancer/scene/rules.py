@@ -5,8 +5,9 @@ says what was expected (the schema puts the file and the key before it).  Values
 come from an earlier stage are written as references:
 
 * ``"identified:mode1.stiffness"`` (also ``.damping``, ``.mass``, ``.frequency``,
-  ``.damping_ratio``): mode 1 of ``[identify]``, on the channel ``[identify] channel``
-  (default: the first driving point);
+  ``.damping_ratio``): mode 1 of ``[identify]`` (an impact test, ``[frf]``), on the channel
+  ``[identify] channel`` (default: the first driving point), or of an operational test
+  scaled by mass change (``[oma]``), on the channel ``[oma] channel``;
 * ``"drive:speed"`` (rad/s) and ``"drive:stiffness"`` (N/m): the drive's hand-over to the
   rotor.
 
@@ -28,8 +29,8 @@ IDENTIFIED_FIELDS = {
     "frequency": "natural_frequency_hz", "damping_ratio": "damping_ratio",
 }
 DRIVE_FIELDS = {"speed": "speed_rad_s", "stiffness": "stiffness_n_per_m"}
-#: the stage a reference's source names
-REFERENCE_STAGES = {"identified": "identify", "drive": "drive"}
+#: the stages a reference's source may name: the one whose section (its ``needs``) the scene has
+REFERENCE_STAGES = {"identified": ("identify", "oma"), "drive": ("drive",)}
 _REF = re.compile(r"^(identified):mode(\d+)\.(\w+)$|^(drive):(\w+)$")
 
 

@@ -198,11 +198,18 @@ def dependencies(scene: Scene, stage: str) -> tuple[str, ...]:
     entry = REGISTRY[stage]
     deps = list(entry.depends)
     for key, ref in references(scene, stage):
-        source = REFERENCE_STAGES[ref.source]
-        needed = REGISTRY[source].needs[0]
-        if scene.section(needed) is None:
-            raise SceneError(f"{scene.source}: key '{key}' = {ref.text!r} refers to stage '{source}', "
-                             f"but the scene has no [{needed}] section")
+        candidates = REFERENCE_STAGES[ref.source]
+        given = [s for s in candidates if scene.section(REGISTRY[s].needs[0]) is not None]
+        named = " or ".join(f"'{s}'" for s in candidates)
+        if not given:
+            sections = " or ".join(f"[{REGISTRY[s].needs[0]}]" for s in candidates)
+            raise SceneError(f"{scene.source}: key '{key}' = {ref.text!r} refers to stage {named}, "
+                             f"but the scene has no {sections} section")
+        if len(given) > 1:
+            sections = " and ".join(f"[{REGISTRY[s].needs[0]}]" for s in given)
+            raise SceneError(f"{scene.source}: key '{key}' = {ref.text!r} refers to stage {named}, but the scene "
+                             f"has {sections}; expected one of them (the test the values come from)")
+        source = given[0]
         if source not in deps:
             deps.append(source)
     for dep, sections in entry.depends_when:

@@ -27,6 +27,7 @@ __all__ = [
     "RotorStage", "StabilityStage", "DriveStage", "CompressorStage", "MountsStage",
     "stage_frf", "stage_identify", "stage_drive", "stage_rotor", "stage_adb_stability", "stage_adb_response",
     "stage_compressor", "stage_mounts", "resolve", "BalanceStage", "stage_balance", "check_frf", "read_balance_job",
+    "stage_oma", "check_oma",
 ]
 
 
@@ -95,13 +96,19 @@ def _serious_flags(mode) -> list[str]:
     return sorted(set(mode.flags) - INFORMATIONAL)
 
 
+def _test_section(scene: Scene) -> str:
+    """The section of the test that ``identified:`` references read: ``oma`` (an operational test) when the
+    scene has [oma] and no [frf], else ``identify``."""
+    return "oma" if scene.section("oma") is not None and scene.section("frf") is None else "identify"
+
+
 def describe_mode(identified, ref: Reference, scene: Scene) -> str:
     """Which identified mode a reference used: number, frequency, damping, channel and flags."""
     mode = identified[ref.mode - 1]
     flags = _serious_flags(mode)
     return (f"mode {ref.mode} at {mode.natural_frequency_hz:.6g} Hz, zeta {100 * mode.damping_ratio:.4g} %, "
             f"channel {_channel(identified, scene)}, flags: {', '.join(flags) or 'none'}"
-            + (" (accepted: identify.accept_flagged)" if flags else ""))
+            + (f" (accepted: {_test_section(scene)}.accept_flagged)" if flags else ""))
 
 
 def _identified_mode(identified, ref: Reference, key: str, scene: Scene):
@@ -112,6 +119,8 @@ def _identified_mode(identified, ref: Reference, key: str, scene: Scene):
 
 
 def _channel(identified, scene: Scene) -> int:
+    if _test_section(scene) == "oma":
+        return _oma_channel(identified, scene)
     channel = scene.section("identify.channel")
     mode = identified[0]
     driving = np.atleast_1d(mode.driving_point)
@@ -123,6 +132,18 @@ def _channel(identified, scene: Scene) -> int:
     return channel
 
 
+def _oma_channel(identified, scene: Scene) -> int:
+    """0-based index of ``[oma] channel`` (a number from 1 or a name, as ``modal oma`` takes it; default 1)."""
+    spec = scene.section("oma.channel", "1")
+    names = [str(n) for n in identified.settings.get("channel_names", [])]
+    if spec in names:
+        return names.index(spec)
+    if spec.isdigit() and 1 <= int(spec) <= identified.n_channels:
+        return int(spec) - 1
+    raise SceneError(f"{scene.source}: key 'oma.channel' = {spec!r}: no such channel; expected a number "
+                     f"1..{identified.n_channels} or a name ({', '.join(names)})")
+
+
 def resolve(value, key: str, scene: Scene, identified=None, drive=None) -> float:
     """A number, or the value a reference points at (SI units)."""
     if isinstance(value, str):
@@ -132,13 +153,19 @@ def resolve(value, key: str, scene: Scene, identified=None, drive=None) -> float
     if value.source == "identified":
         mode = _identified_mode(identified, value, key, scene)
         flags = _serious_flags(mode)
-        if flags and not scene.section("identify.accept_flagged", False):
+        test = _test_section(scene)
+        if flags and not scene.section(f"{test}.accept_flagged", False):
+            narrow = "identify.bands_hz" if test == "identify" else "oma.band_hz"
             raise SceneError(
                 f"{scene.source}: key '{key}' = {value.text!r}: mode {value.mode} ({mode.natural_frequency_hz:.6g} Hz) "
                 f"is flagged ({', '.join(flags)}; see docs/flags.md); expected an unflagged mode: refer to another "
-                f"mode, give identify.bands_hz, or set identify.accept_flagged = true to use it anyway")
+                f"mode, give {narrow}, or set {test}.accept_flagged = true to use it anyway")
         raw = np.atleast_1d(getattr(mode, IDENTIFIED_FIELDS[value.field]))
         number = float(raw[_channel(identified, scene)] if raw.size > 1 else raw[0])
+        if not math.isfinite(number) and test == "oma" and scene.section("oma.mass_change") is None:
+            raise SceneError(f"{scene.source}: key '{key}' = {value.text!r}: an operational test alone gives no "
+                             "k, c, m; expected oma.mass_change and oma.added_mass_kg (a second record with known "
+                             "masses added) to scale its modes")
         if not math.isfinite(number):
             raise SceneError(f"{scene.source}: key '{key}' = {value.text!r} is not defined for that channel "
                              f"(flags: {', '.join(mode.flags) or 'none'}); choose a driving-point channel")
@@ -212,6 +239,31 @@ def _time_options(cfg: dict):
     return SimpleNamespace(kind=cfg.get("kind"), **values)
 
 
+#: [oma] keys that are the options of ``python -m modal oma`` (:class:`modal.operational.files.OMAOptions`)
+OMA_OPTIONS = ("band_hz", "method", "reference_channels", "rotor_speed_hz", "max_order")
+
+
+def _oma_options(scene: Scene):
+    from modal.errors import ModalError
+    from modal.operational.files import OMAOptions
+
+    cfg = scene.section("oma")
+    try:
+        return OMAOptions(**{k: cfg[k] for k in OMA_OPTIONS if k in cfg})
+    except ModalError as exc:
+        raise SceneError(f"{scene.source}: key 'oma': {exc}") from None
+
+
+def check_oma(scene: Scene) -> None:
+    """[oma] options as ``modal oma`` checks them, and a mass change given whole (the record and its masses)."""
+    cfg = scene.section("oma")
+    if ("mass_change" in cfg) != ("added_mass_kg" in cfg):
+        given, missing = ("mass_change", "added_mass_kg") if "mass_change" in cfg else ("added_mass_kg", "mass_change")
+        raise SceneError(f"{scene.source}: key 'oma.{missing}' is missing; oma.{given} needs it (a mass-change test "
+                         "is the record with the masses added and the masses, {channel = kg})")
+    _oma_options(scene)
+
+
 def read_balance_job(scene: Scene):
     """The [balance] readings, parsed and checked (shapes, units, files) before any work; None for a
     simulated study ([balance.simulate]), whose readings the stage makes."""
@@ -266,6 +318,19 @@ def stage_identify(scene: Scene, frf: modal.FRF) -> modal.IdentificationResult:
                           min_prominence_db=cfg.get("min_prominence_db", 6.0), max_modes=cfg.get("max_modes"))
 
 
+def stage_oma(scene: Scene) -> modal.IdentificationResult:
+    """Identify the modes of an operational test, scaled to unit modal mass when [oma] gives a mass change."""
+    from modal.operational.files import oma_file, scale_files
+
+    cfg = scene.section("oma")
+    options = _oma_options(scene)
+    if "mass_change" in cfg:
+        result, _ = scale_files(scene.folder / cfg["file"], scene.folder / cfg["mass_change"], cfg["added_mass_kg"],
+                                options)
+        return result
+    return oma_file(scene.folder / cfg["file"], options)
+
+
 def stage_drive(scene: Scene) -> DriveStage:
     """Belt stages in series and the shaft's hand-over (speed, stiffness, critical-speed margin)."""
     from ..drive.belt import BeltStageSpec, belt_drive
@@ -285,8 +350,10 @@ def stage_drive(scene: Scene) -> DriveStage:
     return DriveStage(drive, handover)
 
 
-def stage_rotor(scene: Scene, identify=None, drive=None) -> RotorStage:
-    """Ball-balancer parameters, with M, k, c resolved from identification or the drive."""
+def stage_rotor(scene: Scene, identify=None, drive=None, oma=None) -> RotorStage:
+    """Ball-balancer parameters, with M, k, c resolved from identification (an impact or an operational test)
+    or the drive."""
+    identify = identify if identify is not None else oma
     rotor, adb = scene.section("rotor"), scene.section("adb")
     values, sources = {}, []
     for key in ("M", "k", "c"):

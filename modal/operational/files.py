@@ -58,6 +58,8 @@ class OMAOptions:
             except (TypeError, ValueError):
                 raise ParameterError(f"'band_hz' is {self.band_hz!r}; expected two frequencies (FMIN, FMAX) in Hz") \
                     from None
+            if not (0 <= low < high < float("inf")):
+                raise ParameterError(f"'band_hz' is ({low:g}, {high:g}); expected 0 <= FMIN < FMAX in Hz")
             object.__setattr__(self, "band_hz", (low, high))
         if self.reference_channels is not None:
             refs = self.reference_channels

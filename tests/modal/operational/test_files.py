@@ -25,7 +25,8 @@ def test_options_from_the_command_line_keep_their_names():
 
 
 @pytest.mark.parametrize("kwargs, message", [({"method": "magic"}, "'method' is 'magic'"),
-                                             ({"band_hz": (1.0,)}, "expected two frequencies")])
+                                             ({"band_hz": (1.0,)}, "expected two frequencies"),
+                                             ({"band_hz": (30.0, 10.0)}, "expected 0 <= FMIN < FMAX")])
 def test_bad_options_are_refused(kwargs, message):
     with pytest.raises(ParameterError, match=message):
         OMAOptions(**kwargs)

@@ -1,0 +1,95 @@
+"""The [oma] stage: a scene takes k, c, M from an operational test scaled by mass change, as from an impact test."""
+from __future__ import annotations
+
+import h5py
+import numpy as np
+import pytest
+from scipy.linalg import eigh
+
+from balancer import run_scene
+from modal.errors import SceneError
+from modal.synthetic import ambient_response, chain_matrices
+
+from support.scenes import ADB, scene
+
+MASSES, SPRINGS = np.array([2.0, 1.5, 1.0, 1.2]), np.array([8e3, 6e3, 5e3, 4e3])
+ADDED = [0.2, 0.15, 0.1, 0.12]
+
+
+def _write(path, rec):
+    with h5py.File(path, "w") as fh:
+        ds = fh.create_dataset("signals", data=rec.signals)
+        ds.attrs["sample_rate_hz"] = rec.sample_rate_hz
+        ds.attrs["quantities"] = ["acceleration"] * rec.signals.shape[0]
+        ds.attrs["units"] = ["m/s^2"] * rec.signals.shape[0]
+    return path.name
+
+
+@pytest.fixture(scope="module")
+def records(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("oma_scene")
+    M, C, K = chain_matrices(MASSES, SPRINGS, 0.01)
+    before = _write(folder / "before.h5", ambient_response(M, C, K, 200.0, 300_000, noise=0.1, seed=1))
+    after = _write(folder / "after.h5", ambient_response(M + np.diag(ADDED), C, K, 200.0, 300_000, noise=0.1, seed=2))
+    return folder, before, after, M, K
+
+
+def _scene_file(folder, name, oma, rotor=None, **extra):
+    import json
+
+    rotor = rotor or {"M": "identified:mode1.mass", "k": "identified:mode1.stiffness",
+                      "c": "identified:mode1.damping", "e": 0.0005, "mass_includes_balls": False}
+    config = scene(oma=oma, rotor=rotor, adb=ADB, outputs={"tables": ["rotor"]}, **extra)
+    lines = []
+    for section, table in config.items():  # a small TOML writer: tables of scalars, lists and inline tables
+        plain = {k: v for k, v in table.items() if not isinstance(v, dict)}
+        lines.append(f"[{section}]")
+        lines += [f"{k} = {json.dumps(v)}" for k, v in plain.items()]
+        for key, sub in table.items():
+            if isinstance(sub, dict) and key == "added_mass_kg":
+                lines.append(f"{key} = {{ {', '.join(f'{json.dumps(c)} = {kg}' for c, kg in sub.items())} }}")
+        for key, sub in table.items():
+            if isinstance(sub, dict) and key != "added_mass_kg":
+                lines.append(f"[{section}.{key}]")
+                lines += [f"{k} = {json.dumps(v)}" for k, v in sub.items()]
+    path = folder / name
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def test_rotor_takes_k_c_m_from_a_mass_change_test(records):
+    folder, before, after, M, K = records
+    oma = {"file": before, "band_hz": [1.0, 60.0], "mass_change": after,
+           "added_mass_kg": {str(k + 1): kg for k, kg in enumerate(ADDED)}, "channel": 2, "accept_flagged": True}
+    run = run_scene(_scene_file(folder, "scaled.toml", oma))
+    assert run.stages["oma"] == "ran" and run.stages["rotor"] == "ran"
+    w2, phi = eigh(K, M)  # mass-normalised: phi' M phi = 1
+    rotor = run.results["rotor"]
+    # channel 2 (numbered from 1) is a driving point of mode 1's mass-normalised shape: m = 1/phi^2, k = m wn^2;
+    # within 20 %: the scaled shape is within 10 % (operational/test_scaling.py), m goes with its square
+    m_true = 1 / phi[1, 0] ** 2
+    assert abs(rotor.params.M / m_true - 1) < 0.2
+    assert abs(rotor.params.k / (m_true * w2[0]) - 1) < 0.2
+    assert rotor.std.M > 0 and rotor.std.k > 0  # the operational test's errors are carried
+    assert "channel 1" in rotor.sources[0]  # 0-based in the sources, as for [identify]
+
+
+def test_an_operational_test_without_mass_change_gives_no_k_c_m(records):
+    folder, before, _, _, _ = records
+    with pytest.raises(SceneError, match="an operational test alone gives no k, c, m; expected oma.mass_change"):
+        run_scene(_scene_file(folder, "unscaled.toml", {"file": before, "band_hz": [1.0, 60.0],
+                                                        "accept_flagged": True}))
+
+
+@pytest.mark.parametrize("oma, extra, message", [
+    ({"mass_change": "after.h5"}, {}, "key 'oma.added_mass_kg' is missing; oma.mass_change needs it"),
+    ({"method": "magic"}, {}, "key 'oma.method' = 'magic'"),
+    ({"channel": 0}, {}, "key 'oma.channel' = 0: expected a channel number counted from 1"),
+    ({"band_hz": [30.0, 10.0]}, {}, "key 'oma': .*0 <= FMIN < FMAX"),
+    ({}, {"frf": {"file": "x.csv"}}, r"has \[frf\] and \[oma\]; expected one of them"),
+])
+def test_bad_oma_sections_are_one_error(records, oma, extra, message):
+    folder, before, _, _, _ = records
+    with pytest.raises(SceneError, match=message) as info:
+        run_scene(_scene_file(folder, "bad.toml", {"file": before, **oma}, **extra))
+    assert "\n" not in str(info.value)
