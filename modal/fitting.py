@@ -46,6 +46,9 @@ class FitOptions:
         Read hints (:func:`modal.read_frf`); ``frequency_step`` and ``frequency_start`` in Hz.
     excitation, response, impact, estimator, window, exponential_decay_s, segment_length, overlap
         Time-data options: a time file is turned into FRFs first (:mod:`modal.time_frf`).
+    oma : OMAOptions, optional
+        Records of responses only (``modal batch --oma``): each file's modes by operational analysis
+        (:func:`modal.operational.files.oma_file`) with these options instead of a fit of FRFs.
     """
 
     method: str = "auto"
@@ -70,9 +73,15 @@ class FitOptions:
     exponential_decay_s: float | None = None
     segment_length: int | None = None
     overlap: float | None = None
+    oma: Any = None
 
     def __post_init__(self) -> None:
         one_of("method", self.method, _METHODS)
+        if self.oma is not None:
+            from .operational.files import OMAOptions
+
+            if not isinstance(self.oma, OMAOptions):
+                raise ParameterError(f"'oma' is {self.oma!r}; expected modal.operational.files.OMAOptions")
         given = [name for name in GLOBAL_OPTIONS if getattr(self, name) is not None]
         if given and self.method not in ("auto", "global"):
             raise ParameterError(f"--{given[0].replace('_', '-')} applies to --method global only")
@@ -90,6 +99,9 @@ class FitOptions:
         values["bands_hz"] = getattr(args, "band", None)
         values["impact"] = bool(values["impact"])
         values["method"] = values["method"] or "auto"
+        values["oma"] = _oma_from_args(args) if getattr(args, "oma", False) else None
+        if values["oma"] is not None:  # the fit options that became the operational ones
+            values.update(bands_hz=None, max_order=None)
         return cls(**values)
 
     @classmethod
@@ -107,6 +119,9 @@ class FitOptions:
         for f in dataclasses.fields(self):
             value = getattr(self, f.name)
             if value is None or value is False:
+                continue
+            if f.name == "oma":
+                out["oma"] = value.settings()
                 continue
             out[f.name] = [list(v) if isinstance(v, tuple) else v for v in value] if isinstance(value, tuple) else value
         return out
@@ -139,8 +154,9 @@ class FitOutput:
 
     Attributes
     ----------
-    frf : FRF
-        The FRF that was fitted (an :class:`~modal.estimate.EstimatedFRF` from time data).
+    frf : FRF or None
+        The FRF that was fitted (an :class:`~modal.estimate.EstimatedFRF` from time data); None for
+        operational analysis (``options.oma``), which identifies from the responses directly.
     results : tuple of IdentificationResult
         One per method that ran (``result.method`` says which ``"auto"`` chose).
     time_data : tuple or None
@@ -180,6 +196,12 @@ def fit_path(path: str | os.PathLike | Sequence[str | os.PathLike], options: Fit
     from .io import read_frf
 
     paths = [path] if isinstance(path, (str, os.PathLike)) else list(path)
+    if options.oma is not None:
+        from .operational.files import oma_file
+
+        if len(paths) != 1:
+            raise ParameterError(f"operational analysis takes one time file at a time; got {len(paths)}")
+        return FitOutput(frf=None, results=(oma_file(paths[0], options.oma),))
     args = options.namespace()
     time_data = None
     if len(paths) == 1 and wants_time(args, paths[0]):
@@ -201,6 +223,20 @@ def fit_path(path: str | os.PathLike | Sequence[str | os.PathLike], options: Fit
                              **(global_options if method == "global" else {}))
                     for method in methods)
     return FitOutput(frf=frf, results=results, time_data=time_data)
+
+
+def _oma_from_args(args: Any):
+    """The operational options of ``modal batch --oma``: its ``--band`` (once) and ``--max-order`` with
+    ``--rotor-speed-hz`` and ``--reference-channels``; ``--method`` stays ``auto`` (the default, ssi)."""
+    from .operational.files import OMAOptions
+
+    bands = getattr(args, "band", None) or []
+    if len(bands) > 1:
+        raise ParameterError(f"--oma takes one --band FMIN FMAX (the band of interest); got {len(bands)}")
+    if (getattr(args, "method", None) or "auto") != "auto":
+        raise ParameterError(f"--method {args.method} fits FRFs; --oma identifies from responses with ssi")
+    return OMAOptions(band_hz=bands[0] if bands else None, reference_channels=getattr(args, "reference_channels", None),
+                      rotor_speed_hz=getattr(args, "rotor_speed_hz", None), max_order=getattr(args, "max_order", None))
 
 
 def driving_channels(frf, names: Sequence[str]):

@@ -50,6 +50,13 @@ def add_batch_parser(sub, add_fit_options) -> argparse.ArgumentParser:
                        help=f"time limit of one file's fit (default {DEFAULT_FILE_TIMEOUT_S:g} s; 0: none): a file "
                             "still fitting then is listed as failed ('timed out after N s') and the batch goes on")
     add_fit_options(batch)
+    batch.add_argument("--oma", action="store_true",
+                       help="records of responses only (ambient, no force): each file's modes by operational "
+                            "analysis (modal oma, method ssi) with --band (once) and --max-order, not a fit of FRFs")
+    batch.add_argument("--rotor-speed-hz", dest="rotor_speed_hz", type=float, metavar="F",
+                       help="--oma: the running speed (poles on its harmonics are tones or flagged 'harmonic')")
+    batch.add_argument("--reference-channels", dest="reference_channels", nargs="+", metavar="CH",
+                       help="--oma: reference channels, numbered from 1 or names (default: chosen from the data)")
     return batch
 
 
@@ -73,6 +80,8 @@ def run_batch(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
         parser.error(f"--workers {args.workers}: expected 1 or more")
     if not (args.file_timeout >= 0 and math.isfinite(args.file_timeout)):
         parser.error(f"--file-timeout {args.file_timeout:g}: expected seconds > 0, or 0 for no limit")
+    if not args.oma and (args.rotor_speed_hz is not None or args.reference_channels):
+        parser.error("--rotor-speed-hz and --reference-channels apply to --oma")
     if args.dashboard:
         print(f"dashboard: http://{args.dashboard}/status (Dask's, while files are fitted)", file=sys.stderr)
     try:

@@ -53,8 +53,13 @@ def fit_one(path: str, options: FitOptions, sha256: str | None = None) -> FileFi
                            error=one_line(exc), retry=True, fit_time_s=time.perf_counter() - start)
     frf = out.frf
     texts = tuple(dict.fromkeys(" ".join(str(w.message).split()) for w in caught))
-    return FileFit(source=path, sha256=sha256, settings=settings, settings_hash=settings_hash,
-                   kind=frf.kind, n_channels=int(frf.n_channels), n_lines=int(frf.n_freq),
-                   frequency_range_hz=(float(frf.frequency_hz[0]), float(frf.frequency_hz[-1])),
+    if frf is None:  # operational analysis: no FRF, the band of interest and no lines
+        first = out.results[0]
+        shape = dict(kind=first.kind, n_channels=int(first.n_channels), n_lines=0,
+                     frequency_range_hz=tuple(float(f) for f in first.settings["band_hz"]))
+    else:
+        shape = dict(kind=frf.kind, n_channels=int(frf.n_channels), n_lines=int(frf.n_freq),
+                     frequency_range_hz=(float(frf.frequency_hz[0]), float(frf.frequency_hz[-1])))
+    return FileFit(source=path, sha256=sha256, settings=settings, settings_hash=settings_hash, **shape,
                    results=tuple(out.results), warnings=texts, fit_time_s=time.perf_counter() - start,
                    table=table_text(out.results))
