@@ -45,8 +45,11 @@ def _references(prepared: Prepared, reference_channels) -> tuple[int, ...]:
 
 
 def _sweep_size(prepared: Prepared, n_refs: int, max_order, block_rows):
-    """(max_order, block_rows): the correlation lags span a period of the lowest frequency of interest
-    (a tenth of the band's top, or its bottom if higher), the Hankel matrix has room for every order."""
+    """(max_order, block rows of the outputs, block columns of the references): the correlation lags span a
+    period of the lowest frequency of interest (a tenth of the band's top, or its bottom if higher), the
+    Hankel matrix has room for every order. With more outputs than references the outputs take fewer block
+    rows, as many as keep the Hankel matrix about square (and room for every order): its rows then cost
+    the error bars' products no more than its columns, and the lags still span the period."""
     fs = prepared.sample_rate_hz
     low, high = prepared.band_hz
     if max_order is None:
@@ -57,22 +60,26 @@ def _sweep_size(prepared: Prepared, n_refs: int, max_order, block_rows):
     rows = int(block_rows) if block_rows is not None else max(span, int(np.ceil(max_order / n_refs)) + 1)
     if rows < 2:
         raise ParameterError(f"{prepared.source}: 'block_rows' is {block_rows!r}; expected at least 2")
+    cols = rows
+    n_out = prepared.n_channels
+    if block_rows is None and n_out > n_refs:
+        rows = min(cols, max(int(np.ceil(max_order / n_out)) + 1, int(np.ceil(n_refs * cols / n_out)), 2))
     n_samples = prepared.signals.shape[1]
-    if n_samples < MIN_LAGS_IN_RECORD * 2 * rows:
-        need = MIN_LAGS_IN_RECORD * 2 * rows / fs
+    if n_samples < MIN_LAGS_IN_RECORD * 2 * cols:
+        need = MIN_LAGS_IN_RECORD * 2 * cols / fs
         raise ParameterError(f"{prepared.source}: the record lasts {n_samples / fs:.4g} s; the band from "
                              f"{max(low, high / 10):.4g} Hz and model order {max_order} need correlations over "
-                             f"{2 * rows} lags and at least {need:.4g} s of record (raise the band's lower edge, "
+                             f"{2 * cols} lags and at least {need:.4g} s of record (raise the band's lower edge, "
                              "lower max_order or measure longer)")
-    return int(max_order), rows
+    return int(max_order), rows, cols
 
 
 def _ssi(prepared: Prepared, refs, max_order, block_rows):
     from .ssi import Perturbation, poles_at, subspace_model
 
-    max_order, rows = _sweep_size(prepared, len(refs), max_order, block_rows)
-    corr = correlations(prepared.signals, prepared.sample_rate_hz, refs, 2 * rows)
-    model = subspace_model(corr.mean, rows, max_order, prepared.sample_rate_hz)
+    max_order, rows, cols = _sweep_size(prepared, len(refs), max_order, block_rows)
+    corr = correlations(prepared.signals, prepared.sample_rate_hz, refs, rows + cols)
+    model = subspace_model(corr.mean, rows, max_order, prepared.sample_rate_hz, cols)
     orders = list(range(2, model.max_order + 1, 2))
     sets = [poles_at(model, n) for n in orders]
     flat, stable, clusters = stabilise(sets, *prepared.band_hz)
@@ -83,7 +90,7 @@ def _ssi(prepared: Prepared, refs, max_order, block_rows):
         if n_blocks >= 2:
             perturb = Perturbation(model, *corr.grouped(n_blocks)).at
     estimates, chosen, kept = estimates_from_clusters(flat, clusters, perturb, len(orders), prepared.scale)
-    settings = {"orders": [orders[0], orders[-1]], "block_rows": rows}
+    settings = {"orders": [orders[0], orders[-1]], "block_rows": rows, "block_cols": cols}
     return estimates, chosen, kept, flat, stable, corr, settings
 
 

@@ -63,26 +63,31 @@ class SubspaceModel:
     sample_rate_hz: float
     max_order: int
     hankel: np.ndarray
+    block_cols: int | None = None
 
 
-def hankel(R: np.ndarray, block_rows: int) -> np.ndarray:
-    """Block Hankel matrix of lags 1…2s: block (a, b) = R[a + b + 1], a = 0…s, b = 0…s−1.
+def hankel(R: np.ndarray, block_rows: int, block_cols: int | None = None) -> np.ndarray:
+    """Block Hankel matrix of lags 1…p+q: block (a, b) = R[a + b + 1], a = 0…p, b = 0…q−1, with p
+    ``block_rows`` and q ``block_cols`` (default p).
 
-    ``R`` has shape (..., lags, n_outputs, n_references); the result (..., n_outputs (s+1), n_references s).
+    ``R`` has shape (..., lags, n_outputs, n_references); the result (..., n_outputs (p+1), n_references q).
     """
-    s = block_rows
-    a = np.arange(s + 1)[:, None]
-    b = np.arange(s)[None, :]
-    blocks = R[..., a + b + 1, :, :]  # (..., s+1, s, l, r)
+    p = block_rows
+    q = block_rows if block_cols is None else block_cols
+    a = np.arange(p + 1)[:, None]
+    b = np.arange(q)[None, :]
+    blocks = R[..., a + b + 1, :, :]  # (..., p+1, q, l, r)
     lead = blocks.shape[:-4]
     l, r = blocks.shape[-2:]
-    return np.swapaxes(blocks, -3, -2).reshape(*lead, (s + 1) * l, s * r)
+    return np.swapaxes(blocks, -3, -2).reshape(*lead, (p + 1) * l, q * r)
 
 
-def subspace_model(R: np.ndarray, block_rows: int, max_order: int, sample_rate_hz: float) -> SubspaceModel:
-    """SVD of the Hankel matrix of ``R`` (lags, outputs, references) and the QR its orders share."""
+def subspace_model(R: np.ndarray, block_rows: int, max_order: int, sample_rate_hz: float,
+                   block_cols: int | None = None) -> SubspaceModel:
+    """SVD of the Hankel matrix of ``R`` (lags, outputs, references) and the QR its orders share (block rows
+    of the outputs ``block_rows``, of the references ``block_cols``, default the same)."""
     l = R.shape[1]
-    H = hankel(R, block_rows)
+    H = hankel(R, block_rows, block_cols)
     p, q = H.shape
     max_order = int(min(max_order, q, l * block_rows))
     if max_order < 2:
@@ -90,7 +95,7 @@ def subspace_model(R: np.ndarray, block_rows: int, max_order: int, sample_rate_h
     U, sv, Vt = np.linalg.svd(H, full_matrices=False)
     Q, Rr = np.linalg.qr(U[: l * block_rows, :max_order])
     return SubspaceModel(U, sv, Vt.T, Q, Rr, Q.T @ U[l:, :max_order], l, block_rows, float(sample_rate_hz),
-                         max_order, H)
+                         max_order, H, block_cols)
 
 
 def continuous(mu: np.ndarray, sample_rate_hz: float) -> np.ndarray:
@@ -149,7 +154,7 @@ class Perturbation:
         top = int(min(max_order or model.max_order, model.max_order))
         self.top = top
         U, V = model.U, model.V
-        dH = hankel(block_R, model.block_rows) - model.hankel[None]  # (blocks, p, q)
+        dH = hankel(block_R, model.block_rows, model.block_cols) - model.hankel[None]  # (blocks, p, q)
         G = dH @ V[:, :top]  # (blocks, p, top): ΔH V₁ for every order up to top
         self.B_right = np.swapaxes(U.T @ G, 1, 2)  # (blocks, top, k): (Uᵀ ΔH V₁)ᵀ
         self.E = G - U @ np.swapaxes(self.B_right, 1, 2)  # the part of ΔH V₁ outside the range of H
