@@ -8,7 +8,7 @@ every method, in one order:
 
 1. the flags of the rules in :mod:`modal.flags`: ``high_uncertainty`` (relative
    error of ζ), ``close_modes`` (modal overlap with any other mode),
-   ``driving_point_assumed``;
+   ``driving_point_unknown``;
 2. the exponential window's damping taken out of the pole
    (:func:`modal.window_damping.remove_window_damping`);
 3. k, c, m of the driving points with their covariance, and the flags on the
@@ -23,10 +23,11 @@ from typing import Sequence
 
 import numpy as np
 
-from .errors import QualityWarning, ResolutionWarning, warn_caller
+from .errors import IdentificationError, QualityWarning, ResolutionWarning, warn_caller
 from .flags import COMPLEX_PHASE_DEG, FLAG_TEXT, INFORMATIONAL, OVERLAP_LIMIT, REL_STD_LIMIT, RESOLUTION_FLAGS, overlap
 from .results import ModeResult, ModeStd, correlation_of, physical_covariance, physical_parameters
 from .units import TWO_PI
+from .validate import channel_mask
 from .window_damping import remove_window_damping
 
 __all__ = ["ModeEstimate", "assemble_modes", "driving_points"]
@@ -92,25 +93,26 @@ class ModeEstimate:
 
 
 def driving_points(frf, driving_point=None) -> tuple[np.ndarray, bool]:
-    """Which channels are driving points (bool per channel), and whether that was assumed.
+    """Which channels are driving points (bool per channel), and whether that is known at all.
 
-    ``driving_point``: the caller's override (bool or one per channel); by default the FRF's point ids
-    say (:meth:`modal.frf.FRF.is_driving_point`), and a single channel without them is assumed to be one
-    (flag ``driving_point_assumed``).
+    The one rule of the toolkit: k, c, m exist only for a channel known to be a driving point, from
+    the point ids (response point = reference point, :meth:`modal.frf.FRF.is_driving_point`) or
+    declared by the caller. ``driving_point``: the declaration (a bool for every channel, one bool per
+    channel, or 0-based channel indices; the channels not named are then not driving points). Without
+    it and without point ids nothing says where the response was measured: no channel is a driving
+    point and the second value is False (flag ``driving_point_unknown``).
     """
-    n_ch = frf.n_channels
-    if driving_point is None:
-        driving = frf.is_driving_point()
-    else:
-        driving = np.broadcast_to(np.asarray(driving_point, bool), (n_ch,)).copy()
-    assumed = driving_point is None and n_ch == 1 and frf.response_points is None
-    return driving, assumed
+    if driving_point is not None:
+        return channel_mask("driving_point", driving_point, frf.n_channels, IdentificationError), True
+    return frf.is_driving_point(), frf.driving_point_known
 
 
-def physical_with_flags(wn, zeta, const, cov, driving, flags: set[str], reference=None, phase_check: bool = True):
+def physical_with_flags(wn, zeta, const, cov, driving, flags: set[str], reference=None, phase_check: bool = True,
+                        driving_known: bool = True):
     """k, c, m, their standard errors and covariance (n_ch, 3, 3) of a mode; flags on the way.
 
-    NaN on transfer channels and where the driving point's constant has no positive real part.
+    NaN on transfer channels (flag ``not_driving_point``), on every channel when ``driving_known`` is
+    False (flag ``driving_point_unknown``), and where the driving point's constant has no positive real part.
     ``reference`` (ωn, ζ, constants, covariance before the fold) of a biased estimate
     (flag ``method_bias``): the difference of k, c, m from those of the reference is
     folded into their covariance (exactly, not to first order: a rotated constant
@@ -137,13 +139,15 @@ def physical_with_flags(wn, zeta, const, cov, driving, flags: set[str], referenc
     sk, sc, sm = (np.sqrt(np.maximum(cov_kcm[..., i, i], 0.0)) for i in range(3))
     for arr in (sk, sc, sm):
         arr[undefined] = np.nan
-    if (~driving).any():
+    if not driving_known:
+        flags.add("driving_point_unknown")
+    elif (~driving).any():
         flags.add("not_driving_point")
     return (k, c, m), (sk, sc, sm), cov_kcm
 
 
 def assemble_modes(estimates: Sequence[ModeEstimate], *, method: str, source: str, single: bool,
-                   driving: np.ndarray | None, driving_assumed: bool = False, window_decay_s: float | None = None,
+                   driving: np.ndarray | None, driving_known: bool = True, window_decay_s: float | None = None,
                    phase_check: bool = True) -> tuple[ModeResult, ...]:
     """The :class:`~modal.results.ModeResult` of every mode, with the flags every method shares, and a
     warning per flagged mode.
@@ -161,8 +165,9 @@ def assemble_modes(estimates: Sequence[ModeEstimate], *, method: str, source: st
     driving : ndarray of bool, shape (n_channels,), or None
         Driving-point channels (k, c, m defined); see :func:`driving_points`. None: no channel has
         an input (output-only data): no k, c, m and no driving-point flags.
-    driving_assumed : bool
-        A single channel taken as a driving point (flag ``driving_point_assumed``).
+    driving_known : bool
+        False: neither point ids nor the caller say which channel is a driving point: no k, c, m
+        (flag ``driving_point_unknown``).
     window_decay_s : float, optional
         τ of an exponential window whose damping is taken out of every pole.
     phase_check : bool
@@ -194,8 +199,6 @@ def assemble_modes(estimates: Sequence[ModeEstimate], *, method: str, source: st
         reference = estimate.reference
         if np.isfinite(s_z) and np.isfinite(zeta) and zeta > 0 and s_z / zeta > REL_STD_LIMIT:
             flags.add("high_uncertainty")
-        if driving_assumed:
-            flags.add("driving_point_assumed")
         if mode_overlap > OVERLAP_LIMIT:
             flags.add("close_modes")
         window_zeta = 0.0
@@ -213,7 +216,7 @@ def assemble_modes(estimates: Sequence[ModeEstimate], *, method: str, source: st
             cov_kcm, inputs = None, np.zeros(const.shape, bool)
         else:
             (k, c, m), (sk, sc, sm), cov_kcm = physical_with_flags(wn, zeta, const, cov, driving, flags, reference,
-                                                                   phase_check)
+                                                                   phase_check, driving_known)
             inputs = driving
         s_const = np.sqrt(np.maximum(cov[:, 2, 2] + cov[:, 3, 3], 0))
         sq = (lambda a: a.reshape(-1)[0].item()) if single else (lambda a: np.asarray(a))

@@ -13,6 +13,7 @@ import sys
 import warnings
 from pathlib import Path
 
+import numpy as np
 
 from .cli_time import add_time_options, save_time_plots
 from .time_frf import frf_from_time
@@ -39,9 +40,11 @@ def add_fit_options(parser: argparse.ArgumentParser) -> None:
                         help="fitting band of one mode in Hz (repeat for several modes); default: automatic")
     parser.add_argument("--kind", choices=FRF_KINDS, help="FRF kind when the file does not say")
     parser.add_argument("--driving-point", dest="driving_point", nargs="+", metavar="CHANNEL",
-                        help="the channel(s) measured at the excitation point (0-based index or response point id); "
-                             "k, c, m are given for these only (default: from the point ids in the file, a single "
-                             "channel without ids is assumed to be one)")
+                        help="the channel(s) measured at the excitation point: number counted from 1 (as the table "
+                             "numbers them; from a time file, its responses in order) or response point id. k, c, m "
+                             "are given for driving points only; default: the file's point ids say (response point "
+                             "= reference point), and without them no channel gets k, c, m (flag "
+                             "driving_point_unknown)")
     parser.add_argument("--frequency-axis", dest="frequency_axis", choices=["hz", "khz", "rad/s", "cpm", "rpm"],
                         help="unit of the file's frequency column when it does not say")
     parser.add_argument("--frequency-step", dest="frequency_step", type=float, metavar="HZ",
@@ -71,8 +74,8 @@ def build_parser(prog: str = "python -m modal") -> argparse.ArgumentParser:
     fit.add_argument("--json", action="store_true", help="print one JSON document on stdout")
     fit.add_argument("--plot", metavar="OUT.png", help="write a figure of the fit (every method's model over the data)")
     fit.add_argument("--channel", type=int, metavar="N",
-                     help="--plot: draw only channel N (0-based); default every channel (the RMS over channels "
-                          "above 8)")
+                     help="--plot: draw only channel N (counted from 1, as the table numbers them); default every "
+                          "channel (the RMS over channels above 8)")
     fit.add_argument("--archive", metavar="OUT.h5", help="write the FRF and results to an HDF5 archive")
     fit.add_argument("--geometry", metavar="GEOM", help="the test geometry (UFF 15/2411 and 82, CSV or TOML): kept "
                      "with the results by --archive, written before the shapes by --export-uff")
@@ -126,10 +129,12 @@ def _fit(args) -> int:
     if frf.response_points is not None:
         refs = frf.reference_points or ("?",) * frf.n_channels
         points = [f"{r} / {q}" for r, q in zip(frf.response_points, refs)]
+    if args.channel is not None and not 1 <= args.channel <= frf.n_channels:
+        raise ModalError(f"--channel {args.channel}: no such channel; expected 1..{frf.n_channels}")
     if args.json:
-        rows = [row for result in results for row in result.rows()]
+        rows = [dict(row, channel=row["channel"] + 1) for result in results for row in result.rows()]
         doc = {"file": args.path[0] if len(args.path) == 1 else list(args.path), "kind": frf.kind, "n_channels": frf.n_channels,
-               "methods": methods, "modes": rows}
+               "methods": methods, "driving_point": _driving_point_doc(results, args.driving_point), "modes": rows}
         json.dump(jsonable(doc), sys.stdout, indent=1, allow_nan=False)
         sys.stdout.write("\n")
     else:
@@ -144,7 +149,7 @@ def _fit(args) -> int:
         from .io._atomic import atomic_path
         from .plots import plot_fit
 
-        fig = plot_fit(frf, results, channel=args.channel)
+        fig = plot_fit(frf, results, channel=None if args.channel is None else args.channel - 1)
         with atomic_path(args.plot) as tmp:
             fig.savefig(tmp, dpi=110, format=Path(args.plot).suffix.lstrip(".") or "png")
         print(f"plot: {args.plot}", file=sys.stderr)
@@ -188,6 +193,19 @@ def _fit(args) -> int:
         write_archive(args.archive, items)
         print(f"archive: {args.archive}", file=sys.stderr)
     return 0
+
+
+def _driving_point_doc(results, declared) -> dict:
+    """What ``--json`` says of the driving point: where it is known from (``"point ids"``, ``"declared"``) or
+    ``"unknown"`` with how to declare it, and the driving-point channels (counted from 1)."""
+    from .flags import FLAG_ACTION
+
+    modes = [mode for result in results for mode in result.modes]
+    if any("driving_point_unknown" in mode.flags for mode in modes):
+        return {"known_from": "unknown", "channels": [], "how_to_declare": FLAG_ACTION["driving_point_unknown"]}
+    driving = np.atleast_1d(modes[0].driving_point) if modes else np.zeros(0, bool)
+    return {"known_from": "declared" if declared else "point ids",
+            "channels": [int(k) + 1 for k in np.flatnonzero(driving)]}
 
 
 def _note(line: str) -> None:

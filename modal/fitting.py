@@ -41,7 +41,7 @@ class FitOptions:
     modes_hz, order, max_order
         Options of method ``"global"`` (choosing it under ``"auto"``).
     driving_point : tuple of str, optional
-        Driving-point channels: 0-based indexes or response point ids.
+        Driving-point channels: numbers counted from 1 or response point ids (:func:`driving_channels`).
     kind, frequency_axis, frequency_step, frequency_start, layout, delimiter, decimal, dataset
         Read hints (:func:`modal.read_frf`); ``frequency_step`` and ``frequency_start`` in Hz.
     excitation, response, impact, estimator, window, exponential_decay_s, segment_length, overlap
@@ -239,22 +239,31 @@ def _oma_from_args(args: Any):
                       rotor_speed_hz=getattr(args, "rotor_speed_hz", None), max_order=getattr(args, "max_order", None))
 
 
-def driving_channels(frf, names: Sequence[str]):
-    """Boolean mask over channels from ``--driving-point`` values (indexes or response point ids)."""
+def driving_channels(frf, names: Sequence[str], option: str = "--driving-point", where: str | None = None):
+    """Boolean mask over the FRF's channels from ``--driving-point`` values: channel numbers counted from 1
+    (as the results table numbers them) or response point ids (for an FRF from a time file: the response
+    channels' names). ``option`` names the setting and ``where`` (default the FRF's source) starts the
+    messages."""
     import numpy as np
 
-    mask = np.zeros(frf.n_channels, bool)
+    where = f"{frf.source}: " if where is None else where
+    n = frf.n_channels
+    mask = np.zeros(n, bool)
     points = list(frf.response_points or [])
+    listing = f" or a response point id ({', '.join(dict.fromkeys(points))})" if points else ""
     for name in names:
-        name = str(name)
-        if name.lstrip("-").isdigit():
-            index = int(name)
-            if not 0 <= index < frf.n_channels:
-                raise ModalError(f"--driving-point {name}: no such channel; expected 0..{frf.n_channels - 1}")
-        elif name in points:
-            index = points.index(name)
+        text = str(name).strip()
+        by_point = [k for k, p in enumerate(points) if p == text]
+        by_number = int(text) - 1 if text.isdigit() and 1 <= int(text) <= n else None
+        if by_number is not None and by_point and by_point != [by_number]:
+            raise ModalError(f"{where}{option} {text} is ambiguous: channel {text} is "
+                             f"{points[by_number]}, and response point {text} is channel "
+                             f"{', '.join(str(k + 1) for k in by_point)}; name the channel by another of its ids")
+        if by_point:
+            mask[by_point] = True
+        elif by_number is not None:
+            mask[by_number] = True
         else:
-            raise ModalError(f"--driving-point {name}: no channel has that response point; expected a channel index "
-                             f"0..{frf.n_channels - 1}" + (f" or one of {', '.join(points)}" if points else ""))
-        mask[index] = True
+            raise ModalError(f"{where}{option} {text}: no such channel; expected a channel number 1..{n}"
+                             f"{listing}")
     return mask

@@ -65,7 +65,8 @@ FLAG_TEXT = {
     "high_uncertainty": (f"standard error of the damping ratio exceeds {100 * REL_STD_LIMIT:g} % of its value, or the "
                          "errors are undetermined (the data do not determine this mode's pole apart from another's)"),
     "did_not_converge": "least-squares refinement did not converge; the start values are reported",
-    "driving_point_assumed": "single-channel FRF without point ids: taken as a driving point",
+    "driving_point_unknown": ("nothing says which channel was measured at the excitation point (no point ids, none "
+                              "declared): k, c, m are not given"),
     "not_driving_point": "transfer FRF (response point differs from reference): k, c, m are not defined for it",
     "complex_mode": (f"modal constant of a driving point is far from real (phase > {COMPLEX_PHASE_DEG:g} deg): "
                      "k, c, m are approximate"),
@@ -145,8 +146,10 @@ FLAG_ACTION = {
                         "nonlinearity (amplitude-dependent peaks) or a bad channel",
     "high_uncertainty": "average more measurements or improve the signal-to-noise ratio near the mode",
     "did_not_converge": "give a band around the mode with --band, or try method global",
-    "driving_point_assumed": "if the response was not measured at the excitation point, say so: "
-                             "--driving-point CHANNEL names the driving point, k, c, m of other channels are dropped",
+    "driving_point_unknown": "declare the channel measured at the excitation point: --driving-point CHANNEL "
+                             "(modal fit, modal batch; channels counted from 1, or a point id), driving_point = "
+                             "CHANNEL under [identify] in a scene, identify(frf, driving_point=...) in Python; or "
+                             "give the file point ids (response point = reference point at the driving point)",
     "not_driving_point": "nothing to do: a transfer FRF gives frequency, damping and modal constant but no k, c, m",
     "complex_mode": "check for close modes or non-proportional damping; k, c, m use |A| and are approximate",
     "non_positive_constant": "check the sign convention of the force and response channels and the driving-point "
@@ -174,9 +177,9 @@ RESOLUTION_FLAGS = GRID_FLAGS | {"outside_band"}
 RULE_FLAGS = frozenset({"high_uncertainty", "close_modes", "driving_point_assumed", "window_damping_dominates",
                         "complex_mode", "non_positive_constant", "not_driving_point"})
 #: Flags that describe the setting, not a defect (``ModeResult.ok`` ignores them).
-INFORMATIONAL = frozenset({"driving_point_assumed", "not_driving_point"})
+INFORMATIONAL = frozenset({"driving_point_unknown", "not_driving_point"})
 #: Flags about a driving-point channel's constant (never on a transfer channel).
-DRIVING_POINT_ONLY = frozenset({"driving_point_assumed", "complex_mode", "non_positive_constant"})
+DRIVING_POINT_ONLY = frozenset({"complex_mode", "non_positive_constant"})
 #: Flags about a transfer channel (never on a driving-point channel).
 TRANSFER_ONLY = frozenset({"not_driving_point"})
 

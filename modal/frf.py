@@ -224,14 +224,21 @@ class FRF:
         """Phase of H in radians, in (−π, π]."""
         return np.angle(self.response)
 
+    @property
+    def driving_point_known(self) -> bool:
+        """Whether the point ids say which channels are driving points: both ``response_points`` and
+        ``reference_points`` are given (without them nothing says where the response was measured
+        relative to the excitation, and :func:`modal.identify` gives no k, c, m unless told)."""
+        return self.response_points is not None and self.reference_points is not None
+
     def is_driving_point(self) -> np.ndarray:
         """Boolean per channel: response point equals reference point.
 
-        A single-channel FRF given without point ids is taken as a driving point
-        (:func:`modal.identify` says so in its flags).
+        All False when the point ids do not say (:attr:`driving_point_known`); a driving point is then
+        declared to :func:`modal.identify` (``driving_point=``).
         """
-        if self.response_points is None or self.reference_points is None:
-            return np.full(self.n_channels, self.n_channels == 1)
+        if not self.driving_point_known:
+            return np.zeros(self.n_channels, bool)
         return np.array([r == q for r, q in zip(self.response_points, self.reference_points)])
 
     # ------------------------------------------------------------ transforms

@@ -14,7 +14,7 @@ from .frf import FRF
 from .peaks import _indicator_and_peak, bands_from_hz, estimate_noise_std, find_modes
 from .results import IdentificationResult
 from .sdof import BANDWISE_METHODS, identify_bands
-from .validate import one_of, per_channel
+from .validate import channel_mask, one_of, per_channel
 
 __all__ = ["identify", "choose_method", "METHODS", "BANDWISE_METHODS"]
 
@@ -86,8 +86,11 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
     noise_std : float or array_like over channels, optional
         Known noise σ (E|n|² = σ²) in the FRF's unit; default estimated from
         each line's misfit to its neighbours (:func:`modal.peaks.neighbour_noise_std`).
-    driving_point : bool or array_like of bool, optional
-        Overrides which channels are driving points (k, c, m defined).
+    driving_point : bool, array_like of bool, int or sequence of int, optional
+        Declares which channels were measured at the excitation point: ``True`` (every channel; the
+        usual single-channel case), one bool per channel, or 0-based channel indices. Default: the
+        point ids say (response point = reference point). k, c, m are given for driving points only;
+        where neither says, for no channel (flag ``driving_point_unknown``).
     min_prominence_db : float
         Peak detection threshold when ``bands_hz`` is not given.
     max_modes : int, optional
@@ -116,6 +119,8 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
     one_of("method", method, METHODS + ("auto",), IdentificationError)
     if noise_std is not None:
         noise_std = per_channel("noise_std", noise_std, frf.n_channels, IdentificationError)
+    if driving_point is not None:
+        driving_point = channel_mask("driving_point", driving_point, frf.n_channels, IdentificationError)
     from .scaling import scale_exponent, scaled_frf, unscale_result
 
     # |H| once: the mode indicator and each channel's max |H|, and (but for the global method, which measures

@@ -107,7 +107,7 @@ def plot_fit(frf: FRF, result: IdentificationResult | Sequence[IdentificationRes
         From :func:`modal.identify` on ``frf``; several (e.g. one per method) are
         drawn over each other, each method with its own line style.
     channel : int, optional
-        Channel to draw (0-based). Default: every channel up to
+        Channel to draw (0-based; the figure numbers channels from 1, as the command line does). Default: every channel up to
         :data:`MAX_DRAWN_CHANNELS` (each with its model), and for more channels the
         RMS magnitude over channels of the data and of each model; the Nyquist
         plot of each mode shows the channel where that mode is strongest.
@@ -157,10 +157,10 @@ def plot_fit(frf: FRF, result: IdentificationResult | Sequence[IdentificationRes
                             color="C3", label=f"model ({name}), RMS")
         strongest = int(np.argmax(np.sum(np.abs(data) ** 2, axis=1)))
         phase_channels = [strongest]
-        ax_phase.set_title(f"phase of channel {strongest} (the strongest)", fontsize="small")
+        ax_phase.set_title(f"phase of channel {strongest + 1} (the strongest)", fontsize="small")
     else:
         for colour, ch in zip(colours, channels):
-            tag = f"ch {ch} " if frf.n_channels > 1 else ""
+            tag = f"ch {ch + 1} " if frf.n_channels > 1 else ""
             ax_mag.semilogy(f, np.abs(data[ch]), ".", ms=2, color=colour, label=f"{tag}data")
             for k, (name, model) in enumerate(zip(names, models)):
                 ax_mag.semilogy(f, np.abs(model[ch]), _STYLES[k % 4], lw=1, color=colour,
@@ -226,7 +226,7 @@ def plot_fit(frf: FRF, result: IdentificationResult | Sequence[IdentificationRes
                     ax.plot(z.real[mark], z.imag[mark], "x", ms=5, mew=1.2, color=colour,
                             label="model at f_n" if r == 0 and label == traces[1][0] else None)
         ax.set_aspect("equal", adjustable="datalim")
-        detail = ", ".join(([f"ch {ch}"] if frf.n_channels > 1 else []) + (["flagged"] if _serious(mode) else []))
+        detail = ", ".join(([f"ch {ch + 1}"] if frf.n_channels > 1 else []) + (["flagged"] if _serious(mode) else []))
         ax.set_title(f"mode {r + 1}: {mode.natural_frequency_hz:.4g} Hz" + (f"\n{detail}" if detail else ""),
                      fontsize="small")
         ax.xaxis.set_major_locator(MaxNLocator(3))

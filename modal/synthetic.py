@@ -54,6 +54,8 @@ def modal_frf(
         Receptance residual terms: upper U (m/N, stiffness line), lower L (1/kg,
         mass line).
     response_points, reference_points : sequence of str, optional
+        Point ids per channel; a channel whose two ids are equal is a driving point. Without them
+        :func:`modal.identify` gives no k, c, m unless told which channel is a driving point.
     """
     freq = np.asarray(frequency_hz, dtype=float)
     fn = positive("natural_frequency_hz", natural_frequency_hz)
@@ -88,13 +90,17 @@ def modal_frf(
 
 def sdof_frf(frequency_hz, mass_kg: float, stiffness_n_per_m: float, damping_n_s_per_m: float,
              kind: str = "receptance") -> FRF:
-    """Driving-point FRF of a single mass–spring–damper, ``1/(k − mω² + icω)`` times (iω)**p."""
+    """Driving-point FRF of a single mass–spring–damper, ``1/(k − mω² + icω)`` times (iω)**p.
+
+    Its point ids say so (response and reference point ``"1"``), so that :func:`modal.identify`
+    gives k, c, m.
+    """
     m = positive("mass_kg", mass_kg)[0]
     k = positive("stiffness_n_per_m", stiffness_n_per_m)[0]
     c = float(non_negative("damping_n_s_per_m", damping_n_s_per_m)[0])
     omega = np.asarray(frequency_hz, dtype=float) * TWO_PI
     h = 1.0 / (k - m * omega**2 + 1j * c * omega) * kind_factor(omega, kind)
-    return FRF(frequency_hz, h, kind=kind, source="<synthetic>")
+    return FRF(frequency_hz, h, kind=kind, response_points=["1"], reference_points=["1"], source="<synthetic>")
 
 
 def matrix_frf(frequency_hz, mass, damping, stiffness, response_dofs=None, reference_dof: int = 0,

@@ -8,6 +8,7 @@ under the same names and calls :func:`plan_time_frf` (when the scene is checked)
 """
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, replace
 from typing import Callable
 
@@ -15,11 +16,14 @@ from .errors import FormatError
 from .estimate import estimate_frf
 from .frf import DEFAULT_UNITS, FRF_KINDS
 
-__all__ = ["TIME_OPTIONS", "wants_time", "frf_from_time", "TimePlan", "plan_time_frf", "estimate_time_frf"]
+__all__ = ["TIME_OPTIONS", "wants_time", "frf_from_time", "TimePlan", "plan_time_frf", "estimate_time_frf",
+           "point_ids"]
 
 #: the attribute names the time options set (None when not given)
 TIME_OPTIONS = ("excitation", "response", "impact", "estimator", "window", "exponential_decay_s", "segment_length",
                 "overlap")
+#: the numbering of repeated channel names in a time record (``1+Z#4``)
+_NUMBERED = re.compile(r"#\d+$")
 _KIND_OF_QUANTITY = {"displacement": "receptance", "velocity": "mobility", "acceleration": "accelerance"}
 
 
@@ -138,6 +142,7 @@ def estimate_time_frf(record, plan: TimePlan, args):
     """The FRFs of ``record`` as ``plan`` says, with the estimation options of ``args`` (an EstimatedFRF)."""
     inputs, outputs = list(plan.inputs), list(plan.outputs)
     window = args.window or ("force" if args.impact else "hann")
+    points = point_ids([record.names[k] for k in inputs + outputs])
     estimate = estimate_frf(
         record.signals[inputs], record.signals[outputs], record.sample_rate_hz,
         estimator=args.estimator or "H1", kind=plan.kind, segment_length=args.segment_length,
@@ -146,8 +151,36 @@ def estimate_time_frf(record, plan: TimePlan, args):
         response_quantity=plan.quantity, excitation_points=[record.names[k] for k in inputs],
         response_points=[record.names[k] for k in outputs], source=record.source,
         full_scale=None if record.full_scale is None else [record.full_scale[k] for k in inputs + outputs])
+    if points is None:  # names, not point ids: they do not say where the force and the responses stood
+        estimate = replace(estimate, reference_points=None)
+    else:
+        forces, responses = points[:len(inputs)], points[len(inputs):]  # channels as estimate_frf orders them
+        estimate = replace(estimate, reference_points=[f for _ in responses for f in forces],
+                           response_points=[r for r in responses for _ in forces])
     units = _ratio_units(record, plan)
     return estimate if units is None else replace(estimate, units=units)
+
+
+def point_ids(names) -> list[str] | None:
+    """The channels' names as point ids (``"101+Z"``), or None when one is not a point id with a direction.
+
+    A time file's channel names are point ids only when they say a node and a direction (UFF 58 records
+    do; a CSV column or a MAT/HDF5 ``names`` entry may): only then does an excitation and a response
+    of the same id make a driving point. The numbering ``#k`` that tells repeated ids apart in a record
+    (:func:`modal.io.timedata.read_time`) is dropped, so that a force and a response at one point match.
+    """
+    from .io.uff import format_point, parse_point
+
+    ids = []
+    for name in names:
+        try:
+            node, direction = parse_point(_NUMBERED.sub("", str(name)))
+        except ValueError:
+            return None
+        if direction == 0:
+            return None
+        ids.append(format_point(node, direction))
+    return ids
 
 
 def _ratio_units(record, plan: TimePlan) -> str | None:

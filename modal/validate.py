@@ -13,7 +13,7 @@ import numpy as np
 
 from .errors import ParameterError
 
-__all__ = ["positive", "non_negative", "per_channel", "per_line", "positive_number", "one_of", "finite_samples"]
+__all__ = ["positive", "non_negative", "per_channel", "per_line", "positive_number", "one_of", "finite_samples", "channel_mask"]
 
 
 def _where(source: str | None) -> str:
@@ -87,3 +87,27 @@ def finite_samples(signal, name: str, source: str, block: int = 2**22) -> None:
                 f"{source}: field {name!r} has a non-finite sample at channel {ch + 1}, sample {first + i}; "
                 "expected finite numbers"
             )
+
+
+def channel_mask(name: str, value, n_channels: int, error: type[Exception] = ParameterError) -> np.ndarray:
+    """Channels chosen by ``value`` as a boolean mask of ``n_channels``.
+
+    ``value``: a bool (every channel, or none), one bool per channel, or channel indices (0-based, an int
+    or a sequence of ints); an index outside ``0..n_channels - 1`` is refused naming the valid range.
+    """
+    arr = np.asarray(value)
+    if arr.dtype == bool:
+        if arr.size not in (1, n_channels) or arr.ndim > 1:
+            raise error(f"'{name}' has {arr.size} values; expected one bool, one per channel ({n_channels}) or "
+                        f"channel indices 0..{n_channels - 1}")
+        return np.broadcast_to(arr.reshape(-1), (n_channels,)).copy()
+    if arr.ndim > 1 or arr.size == 0 or arr.dtype.kind not in "iu":
+        raise error(f"'{name}' = {value!r}: expected a bool, one bool per channel ({n_channels}) or channel "
+                    f"indices 0..{n_channels - 1}")
+    indices = arr.reshape(-1)
+    bad = indices[(indices < 0) | (indices >= n_channels)]
+    if bad.size:
+        raise error(f"'{name}': no channel {int(bad[0])}; expected channel indices 0..{n_channels - 1}")
+    mask = np.zeros(n_channels, bool)
+    mask[indices] = True
+    return mask

@@ -13,6 +13,7 @@ from matplotlib.lines import Line2D
 
 from modal import identify
 from modal.errors import FormatError, ModalError
+from modal.flags import INFORMATIONAL
 from modal.io import read_frf
 from modal.plots import MAX_DRAWN_CHANNELS, model_response, plot_fit
 from modal.synthetic import add_noise, modal_frf
@@ -259,25 +260,39 @@ def test_contradictions_are_detected():
 
 # ---- item 9: --driving-point, and the assumption shown in the table --------------------------------------------
 
-def test_driving_point_option_and_assumption_in_table(tmp_path):
-    declared = run("modal", "fit", *REAL, "--frequency-step", "1", "--kind", "accelerance", "--driving-point", "0",
+def test_driving_point_option_and_unknown_driving_point_in_table(tmp_path):
+    declared = run("modal", "fit", *REAL, "--frequency-step", "1", "--kind", "accelerance", "--driving-point", "1",
                    "--json")
     assert declared.returncode == 0, declared.stderr
     import json
 
-    rows = json.loads(declared.stdout)["modes"]
-    assert {r["channel"] for r in rows if r["driving_point"]} == {0}
-    assert any(r["stiffness_n_per_m"] is not None for r in rows if r["channel"] == 0)
-    assert all(r["stiffness_n_per_m"] is None for r in rows if r["channel"] != 0)
-    bad = run("modal", "fit", *REAL, "--frequency-step", "1", "--kind", "accelerance", "--driving-point", "7")
-    assert bad.returncode == 1 and "--driving-point 7: no such channel" in bad.stderr
+    doc = json.loads(declared.stdout)
+    rows = doc["modes"]
+    # channels counted from 1 on the command line and in its output
+    assert {r["channel"] for r in rows} == {1, 2, 3}
+    assert {r["channel"] for r in rows if r["driving_point"]} == {1}
+    assert doc["driving_point"] == {"known_from": "declared", "channels": [1]}
+    assert any(r["stiffness_n_per_m"] is not None for r in rows if r["channel"] == 1)
+    assert all(r["stiffness_n_per_m"] is None for r in rows if r["channel"] != 1)
+    for wrong in ("0", "4"):
+        bad = run("modal", "fit", *REAL, "--frequency-step", "1", "--kind", "accelerance", "--driving-point", wrong)
+        assert bad.returncode == 1 and f"--driving-point {wrong}: no such channel; expected a channel number 1..3" \
+            in bad.stderr, bad.stderr
     frf = modal_frf(np.linspace(20, 300, 801), [100.0], [0.02], [1.0], kind="receptance")
     from modal.io import write_frf
 
-    write_frf(add_noise(frf, 1e-4, seed=2), tmp_path / "plain.csv")  # no point ids: a driving point is assumed
+    write_frf(add_noise(frf, 1e-4, seed=2), tmp_path / "plain.csv")  # no point ids: nothing says where it was
     table = run("modal", "fit", tmp_path / "plain.csv")
     assert table.returncode == 0, table.stderr
-    assert "driving_point_assumed" in table.stdout
+    assert "driving_point_unknown" in table.stdout and "not_driving_point" not in table.stdout
+    assert "k, c, m: n/a, the driving point is unknown" in table.stdout and "--driving-point" in table.stdout
+    unknown = json.loads(run("modal", "fit", tmp_path / "plain.csv", "--json").stdout)
+    assert unknown["driving_point"]["known_from"] == "unknown" and unknown["driving_point"]["channels"] == []
+    assert "--driving-point" in unknown["driving_point"]["how_to_declare"]
+    assert all(r["stiffness_n_per_m"] is None and r["mass_kg"] is None for r in unknown["modes"])
+    plot = run("modal", "fit", tmp_path / "plain.csv", "--plot", tmp_path / "p.png", "--channel", "2")
+    assert plot.returncode == 1 and "--channel 2: no such channel; expected 1..1" in plot.stderr
+    assert not (tmp_path / "p.png").exists()
 
 
 # ---- item 7: temporaries of killed writers are cleaned, errors name the target ------------------------------------
@@ -396,6 +411,7 @@ kind = "accelerance"
 
 [identify]
 method = "nls"
+driving_point = 1           # the file holds no point ids: declared, counted from 1
 {accept}
 
 [rotor]
@@ -427,7 +443,7 @@ def _beam_flags():
     frf = read_frf(REAL[0], frequency_step=1.0, kind="accelerance")
     from modal.flags import INFORMATIONAL
 
-    return [sorted(set(m.flags) - INFORMATIONAL) for m in _identify(frf)]
+    return [sorted(set(m.flags) - INFORMATIONAL) for m in _identify_driving(frf, "nls")]
 
 
 def test_scene_refuses_a_flagged_mode_and_says_which_mode_it_used(tmp_path):
@@ -490,7 +506,7 @@ def test_flagged_models_and_modes_are_labelled_in_the_plot():
     labels = {line.get_label() for line in fig.axes[0].get_lines()}
     n = len(results[1].modes)
     assert f"model (circle; {n} of {n} modes flagged)" in labels, labels
-    nls_flagged = [m for m in results[0].modes if set(m.flags) - {"driving_point_assumed", "not_driving_point"}]
+    nls_flagged = [m for m in results[0].modes if set(m.flags) - INFORMATIONAL]
     assert any(label.startswith("model (nls") for label in labels)
     titles = [ax.get_title() for ax in fig.axes[2:]]
     assert sum(t.endswith("flagged") for t in titles) == len(nls_flagged)  # the titles follow the first result

@@ -62,6 +62,7 @@ def _fraction(v):
         raise ValueError("a fraction 0 <= f < 1")
     return v
 
+
 def _channel_name(v):
     """A channel as ``modal oma`` names it: its number counted from 1 in the file's order, or its name."""
     if isinstance(v, bool) or not isinstance(v, (int, str)) or (isinstance(v, int) and v < 1) or v == "":
@@ -74,6 +75,24 @@ def _added_masses(v):
     if not isinstance(v, dict) or not v:
         raise ValueError("a table {channel = kg, ...} of the added masses (channels numbered from 1, or names)")
     return {_channel_name(k): POS(kg) for k, kg in v.items()}
+
+
+def _channel_number(v):
+    """A channel counted from 1 (as the command line and the results table number them)."""
+    if isinstance(v, bool) or not isinstance(v, int) or v < 1:
+        raise ValueError("a channel number counted from 1")
+    return v
+
+
+def _channels(v):
+    """Channels by number (counted from 1) or response point id: one, or a list of them."""
+    def one(x):
+        if isinstance(x, str) and x.strip():
+            return x
+        if isinstance(x, bool) or not isinstance(x, int) or x < 1:
+            raise ValueError("a channel number counted from 1 or a response point id, or a list of them")
+        return x
+    return list_of(one)(v) if isinstance(v, list) else one(v)
 
 
 def _radius(v):
@@ -177,7 +196,8 @@ REGISTRY: dict[str, Stage] = {stage.name: stage for stage in (
         "identify", run=f"{_STAGES}:stage_identify", needs=("frf",), depends=("frf",),
         config={"identify": {
             "method": choice("nls", "circle", "halfpower"), "bands_hz": list_of(list_of(NONNEG, length=2)),
-            "channel": INT, "min_prominence_db": POS, "max_modes": INT, "accept_flagged": BOOL,
+            "channel": _channel_number, "driving_point": _channels, "min_prominence_db": POS, "max_modes": INT,
+            "accept_flagged": BOOL,
         }},
         figures=f"{_PLOTS}:identify_figures", plot_inputs=("frf", "identify"),
         plot_modules=("modal.plots", "modal.flags"),

@@ -107,7 +107,7 @@ def describe_mode(identified, ref: Reference, scene: Scene) -> str:
     mode = identified[ref.mode - 1]
     flags = _serious_flags(mode)
     return (f"mode {ref.mode} at {mode.natural_frequency_hz:.6g} Hz, zeta {100 * mode.damping_ratio:.4g} %, "
-            f"channel {_channel(identified, scene)}, flags: {', '.join(flags) or 'none'}"
+            f"channel {_channel(identified, scene) + 1}, flags: {', '.join(flags) or 'none'}"
             + (f" (accepted: {_test_section(scene)}.accept_flagged)" if flags else ""))
 
 
@@ -119,6 +119,8 @@ def _identified_mode(identified, ref: Reference, key: str, scene: Scene):
 
 
 def _channel(identified, scene: Scene) -> int:
+    """The 0-based channel references read: ``[identify] channel`` (counted from 1), else the first
+    driving point; ``[oma] channel`` for an operational test."""
     if _test_section(scene) == "oma":
         return _oma_channel(identified, scene)
     channel = scene.section("identify.channel")
@@ -127,9 +129,10 @@ def _channel(identified, scene: Scene) -> int:
     if channel is None:
         hits = np.flatnonzero(driving)
         return int(hits[0]) if hits.size else 0
-    if not 0 <= channel < driving.size:
-        raise SceneError(f"{scene.source}: key 'identify.channel' = {channel}: expected 0..{driving.size - 1}")
-    return channel
+    if not 1 <= channel <= driving.size:
+        raise SceneError(f"{scene.source}: key 'identify.channel' = {channel}: no such channel; expected "
+                         f"1..{driving.size}")
+    return channel - 1
 
 
 def _oma_channel(identified, scene: Scene) -> int:
@@ -167,8 +170,12 @@ def resolve(value, key: str, scene: Scene, identified=None, drive=None) -> float
                              "k, c, m; expected oma.mass_change and oma.added_mass_kg (a second record with known "
                              "masses added) to scale its modes")
         if not math.isfinite(number):
+            unknown = "driving_point_unknown" in mode.flags
             raise SceneError(f"{scene.source}: key '{key}' = {value.text!r} is not defined for that channel "
-                             f"(flags: {', '.join(mode.flags) or 'none'}); choose a driving-point channel")
+                             f"(flags: {', '.join(mode.flags) or 'none'}); "
+                             + ("the FRF does not say which channel was measured at the excitation point: declare "
+                                "it with driving_point = CHANNEL under [identify] (counted from 1)" if unknown
+                                else "choose a driving-point channel"))
         return number
     handover = getattr(drive, "handover", None)
     if handover is None:
@@ -314,7 +321,18 @@ def stage_identify(scene: Scene, frf: modal.FRF) -> modal.IdentificationResult:
     """Identify the modes of the FRF."""
     cfg = scene.section("identify", {})
     bands = [tuple(b) for b in cfg["bands_hz"]] if "bands_hz" in cfg else None
-    return modal.identify(frf, cfg.get("method", "nls"), bands_hz=bands,
+    driving = None
+    if "driving_point" in cfg:
+        from modal.errors import ModalError
+        from modal.fitting import driving_channels
+
+        declared = cfg["driving_point"] if isinstance(cfg["driving_point"], list) else [cfg["driving_point"]]
+        try:
+            driving = driving_channels(frf, declared, option="key 'identify.driving_point' =",
+                                       where=f"{scene.source}: ")
+        except ModalError as exc:
+            raise SceneError(str(exc)) from None
+    return modal.identify(frf, cfg.get("method", "nls"), bands_hz=bands, driving_point=driving,
                           min_prominence_db=cfg.get("min_prominence_db", 6.0), max_modes=cfg.get("max_modes"))
 
 

@@ -33,7 +33,8 @@ from .records import BatchInfo, Entry, FileFit
 __all__ = ["PartStore", "TABLE_COLUMNS", "table_text", "parse_table", "write_table", "write_batch_archive",
            "parts_folder"]
 
-#: Columns of the batch table (one row per file, method, mode and channel).
+#: Columns of the batch table (one row per file, method, mode and channel; channels counted from 1, as
+#: ``modal fit`` numbers them and ``--driving-point`` names them).
 TABLE_COLUMNS = ("file", "method", "mode", "channel", "natural_frequency_hz", "std_natural_frequency_hz",
                  "damping_ratio", "std_damping_ratio", "stiffness_n_per_m", "std_stiffness_n_per_m",
                  "damping_n_s_per_m", "std_damping_n_s_per_m", "mass_kg", "std_mass_kg", "flags")
@@ -56,12 +57,12 @@ def _cell(value) -> str:
 
 def table_text(results) -> str:
     """The batch table's rows of one file as CSV lines without the ``file`` column (numbers at full
-    precision, empty where not defined)."""
+    precision, empty where not defined; channels counted from 1)."""
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
     for result in results:
         for row in result.rows():
-            cells = [row["method"], row["mode"], row["channel"]]
+            cells = [row["method"], row["mode"], row["channel"] + 1]
             for name in _STD_NAMES:
                 cells += [float(row[name]), float(row["std"][name])]
             cells.append(" ".join(row["flags"]))

@@ -370,8 +370,8 @@ def identify_global(frf: FRF, *, modes_hz=None, order: int | None = None, max_or
         Band to fit, Hz (default: all lines above 0 Hz).
     noise_std : float or array_like over channels, optional
         Known noise σ per channel (default: the FRF's own ``noise_std`` or the estimate).
-    driving_point : bool or array_like of bool, optional
-        Overrides which channels are driving points.
+    driving_point : bool, array_like of bool or channel indices, optional
+        Declares which channels are driving points (:func:`modal.assemble.driving_points`).
     """
     src = frf.source
     power = KIND_POWER[frf.kind]
@@ -506,11 +506,11 @@ def identify_global(frf: FRF, *, modes_hz=None, order: int | None = None, max_or
             int(work.n_freq), 2 * zeta * fn / spacing if spacing > 0 else np.nan, flags, chi2=chi2,
             quality=pole.n_stable_orders / max(pole.n_orders, 1), mode_shape=shapes[0] if single else shapes,
             participation=np.asarray(pole.participation), mpc=mode_mpc))
-    driving, assumed = driving_points(work, driving_point)
+    driving, known = driving_points(work, driving_point)
     # complexity is judged by the shapes' MPC (complex_shape), not by a driving point's phase; the global
     # fit does not take an exponential window's damping out of the poles
     modes = assemble_modes(estimates, method="global", source=src, single=single, driving=driving,
-                           driving_assumed=assumed, phase_check=False)
+                           driving_known=known, phase_check=False)
     settings = {"orders": [int(orders[0]), int(orders[-1])], "references": [str(r) for r in references],
                 "transposed_by_reciprocity": bool(transposed),
                 "band_hz": [float(work.frequency_hz[0]), float(work.frequency_hz[-1])],

@@ -155,7 +155,7 @@ def mode_rows(result, shapes: ModeShapes | None) -> list[dict]:
             "damping": _pm(100 * mode.damping_ratio, 100 * getattr(std, "damping_ratio", np.nan), 4),
             "mpc": _fmt(value, digits=3), "mpd": _fmt(mpd[number - 1], "°", 3),
             "k": _pm(k, sk), "c": _pm(c, sc, 4), "m": _pm(m, sm),
-            "kcm_channel": "—" if ch is None else str(ch),
+            "kcm_channel": "—" if ch is None else str(ch + 1),  # counted from 1, as the command line counts
             "flags": tuple(getattr(mode, "flags", ())),
         })
     return rows

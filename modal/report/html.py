@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..flags import INFORMATIONAL
 from .content import ReportContent, flag_legend, mode_rows, report_content
 from .payload import frf_payload, shapes_payload, stabilisation_payload, to_json
 
@@ -28,7 +29,6 @@ __all__ = ["build_report", "write_report", "SECTIONS"]
 SECTIONS = (("glance", "The test at a glance"), ("modes", "Modes"), ("frf", "FRFs and the fitted models"),
             ("stabilisation", "Stabilisation diagram"), ("mac", "MAC"), ("shapes", "Mode shapes"),
             ("scene", "Scene results"))
-_INFORMATIONAL = {"driving_point_assumed", "not_driving_point"}
 _CSP = "default-src 'none'; img-src data:; style-src 'unsafe-inline'; script-src 'unsafe-inline'"
 
 
@@ -55,7 +55,7 @@ def _table(header, rows, classes=None) -> str:
 def _flags_html(flags) -> str:
     if not flags:
         return "—"
-    return "".join(f'<span class="flag{" info" if f in _INFORMATIONAL else ""}" title="{_e(f)}">{_e(f)}</span>'
+    return "".join(f'<span class="flag{" info" if f in INFORMATIONAL else ""}" title="{_e(f)}">{_e(f)}</span>'
                    for f in flags)
 
 

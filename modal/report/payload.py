@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..estimate.core import EstimatedFRF
+from ..flags import INFORMATIONAL
 from ..frf import FRF
 from ..geometry import Geometry
 from ..shapes import ModeShapes, mean_phase_deviation_deg, mpc, normalise
@@ -125,7 +126,7 @@ def frf_payload(frf: FRF, results) -> dict:
                         "coherence": None if coherence is None else np.mean(coherence, axis=0)[idx]})
     for ch in channels:
         idx = drawn_lines(np.abs(H[ch]))
-        label = f"channel {ch}"
+        label = f"channel {ch + 1}"  # counted from 1, as the command line counts
         if frf.response_points is not None:
             ref = frf.reference_points[ch] if frf.reference_points is not None else "?"
             label += f" ({frf.response_points[ch]} / {ref})"
@@ -164,7 +165,7 @@ def stabilisation_payload(frf: FRF | None, result) -> dict | None:
     out = {"method": result.method, "f": np.asarray(diagram.frequency_hz, float),
            "order": np.asarray(diagram.order, float), "cls": code.astype(float), "classes": list(STABILITY_CLASSES),
            "modes": [float(m.natural_frequency_hz) for m in result.modes],
-           "flagged": [bool(set(getattr(m, "flags", ())) - {"driving_point_assumed", "not_driving_point"})
+           "flagged": [bool(set(getattr(m, "flags", ())) - INFORMATIONAL)
                        for m in result.modes]}
     if frf is not None:
         rms = np.sqrt(np.mean(np.abs(frf.channels) ** 2, axis=0))
@@ -190,7 +191,7 @@ def shapes_payload(shapes: ModeShapes, geometry: Geometry | None) -> dict:
         "lines": [int(i) for i in lines],
         "entry_node": [int(i) for i in placed.node_index(placed.channel_node)],
         "entry_dir": placed.channel_direction.ravel(),
-        "points": list(shapes.points) if shapes.points is not None else [f"channel {c}" for c in shapes.channels],
+        "points": list(shapes.points) if shapes.points is not None else [f"channel {c + 1}" for c in shapes.channels],
         "modes": [{"f": float(f), "zeta": float(z), "flags": list(fl), "mpc": float(p), "mpd": float(d),
                    "re": row.real, "im": row.imag}
                   for f, z, fl, p, d, row in zip(shapes.natural_frequency_hz, shapes.damping_ratio,

@@ -17,16 +17,20 @@ def _pm(value: float, std: float, fmt: str) -> str:
 
 
 def format_table(result: IdentificationResult, point_ids: list[str] | None = None) -> str:
-    """A readable table of modes per channel.
+    """A readable table of modes per channel (channels numbered from 1, as the command line names them).
 
     Columns: frequency (Hz), damping (%), modal constant (1/kg), k (N/m),
-    c (N s/m), m (kg), each with its standard error, and the flags.
+    c (N s/m), m (kg), each with its standard error, and the flags. When no channel is known to be a
+    driving point (flag ``driving_point_unknown``) a last line says why k, c, m are missing and how to
+    declare the driving point.
     """
+    from ..flags import FLAG_ACTION
+
     rows = result.rows()
     lines = [f"method: {result.method}   kind: {result.kind}   modes: {len(result)}   channels: {result.n_channels}"]
     header = f"{'mode':>4}  {'f_n [Hz]':>22}  {'zeta [%]':>20}  {'A [1/kg]':>26}  {'k [N/m]':>20}  {'c [N s/m]':>20}  {'m [kg]':>20}  flags"
     for ch in range(result.n_channels):
-        label = f"channel {ch}" + (f" ({point_ids[ch]})" if point_ids else "")
+        label = f"channel {ch + 1}" + (f" ({point_ids[ch]})" if point_ids else "")
         lines += ["", label, header]
         for row in (r for r in rows if r["channel"] == ch):
             std = row["std"]
@@ -40,6 +44,9 @@ def format_table(result: IdentificationResult, point_ids: list[str] | None = Non
                 f"{_pm(row['damping_n_s_per_m'], std['damping_n_s_per_m'], '.4g'):>20}  "
                 f"{_pm(row['mass_kg'], std['mass_kg'], '.5g'):>20}  {flags}"
             )
+    if any("driving_point_unknown" in mode.flags for mode in result.modes):
+        lines += ["", "k, c, m: n/a, the driving point is unknown (no point ids say which channel was measured at "
+                      "the excitation point); " + FLAG_ACTION["driving_point_unknown"]]
     return "\n".join(lines)
 
 

@@ -51,8 +51,8 @@ def identify_bands(frf, method: str, bands, *, raw_noise: np.ndarray, noise_std=
         The raw-data noise estimate per channel (:func:`modal.peaks.estimate_noise_std`).
     noise_std : float or array_like over channels, optional
         Known noise σ per channel (finite, >= 0); default: the FRF's own per line, else ``raw_noise``.
-    driving_point : bool or array_like of bool, optional
-        Overrides which channels are driving points.
+    driving_point : bool, array_like of bool or channel indices, optional
+        Declares which channels are driving points (:func:`modal.assemble.driving_points`).
     """
     power = KIND_POWER[frf.kind]
     n_ch = frf.n_channels
@@ -75,9 +75,9 @@ def identify_bands(frf, method: str, bands, *, raw_noise: np.ndarray, noise_std=
                                                 f"zeta {missing_mode.damping_ratio:.3g})")
         if any(b is not band and band.low_hz < b.peak_hz < band.high_hz for b in bands):
             estimate.flags.add("close_modes")  # another mode's peak inside this mode's band
-    driving, assumed = driving_points(frf, driving_point)
+    driving, known = driving_points(frf, driving_point)
     modes = assemble_modes(estimates, method=method, source=frf.source, single=frf.response.ndim == 1,
-                           driving=driving, driving_assumed=assumed,
+                           driving=driving, driving_known=known,
                            window_decay_s=frf.exponential_decay_s)
     return IdentificationResult(modes, method, frf.kind, n_ch, noise_std=estimated_noise)
 

@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 from modal.assemble import ModeEstimate, assemble_modes, driving_points
-from modal.errors import QualityWarning, ResolutionWarning
-from modal.flags import FLAG_TEXT, REL_STD_LIMIT
+from modal.errors import IdentificationError, QualityWarning, ResolutionWarning
+from modal.flags import FLAG_ACTION, FLAG_TEXT, REL_STD_LIMIT
 from modal.frf import FRF
 from modal.units import TWO_PI
 from modal.window_damping import remove_window_damping
@@ -90,7 +90,7 @@ def test_one_warning_per_flagged_mode_naming_every_flag_and_pointing_at_the_call
         warnings.simplefilter("always")
         assemble([estimate(flags={"resolution_limited", "missing_mode"}, details=details),
                   estimate(300.0, flags={"method_bias"})])
-        assemble([estimate(400.0)], driving_assumed=True)  # informational flags only: no warning
+        assemble([estimate(400.0)], driving=(False,), driving_known=False)  # informational flags only: no warning
     assert [w.category for w in caught] == [ResolutionWarning, QualityWarning]
     text = str(caught[0].message)
     assert text.startswith("x.uff: test mode near 100 Hz is flagged (")
@@ -101,13 +101,29 @@ def test_one_warning_per_flagged_mode_naming_every_flag_and_pointing_at_the_call
 
 def test_driving_points_from_the_point_ids_or_the_caller():
     f = np.linspace(1.0, 10.0, 5)
-    driving, assumed = driving_points(FRF(f, np.ones(5)))
-    assert driving.tolist() == [True] and assumed  # one channel without point ids: taken as a driving point
+    # one channel without point ids: nothing says it is a driving point, and nothing assumes it
+    driving, known = driving_points(FRF(f, np.ones(5)))
+    assert driving.tolist() == [False] and not known
+    driving, known = driving_points(FRF(f, np.ones(5)), True)  # declared
+    assert driving.tolist() == [True] and known
     two = FRF(f, np.ones((2, 5)), response_points=["1", "2"], reference_points="1")
-    driving, assumed = driving_points(two)
-    assert driving.tolist() == [True, False] and not assumed
-    driving, assumed = driving_points(two, [False, True])
-    assert driving.tolist() == [False, True] and not assumed
+    driving, known = driving_points(two)
+    assert driving.tolist() == [True, False] and known
+    driving, known = driving_points(two, [False, True])
+    assert driving.tolist() == [False, True] and known
+    driving, known = driving_points(two, 1)  # a 0-based channel index
+    assert driving.tolist() == [False, True] and known
+    with pytest.raises(IdentificationError, match=r"no channel 2; expected channel indices 0\.\.1"):
+        driving_points(two, [2])
+
+
+def test_without_a_known_driving_point_no_channel_gets_k_c_m_and_the_mode_says_how_to_declare_one():
+    (mode,) = assemble([estimate(const=(0.5,))], driving=(False,), driving_known=False)
+    assert np.isnan(mode.mass_kg) and np.isnan(mode.stiffness_n_per_m) and np.isnan(mode.std.mass_kg)
+    # the one flag that says why: not "not_driving_point", which would claim a transfer FRF
+    assert mode.flags == ("driving_point_unknown",) and mode.ok
+    assert "--driving-point" in FLAG_ACTION["driving_point_unknown"]
+    assert "driving_point" in FLAG_ACTION["driving_point_unknown"].split("--driving-point")[1]
 
 
 def test_an_output_only_method_hands_over_shapes_and_gets_the_shared_rules_without_k_c_m():

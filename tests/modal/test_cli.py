@@ -105,7 +105,7 @@ def test_real_beam_files_and_time_data_refused():
     out = run("fit", *beams, "--frequency-step", "1", "--kind", "accelerance", "--band", "40", "60", "--json")
     assert out.returncode == 0, out.stderr
     rows = json.loads(out.stdout)["modes"]
-    assert {row["channel"] for row in rows} == {0, 1, 2}
+    assert {row["channel"] for row in rows} == {1, 2, 3}  # counted from 1
     assert abs(rows[0]["natural_frequency_hz"] / 51.5 - 1) < 1e-3  # LSCF value, 0.1 %
     time_file = real / "pyuff_MPSTD_Set001_2024_10_08_10_27_07.uff"
     refused = run("fit", time_file)

@@ -13,7 +13,9 @@ def test_single_and_multi_channel_shapes():
     assert single.n_channels == 1 and single.response.shape == (5,) and single.channels.shape == (1, 5)
     assert multi.n_channels == 3 and multi.channels.shape == (3, 5)
     assert multi.is_driving_point().tolist() == [True, False, False]
-    assert single.is_driving_point().tolist() == [True]  # single channel without ids: assumed
+    # a single channel without point ids: nothing says it is a driving point, and nothing assumes it
+    assert single.is_driving_point().tolist() == [False] and not single.driving_point_known
+    assert multi.driving_point_known
 
 
 def test_arrays_are_read_only():

@@ -35,7 +35,7 @@ def test_exact_sdof_all_methods(kind, zeta):
     assert abs(nls.damping_ratio / zeta - 1) < 1e-9
     for value, truth in ((nls.stiffness_n_per_m, k), (nls.damping_n_s_per_m, c), (nls.mass_kg, m)):
         assert abs(value / truth - 1) < 1e-6
-    assert nls.flags == ("driving_point_assumed",)
+    assert nls.flags == ()  # sdof_frf says it is a driving point (its point ids)
     circle = identify(frf, "circle")[0]
     # the mobility circle is exact for viscous damping and the angle fit recovers the pole:
     # only rounding remains, eps amplified by the band's conditioning ~1/ζ (2e-13 at ζ = 1e-3;
@@ -47,7 +47,7 @@ def test_exact_sdof_all_methods(kind, zeta):
     hp = identify(frf5, "halfpower")[0]
     # dB interpolation + refined peak + exact inversion: ~L^-3 error, 5e-3 at L = 5 (numerics.md §1)
     assert abs(hp.damping_ratio / zeta - 1) < 5e-3
-    assert hp.flags == ("driving_point_assumed",)
+    assert hp.flags == ()
 
 
 @pytest.mark.parametrize("kind", KINDS)
@@ -102,7 +102,8 @@ def test_matrix_system_multichannel_driving_and_transfer():
 def test_results_do_not_depend_on_units():
     frf, fn, m, k, c = sdof_case("mobility", 0.02, 6)
     base = identify(add_noise(frf, 0.005, seed=4))[0]
-    scaled_frf = modal.FRF(frf.frequency_hz * 1e3, add_noise(frf, 0.005, seed=4).response * 1e6, kind="mobility")
+    scaled_frf = modal.FRF(frf.frequency_hz * 1e3, add_noise(frf, 0.005, seed=4).response * 1e6, kind="mobility",
+                             response_points=frf.response_points, reference_points=frf.reference_points)
     scaled = identify(scaled_frf)[0]
     assert abs(scaled.damping_ratio / base.damping_ratio - 1) < 1e-8
     assert abs(scaled.natural_frequency_hz / (1e3 * base.natural_frequency_hz) - 1) < 1e-10
@@ -160,7 +161,7 @@ def test_linear_solves_do_not_depend_on_the_units(method):
     scaled = modal.FRF(f * 1e3, frf.response * 1e-6, kind=frf.kind)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", modal.ModalWarning)
-        base, other = identify(frf, method), identify(scaled, method)
+        base, other = (identify(x, method, driving_point=True) for x in (frf, scaled))
     for a, b in zip(base, other):
         # receptance A' = s_h s_f² A = A here: the same masses, up to rounding and LM paths
         assert abs(b.mass_kg / a.mass_kg - 1) < 1e-9

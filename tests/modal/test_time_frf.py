@@ -9,13 +9,13 @@ from support.timedata import DigitalModes
 FS = 512.0
 
 
-def _time_csv(path, seed=0, n=2**14):
+def _time_csv(path, seed=0, n=2**14, names=("force", "tip")):
     rng = np.random.default_rng(seed)
     force = rng.standard_normal(n)
     plant = DigitalModes(np.array([40.0]), np.array([0.03]), np.array([[1.0]]), FS)
     displacement = plant.respond(force)[0]
     table = np.column_stack([np.arange(n) / FS, force, displacement])
-    np.savetxt(path, table, delimiter=",", header="time [s],force [N],tip [m]", comments="")
+    np.savetxt(path, table, delimiter=",", header=f"time [s],{names[0]} [N],{names[1]} [m]", comments="")
     return path
 
 
@@ -51,3 +51,21 @@ def test_the_frf_unit_is_what_the_channels_were_recorded_in(tmp_path):
     (tmp_path / "unknown.csv").write_text(text.replace("tip [m]", "tip [counts]"))
     estimate = frf_from_time(tmp_path / "unknown.csv", FitOptions(kind="receptance").namespace())[0]
     assert estimate.units == "counts/N"
+
+def test_k_c_m_of_a_time_record_only_where_its_point_ids_or_the_user_say_where_the_response_was(tmp_path):
+    import pytest
+
+    # column names that are not point ids ("force", "tip") do not say where the hammer and the sensor stood:
+    # not a transfer FRF (no not_driving_point), not a driving point either
+    unknown = fit_path(_time_csv(tmp_path / "names.csv"), FitOptions(method="nls")).results[0].modes[0]
+    assert unknown.flags == ("driving_point_unknown",) and np.isnan(unknown.mass_kg)
+    # declared by channel number (counted from 1) or by the response's name: the plant's 1 kg comes back
+    # within 3 standard errors (the leakage bias of the Hann-windowed H1 estimate is far below its scatter)
+    for declared in (("1",), ("tip",)):
+        mode = fit_path(tmp_path / "names.csv", FitOptions(method="nls", driving_point=declared)).results[0].modes[0]
+        assert mode.flags == () and mode.mass_kg == pytest.approx(1.0, abs=3 * mode.std.mass_kg)
+    # point ids in the names: force and response at 3+Z make a driving point, 3+Z -> 4+Z a transfer FRF
+    same = fit_path(_time_csv(tmp_path / "same.csv", names=("3+Z", "3+Z")), FitOptions(method="nls"))
+    assert same.results[0].modes[0].flags == () and np.isfinite(same.results[0].modes[0].mass_kg)
+    other = fit_path(_time_csv(tmp_path / "other.csv", names=("3+Z", "4+Z")), FitOptions(method="nls"))
+    assert other.results[0].modes[0].flags == ("not_driving_point",)

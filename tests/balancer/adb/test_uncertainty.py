@@ -59,7 +59,7 @@ def _monte_carlo():
     thresholds, correlated, independent = [], [], []
     for seed in range(N_SEEDS):
         with warnings.catch_warnings():
-            warnings.simplefilter("ignore", ModalWarning)  # driving_point_assumed
+            warnings.simplefilter("ignore", ModalWarning)  # a noisy draw may be flagged: the scatter is the subject
             mode = modal.identify(add_noise(clean, NOISE, seed=seed), "nls")[0]
         params = ADBParameters.from_identified(mode, **BALLS)
         thresholds.append(_threshold(params, nominal))

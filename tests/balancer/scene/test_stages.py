@@ -129,3 +129,36 @@ def test_time_options_belong_to_a_time_record(tmp_path):
 
     with pytest.raises(SceneError, match="key 'frf.impact' applies to a time record"):
         parse_scene(scene(frf={**SYNTH_FRF, "impact": True}, outputs={"tables": ["frf"]}), source="s.toml")
+
+def test_a_file_without_point_ids_gives_k_c_M_once_its_driving_point_is_declared(tmp_path):
+    import numpy as np
+    import pytest
+
+    from balancer.scene.schema import parse_scene
+    from modal.errors import SceneError
+    from modal.io import write_frf
+    from modal.synthetic import add_noise, modal_frf
+
+    # a driving-point accelerance saved without point ids: nothing in the file says where the response was
+    truth = modal_frf(np.linspace(0.25, 200.0, 800), [15.6, 120.0], [0.05, 0.02], [0.96, 0.35], kind="accelerance")
+    write_frf(add_noise(truth, 0.002, seed=5), tmp_path / "plain.csv")
+    rotor = {"M": "identified:mode1.mass", "k": "identified:mode1.stiffness", "c": "identified:mode1.damping",
+             "e": 0.0005}
+
+    def run(identify):
+        config = scene(frf={"file": "plain.csv"}, identify=identify, rotor=rotor, adb=ADB, outputs={"tables": ["rotor"]})
+        return run_scene(parse_scene(config, source=str(tmp_path / "s.toml"), folder=tmp_path))
+
+    with pytest.raises(SceneError, match=r"declare it with driving_point = CHANNEL under \[identify\] \(counted "
+                                         r"from 1\)"):
+        run({"method": "nls"})
+    with pytest.raises(SceneError, match=r"'identify.driving_point' = 2: no such channel; expected a channel "
+                                         r"number 1\.\.1"):
+        run({"method": "nls", "driving_point": 2})
+    with pytest.raises(SceneError, match=r"'identify.channel' = 0: .*counted from 1"):
+        run({"method": "nls", "driving_point": 1, "channel": 0})
+    done = run({"method": "nls", "driving_point": 1, "channel": 1})
+    mode = done.results["identify"].modes[0]
+    assert done.results["rotor"].params.k == mode.stiffness_n_per_m
+    # the modal mass of the first mode, 1/0.96 kg, within 3 of its standard errors
+    assert abs(mode.mass_kg - 1 / 0.96) < 3 * mode.std.mass_kg

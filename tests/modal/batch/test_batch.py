@@ -342,3 +342,23 @@ def test_find_files_recurses_skips_hidden_and_the_outputs(tmp_path):
         fit_files(tmp_path, methd="nls")
     with pytest.raises(ParameterError, match="no FRF file found"):
         fit_files(tmp_path / "empty*")
+
+
+def test_a_file_without_point_ids_gets_no_k_c_m_unless_its_driving_point_is_declared():
+    # the beam's second file is a transfer FRF (hammer at point 2, response at point 1) and says nothing of
+    # its points: k and m made from it would be numbers without meaning, so the table leaves them empty
+    from support.paths import REAL
+
+    from modal.batch.store import parse_table
+    from modal.batch.task import fit_one
+    from modal.fitting import FitOptions
+
+    path = str(REAL / "pyuff_meas_point_2.txt")
+    options = dict(method="nls", frequency_step=1.0, kind="accelerance", bands_hz=((270.0, 290.0),))
+    rows = parse_table(path, fit_one(path, FitOptions(**options)).table)
+    assert len(rows) == 1 and rows[0]["channel"] == 1  # channels counted from 1, as --driving-point names them
+    assert np.isnan(rows[0]["stiffness_n_per_m"]) and np.isnan(rows[0]["mass_kg"])
+    assert rows[0]["flags"].split() == ["driving_point_unknown"]
+    # declared (--driving-point 1), the same file's channel gets them
+    rows = parse_table(path, fit_one(path, FitOptions(**options, driving_point=("1",))).table)
+    assert rows[0]["stiffness_n_per_m"] > 0 and rows[0]["mass_kg"] > 0 and "driving_point" not in rows[0]["flags"]

@@ -193,7 +193,7 @@ def test_cli_global_on_the_real_beam_with_a_stabilisation_plot(tmp_path):
                          capture_output=True, text=True, cwd=ROOT, env={**os.environ, "MPLBACKEND": "Agg"}, timeout=120)
     assert out.returncode == 0, out.stderr
     rows = json.loads(out.stdout)["modes"]
-    assert {row["method"] for row in rows} == {"global"} and {row["channel"] for row in rows} == {0, 1, 2}
+    assert {row["method"] for row in rows} == {"global"} and {row["channel"] for row in rows} == {1, 2, 3}  # counted from 1
     found = np.array(sorted({row["natural_frequency_hz"] for row in rows}))
     assert all(np.min(np.abs(found / f - 1)) < 5e-4 for f in BEAM_HZ)
     assert plot.exists()

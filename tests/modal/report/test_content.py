@@ -29,14 +29,14 @@ def test_mode_rows_carry_the_results_numbers(fitted):
     mode = result[0]
     assert rows[0]["frequency"] == f"{mode.natural_frequency_hz:.6g} ± {mode.std.natural_frequency_hz:.2g}"
     k = float(np.atleast_1d(mode.stiffness_n_per_m)[0])
-    assert rows[0]["k"].startswith(f"{k:.5g} ± ") and rows[0]["kcm_channel"] == "0"  # channel 0 is the driving point
+    assert rows[0]["k"].startswith(f"{k:.5g} ± ") and rows[0]["kcm_channel"] == "1"  # the first channel (counted from 1) is the driving point
     assert float(rows[0]["mpc"]) == pytest.approx(1.0, abs=1e-3)  # real modal constants (noise 0.2 %)
 
 
 def test_flag_legend_says_what_each_flag_means_and_what_to_do(fitted):
     _, result = fitted
     legend = dict((f, (text, action)) for f, text, action in flag_legend([result]))
-    assert "not_driving_point" in legend  # channel 1 is a transfer FRF
+    assert "not_driving_point" in legend  # the second channel is a transfer FRF
     assert legend["not_driving_point"][1] == FLAG_ACTION["not_driving_point"]
 
 

@@ -162,4 +162,4 @@ def test_a_neighbour_moved_by_a_missing_mode_is_flagged_too():
         warnings.simplefilter("ignore", modal.ModalWarning)
         strong = identify(frf, bands_hz=bands)[1]
     assert abs(strong.damping_ratio - zeta) < 3 * strong.std.damping_ratio
-    assert not set(strong.flags) - {"driving_point_assumed"}
+    assert not set(strong.flags) - {"driving_point_unknown"}

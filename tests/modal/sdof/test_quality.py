@@ -19,7 +19,7 @@ def test_single_mode_methods_next_to_another_mode(method):
     # (circle ζ -0.35 %, m +0.7 %: 17 and 22 of their errors before the check)
     frf = modal_frf(np.linspace(50, 400, 3501), [100.0, 150.0], [0.02, 0.02], [1.0, 1.0])
     with pytest.warns(QualityWarning, match="method_bias"):
-        result = identify(frf, method)
+        result = identify(frf, method, driving_point=True)
     assert len(result) == 2
     w1, w2 = 100.0**2, 150.0**2
     for mode, fn in zip(result, (100.0, 150.0)):
@@ -96,7 +96,8 @@ def test_halfpower_constant_biased_along_its_magnitude_is_flagged():
         bands.append((max(low, f[0]), min(high, f[-1])))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", modal.ModalWarning)
-        mode = identify(modal_frf(f, fn, zeta, constants, kind="mobility"), "halfpower", bands_hz=bands)[0]
+        mode = identify(modal_frf(f, fn, zeta, constants, kind="mobility"), "halfpower", bands_hz=bands,
+                        driving_point=True)[0]
     mass = 1 / constants[0]
     assert abs(mode.mass_kg / mass - 1) > 1e-5  # the method's bias is there ...
     assert "method_bias" in mode.flags  # ... and said
