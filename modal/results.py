@@ -178,17 +178,29 @@ class IdentificationResult:
         Parameters
         ----------
         frequency_hz : array_like
-            Lines, Hz (> 0 where the model has a lower residual term).
+            Lines, Hz (>= 0), for example the fitted FRF's own axis with its 0 Hz line.
 
         Returns
         -------
         FRF
-            Of this result's kind, one channel per channel of the fitted FRF.
+            Of this result's kind, one channel per channel of the fitted FRF. On a 0 Hz line the
+            model's limit: the lower residual (mass line, ``-L/omega**2`` in receptance) of an accelerance
+            tends to ``L`` there.
+
+        Raises
+        ------
+        ParameterError
+            A negative or non-finite line, or a 0 Hz line where the model has no finite limit: the
+            mass line of a receptance or mobility grows without bound towards 0 Hz.
         """
+        from .errors import ParameterError
         from .frf import FRF, KIND_POWER
         from .model import mode_basis
 
         freq = np.asarray(frequency_hz, float)
+        if not np.all(np.isfinite(freq)) or np.any(freq < 0):
+            raise ParameterError("synthesize: 'frequency_hz' holds a negative or non-finite line; expected lines "
+                                 ">= 0 Hz")
         omega = freq * TWO_PI
         power = KIND_POWER[self.kind]
         total = np.zeros((self.n_channels, freq.size), complex)
@@ -198,9 +210,17 @@ class IdentificationResult:
             total += const[:, None] * phi[None, :]
         if self.residuals is not None:
             upper, lower = np.asarray(self.residuals, complex).T
-            with np.errstate(divide="ignore", invalid="ignore"):
-                kind = (1j * omega) ** power
-                total += upper[:, None] * kind[None, :] - lower[:, None] * (kind / omega**2)[None, :]
+            # (i omega)**p / omega**2 = i**p omega**(p - 2): for an accelerance (p = 2) the constant -1 on
+            # every line, 0 Hz included; below p = 2 it has no finite value at 0 Hz
+            mass_line = np.zeros(freq.size, complex)
+            positive = omega > 0
+            mass_line[positive] = 1j**power * omega[positive] ** (power - 2)
+            if power == 2:
+                mass_line[~positive] = -1.0
+            elif (~positive).any() and np.any(lower != 0):
+                raise ParameterError(f"synthesize: the {self.kind} model's lower residual (mass line) has no finite "
+                                     "value at 0 Hz; expected lines above 0 Hz (frequency_hz[frequency_hz > 0])")
+            total += upper[:, None] * ((1j * omega) ** power)[None, :] - lower[:, None] * mass_line[None, :]
         return FRF(freq, total[0] if self.n_channels == 1 else total, kind=self.kind,
                    source=f"synthesised ({self.method})")
 

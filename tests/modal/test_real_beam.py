@@ -65,3 +65,23 @@ def test_no_model_inadequate_fatigue_on_the_real_files(method):
         assert len(result) >= 5
         for mode in result:
             assert "model_inadequate" not in mode.flags, (path.name, mode.natural_frequency_hz, mode.flags)
+
+
+def test_the_model_is_synthesised_on_the_measured_axis_with_its_0_hz_line():
+    """The file's axis starts at 0 Hz; the global fit's lower residual (mass line, -L/omega**2 in receptance) is
+    constant in accelerance, so the model has a finite 0 Hz line: the limit of the lines above it."""
+    from support.paths import REAL
+
+    frf = modal.read_frf(REAL / "pyuff_meas_point_1.txt", frequency_step=1.0, kind="accelerance")
+    assert frf.frequency_hz[0] == 0.0
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ModalWarning)
+        result = modal.identify(frf, "global")
+    assert result.residuals is not None and np.any(result.residuals[:, 1] != 0)
+    model = result.synthesize(frf.frequency_hz)
+    assert model.n_freq == frf.n_freq and np.all(np.isfinite(model.response))
+    near_zero = result.synthesize([1e-6, 2e-6]).response[0]
+    # the modes' share of an accelerance goes as omega**2: at 1e-6 Hz it is ~1e-12 of their size near 1 Hz
+    assert model.response[0] == pytest.approx(near_zero, rel=1e-9, abs=1e-12)
+    # the lines above 0 Hz are what they were when synthesised on their own
+    assert np.allclose(model.response[1:], result.synthesize(frf.frequency_hz[1:]).response, rtol=1e-12, atol=0)

@@ -63,3 +63,19 @@ def test_physical_covariance_is_the_first_order_propagation():
     np.testing.assert_allclose(got, jac @ cov @ jac.T, rtol=1e-8)
     (_, _, _), stds = physical_parameters(theta[0], theta[1], theta[2] + 1j * theta[3], cov)
     np.testing.assert_allclose(np.array(stds, float), np.sqrt(np.diag(got)), rtol=1e-15)
+
+
+def test_a_mass_line_without_a_finite_0_hz_value_is_refused_there_and_kept_elsewhere():
+    from dataclasses import replace
+
+    from modal.errors import ParameterError
+
+    frf = modal_frf(np.linspace(0.0, 200.0, 401), [100.0], [0.02], [1.0], kind="mobility")
+    result = replace(identify(frf.cropped(50.0, 150.0), "nls"), residuals=np.array([[1e-6, 2.0]]))
+    with pytest.raises(ParameterError, match="mobility model's lower residual .* no finite value at 0 Hz"):
+        result.synthesize(frf.frequency_hz)
+    above = result.synthesize(frf.frequency_hz[1:])
+    # the mass line of a mobility: -L (i omega) / omega**2 = -i L / omega
+    omega = frf.frequency_hz[1:] * 2 * np.pi
+    no_residual = replace(result, residuals=None).synthesize(frf.frequency_hz[1:])
+    assert np.allclose(above.response - no_residual.response, 1e-6 * 1j * omega - 2.0j / omega, rtol=1e-12, atol=0)
