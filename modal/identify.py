@@ -121,6 +121,26 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
         noise_std = per_channel("noise_std", noise_std, frf.n_channels, IdentificationError)
     if driving_point is not None:
         driving_point = channel_mask("driving_point", driving_point, frf.n_channels, IdentificationError)
+    result = _identify(frf, method, bands_hz, noise_std, driving_point, min_prominence_db, max_modes, global_options)
+    _check_kind(frf, result, driving_point)
+    return result
+
+
+def _check_kind(frf: FRF, result: IdentificationResult, driving_point) -> None:
+    """Warn when the data contradict the declared kind (:func:`modal.kind_check.kind_contradiction`)."""
+    from .errors import QualityWarning, warn_caller
+    from .kind_check import kind_contradiction
+
+    driving = driving_point if driving_point is not None else (frf.is_driving_point() if frf.driving_point_known
+                                                               else None)
+    message = kind_contradiction(frf, result.modes, driving)
+    if message is not None:
+        warn_caller(f"{frf.source}: {message}", QualityWarning)
+
+
+def _identify(frf: FRF, method: str, bands_hz, noise_std, driving_point, min_prominence_db: float,
+              max_modes: int | None, global_options: dict) -> IdentificationResult:
+    """:func:`identify` after its arguments are checked."""
     from .scaling import scale_exponent, scaled_frf, unscale_result
 
     # |H| once: the mode indicator and each channel's max |H|, and (but for the global method, which measures
@@ -133,10 +153,9 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
     exponent = scale_exponent(frf, peak=indicator[1])
     if exponent:  # values near over- or underflow: fit 2**e H (exact) and scale the results back
         gain = 2.0**exponent
-        result = identify(scaled_frf(frf, exponent), method, bands_hz,
-                          noise_std=None if noise_std is None else noise_std * gain,
-                          driving_point=driving_point, min_prominence_db=min_prominence_db, max_modes=max_modes,
-                          **global_options)
+        result = _identify(scaled_frf(frf, exponent), method, bands_hz,
+                           None if noise_std is None else noise_std * gain, driving_point, min_prominence_db,
+                           max_modes, global_options)
         return unscale_result(result, gain)
     found = None  # peak bands the automatic choice already searched
     if method == "auto":  # chosen on the (possibly rescaled) data, so the choice never overflows
