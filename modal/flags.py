@@ -174,10 +174,12 @@ GRID_FLAGS = frozenset({"resolution_limited", "missing_crossing", "too_few_point
 RESOLUTION_FLAGS = GRID_FLAGS | {"outside_band"}
 #: Flags :func:`modal.assemble.assemble_modes` raises by its shared rules (a result assembled again, as by
 #: mass-change scaling or merging setups, starts from the method's own flags without these).
-RULE_FLAGS = frozenset({"high_uncertainty", "close_modes", "driving_point_assumed", "window_damping_dominates",
+RULE_FLAGS = frozenset({"high_uncertainty", "close_modes", "driving_point_unknown", "window_damping_dominates",
                         "complex_mode", "non_positive_constant", "not_driving_point"})
-#: Flags that describe the setting, not a defect (``ModeResult.ok`` ignores them).
-INFORMATIONAL = frozenset({"driving_point_unknown", "not_driving_point"})
+#: Flags that describe the setting, not a defect (``ModeResult.ok`` ignores them). ``driving_point_assumed``
+#: is no longer raised (k, c, m only where the driving point is known or declared) but archives written
+#: before still carry it, and read back their modes as they were judged then.
+INFORMATIONAL = frozenset({"driving_point_unknown", "not_driving_point", "driving_point_assumed"})
 #: Flags about a driving-point channel's constant (never on a transfer channel).
 DRIVING_POINT_ONLY = frozenset({"complex_mode", "non_positive_constant"})
 #: Flags about a transfer channel (never on a driving-point channel).

@@ -129,6 +129,8 @@ def test_an_archive_written_before_classes_moved_still_loads():
     old = back["identify"]
     assert [set(m.flags) - {"driving_point_assumed"} for m in old.modes] == [set(m.flags) for m in again.modes]
     assert all("driving_point_assumed" in m.flags for m in old.modes)
+    # that flag described the setting then, as it would now: the modes keep the verdict they were archived with
+    assert [m.ok for m in old.modes] == [m.ok for m in again.modes]
     from dataclasses import replace
 
     def numbers(result):
