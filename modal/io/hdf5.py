@@ -39,6 +39,8 @@ SCHEMA = "modalbal-archive"
 SCHEMA_VERSION = "1.0"
 #: Group under the root that holds one subgroup per FRF.
 FRF_GROUP = "frf"
+#: seconds a read may take before the file counts as damaged (libhdf5 looping on it)
+READ_TIMEOUT_S = 20.0
 
 
 def _h5py():
@@ -296,12 +298,13 @@ def read_frf_hdf5(path: str | os.PathLike, **hints: Any) -> FRF:
     """Read the FRF of an archive file (``dataset=`` names the group if there are several).
 
     The file is read in a forked child process: libhdf5 can loop forever on a damaged
-    file (found by fuzzing), which then ends in a FormatError after 20 s (a sound file of
-    1000 channels reads in 0.05 s).
+    file (found by fuzzing), which then ends in a FormatError after ``READ_TIMEOUT_S``
+    (a sound file of 1000 channels reads in 0.05 s).
     """
     from ._isolate import call_isolated
 
-    return call_isolated(_read_frf_hdf5_here, (path, hints), source_name(path), "HDF5 file", timeout_s=20.0)
+    return call_isolated(_read_frf_hdf5_here, (path, hints), source_name(path), "HDF5 file",
+                         timeout_s=READ_TIMEOUT_S)
 
 
 def _read_frf_hdf5_here(path: str | os.PathLike, hints: dict[str, Any]) -> FRF:
