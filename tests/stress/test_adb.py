@@ -101,6 +101,7 @@ ENERGY_ARGS = (adb_parameters(), log_uniform(1e-6, 1e-2), log_uniform(1e-6, 1.0)
 
 
 @pytest.mark.stress
+@pytest.mark.stress_quick
 @seed(STRESS_SEED)
 @STRESS
 @given(*ENERGY_ARGS)
@@ -201,6 +202,7 @@ def check_boundary(params: ADBParameters) -> None:
 
 
 @pytest.mark.stress
+@pytest.mark.stress_quick
 @seed(STRESS_SEED + 2)
 @STRESS
 @given(adb_parameters())

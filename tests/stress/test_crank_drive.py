@@ -87,6 +87,7 @@ SAMPLES = st.lists(st.tuples(st.floats(0.0, 1.0), st.floats(0.0, 1.0)), min_size
 
 
 @pytest.mark.stress
+@pytest.mark.stress_quick
 @seed(STRESS_SEED)
 @STRESS
 @given(mechanisms(), log_uniform(10.0, 3e4), st.sampled_from(OBJECTIVES), SAMPLES)
@@ -199,6 +200,7 @@ SPEED = log_uniform(1.0, 1e5)
 
 
 @pytest.mark.stress
+@pytest.mark.stress_quick
 @seed(STRESS_SEED + 1)
 @STRESS
 @given(stages(), SPEED, POWER, st.floats(1.0, 3.0))
@@ -224,6 +226,7 @@ def check_drive(geometries, efficiencies, speed, power) -> None:
 
 
 @pytest.mark.stress
+@pytest.mark.stress_quick
 @seed(STRESS_SEED + 2)
 @STRESS
 @given(st.lists(stages(), min_size=1, max_size=4), st.lists(st.floats(0.5, 1.0), min_size=4, max_size=4),
@@ -328,6 +331,7 @@ MASSES = st.lists(log_uniform(0.01, 1e3), min_size=5, max_size=5)
 
 
 @pytest.mark.stress
+@pytest.mark.stress_quick
 @seed(STRESS_SEED + 3)
 @STRESS
 @given(shafts(), log_uniform(0.005, 0.5), MASSES)

@@ -281,6 +281,7 @@ def check_halfpower(case: Case) -> None:
 
 
 @pytest.mark.stress
+@pytest.mark.stress_quick
 @seed(STRESS_SEED)
 @STRESS
 @given(cases())
@@ -295,6 +296,7 @@ def test_nls_finite_and_within_sigma_or_flagged(case):
 
 
 @pytest.mark.stress
+@pytest.mark.stress_quick
 @seed(STRESS_SEED + 1)
 @STRESS
 @given(cases())
@@ -309,6 +311,7 @@ def test_circle_finite_and_within_sigma_or_flagged(case):
 
 
 @pytest.mark.stress
+@pytest.mark.stress_quick
 @seed(STRESS_SEED + 2)
 @STRESS
 @given(cases())

@@ -216,6 +216,7 @@ def test_exact_optimum_beats_any_balance_fraction(lam, m_rot, m_rec, alpha):
 
 
 @pytest.mark.stress
+@pytest.mark.stress_quick
 @seed(int(os.environ.get("STRESS_SEED", "8")))
 @settings(max_examples=int(os.environ.get("STRESS_EXAMPLES", "500")), deadline=None, database=None)
 @given(**OPTIMUM_ARGS)
