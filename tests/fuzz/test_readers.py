@@ -697,3 +697,63 @@ except modal.ModalError as exc:
                           capture_output=True, text=True, timeout=60)
     assert proc.returncode == 0, proc.stderr[-500:]
     assert "FormatError" in proc.stdout, proc.stdout
+
+
+def _forked_reader(body) -> tuple[int, int]:
+    """A forked process in its own group running ``body(pipe)``, like the fuzzer's reader: (pid, read end)."""
+    read_end, write_end = os.pipe()
+    pid = os.fork()
+    if pid == 0:  # pragma: no cover - the child
+        os.setpgid(0, 0)
+        os.close(read_end)
+        try:
+            with os.fdopen(write_end, "w", encoding="utf-8") as pipe:
+                body(pipe)
+        finally:
+            os._exit(0)
+    os.close(write_end)
+    return pid, read_end
+
+
+@pytest.mark.skipif(not hasattr(os, "fork"), reason="the reader process is forked")
+def test_a_reader_that_dies_or_hangs_is_recorded_and_the_run_goes_on(monkeypatch):
+    import io
+
+    def dies(pipe):
+        pipe.write("S\t3\tbit_flips\n")
+        pipe.flush()
+        os.kill(os.getpid(), signal.SIGKILL)
+
+    out = io.StringIO()
+    pid, fd = _forked_reader(dies)
+    assert _watch(pid, fd, out, 10) == 4  # the next reader starts after the input that killed this one
+    assert "R\t3\tfinding\tprocess died (signal 9) reading the input" in out.getvalue()
+
+    def hangs(pipe):
+        pipe.write("S\t4\tinsert\nR\t4\tvalid\t\t\n")
+        helper = os.fork()  # like read_frf's own child, stuck in compiled code
+        if helper == 0:
+            time.sleep(60)
+            os._exit(0)
+        pipe.write(f"W\t{helper}\thelper\nS\t5\tdelete\n")
+        pipe.flush()
+        time.sleep(60)
+
+    monkeypatch.setitem(globals(), "TIME_LIMIT_S", 0.2)
+    out = io.StringIO()
+    pid, fd = _forked_reader(hangs)
+    start = time.monotonic()
+    assert _watch(pid, fd, out, 10) == 6
+    # killed 0.2 s (+1 s) after starting input 5, not after the helper's 60 s
+    assert time.monotonic() - start < 10
+    assert "R\t4\tvalid" in out.getvalue() and "R\t5\tfinding\thang: no result after 0.2 s" in out.getvalue()
+    helper = int(re.search(r"W\t(\d+)\thelper", out.getvalue()).group(1))
+    deadline = time.monotonic() + 5  # killed with the reader's group, then reaped by init
+    while time.monotonic() < deadline:
+        try:
+            os.kill(helper, 0)
+        except ProcessLookupError:
+            break
+        time.sleep(0.05)
+    else:
+        raise AssertionError(f"the reader's child {helper} outlived the hang")
