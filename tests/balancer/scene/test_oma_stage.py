@@ -71,7 +71,7 @@ def test_rotor_takes_k_c_m_from_a_mass_change_test(records):
     assert abs(rotor.params.M / m_true - 1) < 0.2
     assert abs(rotor.params.k / (m_true * w2[0]) - 1) < 0.2
     assert rotor.std.M > 0 and rotor.std.k > 0  # the operational test's errors are carried
-    assert "channel 1" in rotor.sources[0]  # 0-based in the sources, as for [identify]
+    assert "channel 2" in rotor.sources[0]  # numbered from 1 in the sources, as in the scene and for [identify]
 
 
 def test_an_operational_test_without_mass_change_gives_no_k_c_m(records):
