@@ -9,7 +9,8 @@ against a bare least-squares fit, 1000 channels against sdypy-EMA, the stability
 against numpy's eigenvalues, the demo scene against the import floor, a 100 000-line
 noisy FRF against a minute), identification against the Cramér–Rao bound over damping, noise
 and resolution (``bench_identify``), 1 and 1000 channels, the calibration of every
-method's standard errors (``bench_calibration``), file reading
+method's standard errors (``bench_calibration``) and of the whole chain from time
+records (``bench_chain``), file reading
 (``bench_io``), the counterweight optimiser against brute-force grids
 (``bench_crank``), the ball-balancer stability map and simulations against plain
 ``solve_ivp`` (``bench_adb``), batches of files on Dask against one process
@@ -523,6 +524,8 @@ def main(argv: list[str] | None = None) -> int:
     if "calibration" in wanted:
         sections.append(("Calibration of the standard errors (issue 21)",
                          run_module("bench_calibration", ["--seeds", "50" if args.quick else "200"])))
+        sections.append(("Calibration of the chain, time records to modes",
+                         run_module("bench_chain", ["--records", "20" if args.quick else "80", "--cells", "all"])))
     if "global" in wanted:
         sections.append(("Global identification (pLSCF + joint refinement) against sdypy-EMA",
                          run_module("bench_global", ["--runs", str(runs), "--seeds", "2" if args.quick else "5"])))
