@@ -115,6 +115,8 @@ CELLS = {c.name: c for c in [
     Cell("hammer-rect-6", "hammer, 6 hits of 4 s, rectangular window", hammer_cell(6, "rect", None)),
     Cell("hammer-exp-3", "hammer, 3 hits, exponential window τ = 0.5 s", hammer_cell(3)),
     Cell("hammer-exp-1", "hammer, 1 hit, exponential window τ = 0.5 s", hammer_cell(1)),
+    Cell("hammer-rect-1", "hammer, 1 hit, rectangular window (each hit of a repeated test on its own)",
+         hammer_cell(1, "rect", None)),
 ]}
 
 

@@ -13,6 +13,7 @@ from typing import Literal
 import numpy as np
 
 from .errors import FRFValidationError, ModalWarning, warn
+from .noise_model import NoiseModel
 from .units import TWO_PI
 from .validate import one_of, per_line, positive_number
 
@@ -96,6 +97,11 @@ class FRF:
         τ of an exponential window applied to the records the FRF was estimated from, s: every
         pole's real part is more negative by 1/τ, and :func:`modal.identify` takes that damping
         back out. None without such a window.
+    noise_model : NoiseModel, optional
+        What an estimate from time records knows about its errors beyond ``noise_std``: the
+        averages they rest on, the correlation of neighbouring lines and the lag window that
+        biases the estimate (:class:`modal.noise_model.NoiseModel`); :func:`modal.identify`
+        weights the lines with that correlation and takes the window's bias out. None when unknown.
 
     Attributes
     ----------
@@ -114,6 +120,7 @@ class FRF:
     _single: bool = field(default=False, repr=False)
     noise_std: np.ndarray | None = None
     exponential_decay_s: float | None = None
+    noise_model: NoiseModel | None = None
 
     def __post_init__(self) -> None:
         src = self.source
@@ -189,6 +196,16 @@ class FRF:
                 noise = noise[..., order]
             noise.setflags(write=False)
             object.__setattr__(self, "noise_std", noise)
+        if self.noise_model is not None:
+            if not isinstance(self.noise_model, NoiseModel):
+                raise FRFValidationError(f"{src}: field 'noise_model' is a {type(self.noise_model).__name__}; "
+                                         "expected a modal.noise_model.NoiseModel")
+            corr = self.noise_model.line_correlation
+            if corr is not None and corr.shape[1] != freq.size:
+                raise FRFValidationError(f"{src}: field 'noise_model' has a line correlation over {corr.shape[1]} "
+                                         f"lines; expected {freq.size} (one per line)")
+            if order is not None and corr is not None:  # the lines were reordered: neighbours are not neighbours
+                object.__setattr__(self, "noise_model", replace(self.noise_model, line_correlation=None))
         if self.exponential_decay_s is not None:
             object.__setattr__(self, "exponential_decay_s", positive_number(
                 "exponential_decay_s", self.exponential_decay_s, "time in s", FRFValidationError, src))
@@ -270,7 +287,8 @@ class FRF:
                 f"{self.source}: band {f_low_hz}–{f_high_hz} Hz holds {int(keep.sum())} lines, expected at least 2"
             )
         return replace(self, frequency_hz=self.frequency_hz[keep], response=self.response[..., keep],
-                       noise_std=None if self.noise_std is None else self.noise_std[..., keep])
+                       noise_std=None if self.noise_std is None else self.noise_std[..., keep],
+                       noise_model=None if self.noise_model is None else self.noise_model.cropped(keep))
 
     def channel(self, index: int) -> "FRF":
         """A single-channel FRF of channel ``index``."""

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["NLSFit", "RowResidual", "fit_modes", "orthonormal_factor", "truncation_shift"]
+__all__ = ["LineWhitening", "NLSFit", "RowResidual", "fit_modes", "orthonormal_factor", "truncation_shift"]
 
 
 @dataclass(frozen=True)
@@ -43,7 +43,8 @@ class NLSFit:
         max |H| of each channel over the lines, FRF unit (the fit works on each channel over it,
         or over 1 where it is 0).
     line_weighted : bool
-        The fit weighted its lines (``line_weight`` given): ``residual`` is the weighted one.
+        The fit weighted or whitened its lines (``line_weight`` or ``whitening`` given): ``residual`` is the
+        weighted (whitened) one.
     escaped : ndarray of bool, shape (n_modes,)
         The poles within the lines whose damping ratio grew past ``max_damping`` (the fit stopped there,
         not converged).
@@ -182,6 +183,58 @@ def _pole_covariance(F: np.ndarray) -> np.ndarray:
     return cov / scale
 
 
+#: the residual counts as correlated between lines when its Ljung–Box statistic over the lags exceeds the
+#: chi-square quantile of this tail probability (white residuals pass 99 % of the time)
+WHITENESS_P = 0.01
+
+
+def _residual_correlated(residual, lags: int, region) -> bool:
+    """Ljung–Box test of the (whitened) residual, pooled over channels: whether its lines correlate over
+    ``lags`` (then the sandwich covariance is used, else the Fisher information alone)."""
+    from scipy.stats import chi2
+
+    r = residual[:]  # (n_ch, n_freq)
+    n = r.shape[1]
+    lags = min(lags, n // 4)
+    if lags < 1:
+        return False
+    energy = float(np.vdot(r, r).real)
+    if not energy > 0:
+        return False
+    same = None if region is None else np.asarray(region)
+    statistic = 0.0
+    for lag in range(1, lags + 1):
+        product = r[:, :-lag].conj() * r[:, lag:]
+        if same is not None:
+            product = product[:, same[:-lag] == same[lag:]]
+        rho = product.sum() / energy  # complex: real and imaginary parts each ~ N(0, 1/(2n)) when white
+        statistic += 2 * n * n / (n - lag) * abs(rho) ** 2 * r.shape[0]
+    return bool(statistic > chi2.ppf(1 - WHITENESS_P, 2 * lags))
+
+
+def _line_scores(E, Cm, weights, residual, inverse_scale) -> np.ndarray:
+    """Each line's contribution 2 Σ_c w_c Re(conj(∂r/∂θ_j) r) to the gradient of the weighted cost, (n_theta, n_freq)."""
+    scaled = residual[:] * inverse_scale[:, None]  # (n_ch, n_freq), the fit's units
+    finite = np.where(np.isfinite(weights), weights, 0.0)
+    combined = (Cm.conj() * finite) @ scaled  # (n_theta, n_freq): Σ_c w_c conj(C_jc) r_ck
+    return 2.0 * np.real(E.conj().T * combined)
+
+
+def _lag_covariance(scores: np.ndarray, lags: int, region) -> np.ndarray:
+    """Σ_ℓ (1 − |ℓ|/(L + 1)) Σ_k s_k s_{k+ℓ}ᵀ over |ℓ| ≤ L, pairs of lines in one region only."""
+    out = scores @ scores.T
+    n = scores.shape[1]
+    same = None if region is None else np.asarray(region)
+    for lag in range(1, min(lags, n - 1) + 1):
+        left, right = scores[:, :-lag], scores[:, lag:]
+        if same is not None:
+            keep = same[:-lag] == same[lag:]
+            left, right = left[:, keep], right[:, keep]
+        product = left @ right.T
+        out += (1.0 - lag / (lags + 1.0)) * (product + product.T)
+    return out
+
+
 def _compress(rows: np.ndarray, scale: np.ndarray, probes: np.ndarray) -> np.ndarray:
     """Many channels: replace Y (n_freq, n_ch) by Y V with V (n_ch, k) orthonormal, where Y is
     ``rows`` (n_ch, n_freq) transposed with each channel times its ``scale``.
@@ -248,10 +301,15 @@ def _project(Phi, Y):
     return Q, R, QhY, float(np.vdot(res, res).real)
 
 
-def _fill_covariance(mode_cov, dphi, Q, R, Cm, noise_var) -> None:
+def _fill_covariance(mode_cov, dphi, Q, R, Cm, noise_var, correlated_lags=0, residual=None, region=None,
+                     inverse_scale=None) -> None:
     """Covariance of (ωn, ζ, Re c, Im c) per mode and channel, in the fit's units, into ``mode_cov``
     (n_modes, n_ch, 4, 4): the poles' from their Fisher information (the Schur complement, by the projected
-    Jacobian), the constants' from the linear fit's plus their sensitivity to the poles."""
+    Jacobian), the constants' from the linear fit's plus their sensitivity to the poles.
+
+    With ``correlated_lags`` > 0 and a ``residual`` (:class:`RowResidual`, FRF unit; ``inverse_scale`` takes
+    it to the fit's) whose lines a Ljung–Box test finds correlated over those lags, the poles' covariance is
+    the Newey–West sandwich F⁻¹ B F⁻¹ instead (see :func:`fit_modes`)."""
     n_theta = dphi.shape[1]
     n_modes = n_theta // 2
     E = dphi - Q @ (Q.conj().T @ dphi)
@@ -263,6 +321,15 @@ def _fill_covariance(mode_cov, dphi, Q, R, Cm, noise_var) -> None:
     cov_theta = np.full((n_theta, n_theta), np.nan)
     if np.all(np.isfinite(F)):
         cov_theta = _pole_covariance(F)
+        if correlated_lags > 0 and np.all(np.isfinite(cov_theta)) and _residual_correlated(
+                residual, correlated_lags, region):
+            n_freq = dphi.shape[0]
+            dof = n_freq - Q.shape[1] - n_theta / (2 * Cm.shape[1])
+            scores = _line_scores(E, Cm, weights, residual, inverse_scale)
+            middle = _lag_covariance(scores, correlated_lags, region) * (n_freq / dof if dof > 0 else np.nan)
+            sandwich = cov_theta @ middle @ cov_theta
+            if np.all(np.isfinite(sandwich)) and np.all(np.diag(sandwich) > 0):
+                cov_theta = sandwich
     elif np.all(noise_var == 0):
         cov_theta = np.zeros((n_theta, n_theta))
     # sensitivity of the linear coefficients to the poles: G_j = −Φ⁺ ∂Φ/∂θ_j C
@@ -291,7 +358,8 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
               region: np.ndarray | None = None, max_iter: int = 200, step_tol: float = 1e-13,
               background_powers: tuple[int, ...] = (0,), residual_terms: bool = False,
               line_weight: np.ndarray | None = None, channel_scale: np.ndarray | None = None,
-              max_damping: float | None = None, errors: bool = True) -> NLSFit:
+              max_damping: float | None = None, errors: bool = True,
+              whitening: LineWhitening | None = None, correlated_lags: int = 0) -> NLSFit:
     """Fit poles and modal constants of several modes to many channels at once.
 
     Parameters
@@ -338,6 +406,17 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
         there may pass through wide ones: it is left to go on (the caller judges where it converges).
     errors : bool
         Compute ``mode_cov`` (False: NaN; a fit whose poles only start another needs none).
+    whitening : LineWhitening, optional
+        Generalised least squares for errors correlated between lines: with the (weighted)
+        errors' correlation matrix R, W with W R Wᴴ = I; the fit minimises ‖W r‖², ``noise_var``
+        and the covariances are those of the whitened problem.
+    correlated_lags : int
+        0: the poles' covariance is the inverse Fisher information (independent lines). Else the
+        errors may correlate over this many neighbouring lines in ways no model gives (the leakage
+        of a lightly damped mode in windowed records): the covariance is the sandwich
+        F⁻¹ B F⁻¹ with B the lag-window (Bartlett) sum of the products of each line's score with
+        those of its neighbours within these lags, from the fit's own residual (Newey & West 1987),
+        when a Ljung–Box test finds the residual correlated over the lags.
     """
     omega = np.asarray(omega, float)
     rows = np.ascontiguousarray(np.atleast_2d(np.asarray(response, complex)))  # (n_ch, n_freq), the FRF's unit
@@ -373,6 +452,9 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
         weight = np.asarray(line_weight, float)[:, None]
         rows = rows * weight[:, 0]
         background = background * weight
+    if whitening is not None:
+        rows = np.ascontiguousarray(whitening(rows.T).T)
+        background = whitening(background)
     def design(p):
         Phi = np.empty((x.size, n_b), dtype=complex)
         Phi[:, n_modes:] = background
@@ -380,6 +462,9 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
         if weight is not None:  # the modes' columns (the background's are weighted once, above)
             Phi[:, :n_modes] *= weight
             dphi *= weight
+        if whitening is not None:
+            Phi[:, :n_modes] = whitening(Phi[:, :n_modes])
+            dphi = whitening(dphi)
         return Phi, dphi
 
     if n_ch > 2 * (2 * n_b + 8):  # many channels: fit on fewer combinations
@@ -492,7 +577,7 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
     Cm = C[mode_of]
     mode_cov = np.full((n_modes, n_ch, 4, 4), np.nan)
     if errors:
-        _fill_covariance(mode_cov, dphi, Q, R, Cm, noise_var)
+        _fill_covariance(mode_cov, dphi, Q, R, Cm, noise_var, correlated_lags, residual, region, inverse_scale)
     # back to physical units: x → ω = x w_ref; c → A = c · ch_scale · w_ref^(2−p)
     a_scale = ch_scale * w_ref ** (2 - power)  # (n_ch,)
     unit = np.empty((n_ch, 4))  # each channel's (ωn, ζ, Re A, Im A) per fitted unit
@@ -511,9 +596,61 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
         n_iter=n_iter,
         residual=residual,
         channel_scale=peak,
-        line_weighted=weight is not None,
+        line_weighted=weight is not None or whitening is not None,
         escaped=escaped,
     )
+
+
+#: a line correlation matrix that is not positive definite even when tapered (a correlation carried over a few
+#: lags only, or measured from few records) is blended towards the identity, (R + εI)/(1 + ε), ε from this up
+CORRELATION_RIDGE = 0.01
+#: a correlation carried over this many lags or more is tapered at once (cut off in its tail, it is rarely
+#: positive definite as it stands: the exponential window's)
+TAPER_FROM = 8
+
+
+class LineWhitening:
+    """Whitening of errors correlated between neighbouring lines: W = L⁻¹ for the banded Cholesky factor L
+    of their correlation matrix R = L Lᴴ (W R Wᴴ = I); ``whitening(X)`` is W X for X (n_lines, k).
+
+    Parameters
+    ----------
+    band : ndarray, shape (bandwidth + 1, n_lines)
+        R in LAPACK's lower banded storage, ``band[d, j] = R[j + d, j]``
+        (:meth:`modal.noise_model.NoiseModel.correlation_band`).
+    """
+
+    def __init__(self, band: np.ndarray):
+        from scipy.linalg import cholesky_banded
+
+        nonzero = np.flatnonzero(np.any(np.abs(band[1:]) > 0, axis=1))
+        bandwidth = int(nonzero[-1]) + 1 if nonzero.size else 0
+        band = np.asarray(band[:bandwidth + 1], complex)
+        # a correlation cut off after a few lags may be indefinite: then it is tapered (1 − d/(b + 1), which
+        # keeps a stationary correlation positive definite), and blended towards the identity if need be
+        taper = 1.0 - np.arange(bandwidth + 1)[:, None] / (bandwidth + 1.0)
+        attempts = [(band, 0.0)] if bandwidth < TAPER_FROM else []
+        attempts += [(band * taper, 0.0)]
+        attempts += [(band * taper, CORRELATION_RIDGE * 4.0**k) for k in range(8)]
+        for trial, ridge in attempts:
+            try:
+                shifted = trial.copy()
+                shifted[0] += ridge
+                self._factor = cholesky_banded(shifted / (1.0 + ridge), lower=True, check_finite=False)
+                break
+            except np.linalg.LinAlgError:
+                continue
+        else:
+            raise np.linalg.LinAlgError("the lines' correlation matrix is far from positive definite")
+        self.bandwidth = bandwidth
+        self.ridge = ridge
+
+    def __call__(self, values: np.ndarray) -> np.ndarray:
+        from scipy.linalg import solve_banded
+
+        if self.bandwidth == 0:
+            return values / self._factor[0][:, None] if values.ndim == 2 else values / self._factor[0]
+        return solve_banded((self.bandwidth, 0), self._factor, values)
 
 
 #: background powers of the check in :func:`truncation_shift`: offset, slope, curvature

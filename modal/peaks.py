@@ -120,6 +120,21 @@ def neighbour_noise_std(frequency: np.ndarray, values: np.ndarray) -> np.ndarray
     return _noise_from_medians(median, stencil)
 
 
+def neighbour_noise_rms(frequency: np.ndarray, values: np.ndarray) -> np.ndarray:
+    """:func:`neighbour_noise_std` from the mean of the misfit powers instead of their median: the RMS noise
+    over the lines when its level varies along them (a single hammer hit: noise on the force makes the FRF's
+    error proportional to |H|, large at the peaks). Use it on a fit's residual, where no curvature of the
+    signal is left to take for noise."""
+    values = np.atleast_2d(np.asarray(values, dtype=complex))
+    if values.shape[1] < 5:
+        return np.abs(values).max(axis=1) * np.nan
+    stencil = _stencil(frequency)
+    power = _misfit_power(frequency, values, stencil, scaled=False).mean(axis=1)
+    if stencil is None:
+        power *= EVEN_NORM
+    return np.sqrt(power)
+
+
 def estimate_noise_std(frf: FRF) -> np.ndarray:
     """Noise standard deviation per channel (E|n|² = σ²) of the raw data.
 

@@ -21,6 +21,7 @@ import numpy as np
 
 from ..errors import FRFValidationError, ParameterError, QualityWarning, warn
 from ..frf import FRF, FRF_KINDS, KIND_POWER
+from ..noise_model import NoiseModel, lag_window, lags_carried, window_line_correlation
 from ..validate import finite_samples, one_of, per_line, positive_number
 from . import spectra
 from .hits import find_hits
@@ -114,6 +115,7 @@ class EstimatedFRF(FRF):
                 f"{self.source}: band {f_low_hz}–{f_high_hz} Hz holds {int(keep.sum())} lines, expected at least 2"
             )
         return replace(self, frequency_hz=self.frequency_hz[keep], response=self.response[..., keep],
+                       noise_model=None if self.noise_model is None else self.noise_model.cropped(keep),
                        **self._per_line(keep))
 
     def channel(self, index: int) -> "EstimatedFRF":
@@ -142,6 +144,35 @@ def _as_signals(value, name: str, source: str):
             f"{source}: field {name!r} has shape {tuple(value.shape)}; expected (samples,) or (channels, samples)"
         )
     return value
+
+
+def _noise_model(sums, output_correlation, input_window, output_window, sample_rate_hz, overlap_factor,
+                 decay_s=None) -> NoiseModel:
+    """The estimate's :class:`~modal.noise_model.NoiseModel` from its sums and windows.
+
+    One input: the errors of lines k and k + m correlate by c_out(m) Σ conj(X_k) X_{k+m} / √(S_xx,k S_xx,k+m)
+    (the response noise's window correlation times the excitation's own, over the records), and the lag window
+    follows from the excitation's mean square per sample; an exponential window's decay is divided out of it
+    (identification removes that damping exactly). Several inputs: the averages only.
+    """
+    n_in = sums.sxx.shape[0]
+    dof = max(sums.n_records - n_in, 0) / overlap_factor
+    interval = 1.0 / sample_rate_hz
+    if sums.sxx_lag is None:
+        return NoiseModel(sums.n_records, dof, None, None, interval)
+    power = sums.sxx[0, 0].real
+    n_lags, n_lines = sums.sxx_lag.shape
+    correlation = np.zeros((n_lags, n_lines), complex)
+    for m in range(1, n_lags + 1):
+        with np.errstate(divide="ignore", invalid="ignore"):
+            value = output_correlation[m] * sums.sxx_lag[m - 1, :-m] / np.sqrt(power[:-m] * power[m:])
+        correlation[m - 1, :-m] = np.where(np.isfinite(value), value, 0.0)
+    magnitude = np.abs(correlation)
+    correlation = np.where(magnitude > 1, correlation / np.maximum(magnitude, 1e-300), correlation)
+    lags = lag_window(input_window, output_window, sums.excitation_square / sums.n_records)
+    if decay_s is not None:
+        lags = lags * np.exp(np.arange(lags.size) * interval / decay_s)
+    return NoiseModel(sums.n_records, dof, correlation, lags, interval)
 
 
 def _default_segment_length(n_samples: int) -> int:
@@ -301,7 +332,10 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
             warn(f"{source}: {item.describe(labels[item.channel])}: the spectra are distorted where it clipped; "
                  "lower the gain or the excitation level", QualityWarning)
 
-    sums = spectra.accumulate(x, y, starts, length, in_w, out_w)
+    output_correlation = window_line_correlation(out_w)
+    sums = spectra.accumulate(x, y, starts, length, in_w, out_w,
+                              lags=lags_carried(output_correlation, length // 2 + 1))
+    factor = spectra.overlap_variance_factor(out_w, step) if not impact else 1.0
     estimate = {"H1": spectra.h1, "H2": spectra.h2, "Hv": spectra.hv}[estimator]
     frf3, coherence3, multiple, variance3 = estimate(sums, source)
     n_out, n_in, n_lines = frf3.shape
@@ -310,8 +344,8 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
     coherence = coherence3.reshape(n_out * n_in, n_lines)
     noise = None
     if variance3 is not None:
-        factor = spectra.overlap_variance_factor(out_w, step) if not impact else 1.0
         noise = np.sqrt(variance3.reshape(n_out * n_in, n_lines) * factor)
+    model = _noise_model(sums, output_correlation, in_w, out_w, fs, factor, decay_s=exponential_decay_s)
 
     if response_quantity is not None:
         delta = KIND_POWER[kind] - RESPONSE_QUANTITIES[response_quantity]
@@ -324,6 +358,7 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
             multiple = multiple[:, keep]
             if noise is not None:
                 noise = noise[:, keep] * np.abs(scale)
+            model = model.cropped(keep)
 
     single = n_out * n_in == 1
     return EstimatedFRF(
@@ -341,6 +376,7 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
         estimator=estimator,
         window=window,
         exponential_decay_s=None if exponential_decay_s is None else float(exponential_decay_s),
+        noise_model=model,
         sample_rate_hz=fs,
         segment_length=length,
         overlap=0.0 if impact else float(overlap),

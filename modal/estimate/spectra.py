@@ -36,12 +36,18 @@ class SpectralSums:
     syx : ndarray, shape (n_outputs, n_inputs, n_lines)
     syy : ndarray, shape (n_outputs, n_lines)
     n_records : int
+    sxx_lag : ndarray, shape (n_lags, n_lines), optional
+        One input: ``Σ conj(X_k) X_{k+m}`` for m = 1 … n_lags (zero past the last line).
+    excitation_square : ndarray, shape (length,), optional
+        One input: Σ x[n]² over the records at each sample n of a record (unwindowed).
     """
 
     sxx: np.ndarray
     syx: np.ndarray
     syy: np.ndarray
     n_records: int
+    sxx_lag: np.ndarray | None = None
+    excitation_square: np.ndarray | None = None
 
 
 def _records(signal, starts: np.ndarray, length: int) -> np.ndarray:
@@ -53,7 +59,7 @@ def _records(signal, starts: np.ndarray, length: int) -> np.ndarray:
 
 
 def accumulate(excitation, response, starts, length: int, input_window: np.ndarray,
-               output_window: np.ndarray) -> SpectralSums:
+               output_window: np.ndarray, lags: int = 0) -> SpectralSums:
     """Sum the spectra of the records that start at ``starts``.
 
     Parameters
@@ -66,6 +72,9 @@ def accumulate(excitation, response, starts, length: int, input_window: np.ndarr
         Samples per record.
     input_window, output_window : ndarray, shape (length,)
         Weights applied to the excitation and response records.
+    lags : int
+        One input: also sum the products of each line with the ``lags`` lines above it
+        (``sxx_lag``) and the excitation's square at each sample (``excitation_square``).
     """
     starts = np.asarray(starts, dtype=np.int64)
     n_in, n_out = excitation.shape[0], response.shape[0]
@@ -73,17 +82,25 @@ def accumulate(excitation, response, starts, length: int, input_window: np.ndarr
     sxx = np.zeros((n_in, n_in, n_lines), complex)
     syx = np.zeros((n_out, n_in, n_lines), complex)
     syy = np.zeros((n_out, n_lines))
+    one_input = n_in == 1
+    sxx_lag = np.zeros((lags, n_lines), complex) if one_input else None
+    square = np.zeros(length) if one_input else None
     per_record = (n_in + n_out) * n_lines * 16 + (n_in + n_out) * length * 8
     block = max(1, int(_BLOCK_BYTES // max(per_record, 1)))
     for first in range(0, starts.size, block):
         chunk = starts[first:first + block]
-        x = np.fft.rfft(_records(excitation, chunk, length) * input_window, axis=-1)
+        raw = _records(excitation, chunk, length)
+        x = np.fft.rfft(raw * input_window, axis=-1)
         y = np.fft.rfft(_records(response, chunk, length) * output_window, axis=-1)
         xc = x.conj()
         sxx += np.einsum("isf,jsf->ijf", x, xc)
         syx += np.einsum("osf,isf->oif", y, xc)
         syy += np.einsum("osf,osf->of", y, y.conj()).real
-    return SpectralSums(sxx, syx, syy, int(starts.size))
+        if one_input:
+            square += np.einsum("sn,sn->n", raw[0], raw[0])
+            for m in range(1, min(lags, n_lines - 1) + 1):
+                sxx_lag[m - 1, :-m] += np.einsum("sf,sf->f", xc[0, :, :-m], x[0, :, m:])
+    return SpectralSums(sxx, syx, syy, int(starts.size), sxx_lag, square)
 
 
 def overlap_variance_factor(window: np.ndarray, step: int) -> float:

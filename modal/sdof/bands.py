@@ -10,11 +10,13 @@ from __future__ import annotations
 import numpy as np
 
 from ..model import mode_basis, solve_linear
+from ..nls import LineWhitening
 from ..peaks import ModeBand
 from ..units import TWO_PI
 
 __all__ = ["POLE_CHANNELS", "band_mask", "band_run", "band_lines", "regions", "band_data", "band_peaks",
-           "channel_weights", "strongest_channels", "band_noise", "line_weight", "constants_at_poles"]
+           "channel_weights", "strongest_channels", "band_noise", "line_weight", "line_whitening",
+           "constants_at_poles"]
 
 #: half-power and circle fits: the pole comes from at most this many strongest channels;
 #: the other channels' modal constants are solved linearly with that pole
@@ -97,6 +99,33 @@ def band_noise(frf, bands, line_noise):
     return np.sqrt(np.mean(line_noise[:, lines] ** 2, axis=1))
 
 
+#: the weights' noise level rests on at least this many degrees of freedom (relative error √(2/dof) = 0.2)
+NOISE_DOF_TARGET = 50
+#: ... averaged over at most this many lines
+MAX_SMOOTHING_LINES = 41
+
+
+def smoothing_lines(model) -> int:
+    """Odd number of neighbouring lines over which a noise variance of ``model.degrees_of_freedom`` is averaged
+    to reach :data:`NOISE_DOF_TARGET` (the lines' correlation counted), at most :data:`MAX_SMOOTHING_LINES`."""
+    lines = 1
+    while lines < MAX_SMOOTHING_LINES and (model.degrees_of_freedom * lines / model.smoothing_inflation(lines)
+                                           < NOISE_DOF_TARGET):
+        lines += 2
+    return lines
+
+
+def _smoothed(values: np.ndarray, lines: int) -> np.ndarray:
+    """Moving average over ``lines`` (odd) neighbouring lines, over fewer at the ends."""
+    if lines <= 1 or values.size < 2:
+        return values
+    half = lines // 2
+    total = np.concatenate([[0.0], np.cumsum(values)])
+    index = np.arange(values.size)
+    lo, hi = np.clip(index - half, 0, values.size), np.clip(index + half + 1, 0, values.size)
+    return (total[hi] - total[lo]) / (hi - lo)
+
+
 def line_weight(frf, bands):
     """Weights σ_ref/σ_line of the bands' lines for an FRF that carries its noise per line, else None.
 
@@ -105,16 +134,47 @@ def line_weight(frf, bands):
     An estimate's noise spikes at the zeros of the force spectrum (a 1 ms hammer pulse: 1, 2, 3 kHz);
     unweighted, those few lines pulled the 1450 and 2600 Hz poles of a hammer test to 1500 and 2500 Hz.
     A line claimed quieter than 1e-3 σ_ref counts as 1e-3 σ_ref (no line weighs more than 1000).
+    A noise level resting on few averages (its :class:`~modal.noise_model.NoiseModel` says how many degrees
+    of freedom) is averaged over neighbouring lines first (:func:`smoothing_lines`): weights from a variance
+    of 2 degrees of freedom scatter by a factor of ten between lines, and the fit then trusts a few lines
+    that came out quiet by chance.
     """
     line_noise = frf.noise_std
     if line_noise is None:
         return None
     keep, _ = regions(bands, frf.frequency_hz)
-    sigma = np.sqrt(np.mean(np.atleast_2d(np.asarray(line_noise, float))[:, keep] ** 2, axis=0))
+    variance = np.mean(np.atleast_2d(np.asarray(line_noise, float)) ** 2, axis=0)
+    model = frf.noise_model
+    if model is not None and 0 < model.degrees_of_freedom < NOISE_DOF_TARGET:
+        variance = _smoothed(variance, smoothing_lines(model))
+    sigma = np.sqrt(variance[keep])
     ref = float(np.sqrt(np.mean(sigma**2))) if sigma.size else 0.0
     if not (np.all(np.isfinite(sigma)) and ref > 0):
         return None
     return ref / np.maximum(sigma, 1e-3 * ref)
+
+
+def line_whitening(frf, bands):
+    """:class:`modal.nls.LineWhitening` of the bands' lines for an FRF whose noise model carries the
+    correlation of neighbouring lines (an estimate from time data), else None."""
+    model = frf.noise_model
+    if model is None or model.line_correlation is None or model.n_lags == 0 or frf.noise_std is None:
+        return None
+    keep, _ = regions(bands, frf.frequency_hz)
+    lines = np.flatnonzero(keep)
+    key = (id(model), lines.size, hash(lines.tobytes()))
+    cached = _WHITENINGS.get(key)
+    if cached is not None and cached[0] is model:  # the same model and lines: the fits of one identify
+        return cached[1]
+    whitening = LineWhitening(model.correlation_band(lines))
+    if len(_WHITENINGS) >= 8:
+        _WHITENINGS.clear()
+    _WHITENINGS[key] = (model, whitening)
+    return whitening
+
+
+#: the last whitenings made (the fits of one identification share them), by noise model and lines
+_WHITENINGS: dict = {}
 
 
 def constants_at_poles(frf, bands, power, omega_n, damping_ratio):

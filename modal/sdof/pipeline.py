@@ -19,14 +19,14 @@ import numpy as np
 from ..assemble import ModeEstimate, assemble_modes, driving_points
 from ..flags import BIAS_LIMIT, model_inadequate
 from ..frf import KIND_POWER, line_spacing
-from ..peaks import channel_sample
+from ..peaks import channel_sample, neighbour_noise_rms
 from ..results import IdentificationResult
 from ..units import TWO_PI
 from .bands import POLE_CHANNELS, band_data, band_mask, band_noise, band_peaks, constants_at_poles, strongest_channels
 from .checks import fit_residual, fit_residual_noise_std
 from .estimates import bandwise_covariance, rescaled, sdof_estimates, without_neighbours
 from .quality import chi2_of, constant_distance, fit_noise, local_misfit, missing_mode_in_bands, refinement_check
-from .refine import nls_fit, truncation, with_shift
+from .refine import nls_fit, truncation, with_shift, without_window_bias
 
 __all__ = ["BANDWISE_METHODS", "identify_bands"]
 
@@ -66,8 +66,10 @@ def identify_bands(frf, method: str, bands, *, raw_noise: np.ndarray, noise_std=
     if method in ("halfpower", "circle"):
         estimates, missing_mode = _single_mode_fits(frf, bands, power, method, noise, estimated_noise, known_noise,
                                                     rescale=noise_std is None and not known_noise)
+        settings = {}
     else:
-        estimates, missing_mode = _least_squares_fits(frf, bands, power, noise, estimated_noise, known_noise)
+        estimates, missing_mode, note = _least_squares_fits(frf, bands, power, noise, estimated_noise, known_noise)
+        settings = {} if note is None else {"window_bias": note}
     for index, (band, estimate) in enumerate(zip(bands, estimates)):
         if missing_mode is not None and (missing_mode.band == index or index in missing_mode.moved_bands):
             estimate.flags.add("missing_mode")
@@ -79,7 +81,7 @@ def identify_bands(frf, method: str, bands, *, raw_noise: np.ndarray, noise_std=
     modes = assemble_modes(estimates, method=method, source=frf.source, single=frf.response.ndim == 1,
                            driving=driving, driving_known=known,
                            window_decay_s=frf.exponential_decay_s)
-    return IdentificationResult(modes, method, frf.kind, n_ch, noise_std=estimated_noise)
+    return IdentificationResult(modes, method, frf.kind, n_ch, noise_std=estimated_noise, settings=settings)
 
 
 def _estimate(frf, band, wn, zeta, const, cov, s_wn, s_z, flags, chi2, quality, reference=None) -> ModeEstimate:
@@ -172,11 +174,14 @@ def _single_mode_fits(frf, bands, power, method, noise, estimated_noise, known_n
 def _least_squares_fits(frf, bands, power, noise, estimated_noise, known_noise):
     """The joint least-squares fit of every band's mode (method ``"nls"``) and its checks.
 
-    Returns the modes' :class:`~modal.assemble.ModeEstimate` and the missing mode found, or None.
+    Returns the modes' :class:`~modal.assemble.ModeEstimate`, the missing mode found (or None), and what was
+    done about the window's bias of an estimate from time records (a sentence, or None).
     """
     data = band_data(frf, bands)  # the lines of the bands, taken out once
     band_peak = band_peaks(bands, data)
     fit = nls_fit(frf, bands, power, noise, data, band_peak)
+    # an estimate from windowed records: fit the model as the window shows it (its bias is the window's)
+    data, fit, note = without_window_bias(frf, bands, power, data, band_peak, fit)
     # the checks all measure the residual of the same modes on the same lines: the fit's own when it is
     # unweighted (no second solve), else computed once
     own = fit.residual is not None and not fit.line_weighted
@@ -195,7 +200,15 @@ def _least_squares_fits(frf, bands, power, noise, estimated_noise, known_noise):
     else:
         residual_noise = fit_noise(frf, bands, power, fit.omega_n, fit.damping_ratio, estimated_noise,
                                    residual=residual, data=data)[rows]
-    chi2 = chi2_of(fit.noise_var[rows], residual_noise)
+    chi2_noise = residual_noise
+    if own and frf.noise_model is not None:
+        # an estimate from one record (no noise level per line): the chi-square compares mean squares, and
+        # where the noise level varies along the lines (noise on the force makes the errors proportional to
+        # |H|, large at the peaks) the residual's RMS line-to-line misfit is the noise it holds, above its
+        # median level; a misfit of the model, smooth on lines that resolve the modes, does not enter it
+        with np.errstate(all="ignore"):
+            chi2_noise = np.fmax(residual_noise, neighbour_noise_rms(data[0], fit.residual[rows]))
+    chi2 = chi2_of(fit.noise_var[rows], chi2_noise)
     # the check's noise is the residual's own (of every channel, when at hand; else it measures its own)
     missing_mode = missing_mode_in_bands(frf, bands, power, fit.omega_n, fit.damping_ratio, estimated_noise, residual,
                                          None if known_noise or isinstance(rows, np.ndarray) else residual_noise,
@@ -223,4 +236,4 @@ def _least_squares_fits(frf, bands, power, noise, estimated_noise, known_noise):
         if not (band.low_hz <= wn / TWO_PI <= band.high_hz):
             flags.add("band_edge_peak")
         estimates.append(_estimate(frf, band, wn, zeta, fit.modal_constant[r], cov, s_wn, s_z, flags, chi2, chi2))
-    return estimates, missing_mode
+    return estimates, missing_mode, note

@@ -11,13 +11,18 @@ from __future__ import annotations
 import numpy as np
 
 from ..flags import REL_STD_LIMIT
+from ..leakage import bias_matters, window_bias
 from ..nls import fit_modes, truncation_shift
 from ..units import TWO_PI
 from . import starts
-from .bands import band_data, line_weight
+from .bands import band_data, line_weight, line_whitening
 from .checks import residual_structure, restart_pole
 
-__all__ = ["STRUCTURED_RATIO", "doubtful", "nls_fit", "fit_cost", "fit_bands", "truncation", "with_shift"]
+__all__ = ["STRUCTURED_RATIO", "doubtful", "nls_fit", "fit_cost", "fit_bands", "truncation", "with_shift",
+           "without_window_bias", "WINDOW_BIAS_ROUNDS"]
+
+#: rounds of the fixed point that fits the model convolved with the estimate's lag window
+WINDOW_BIAS_ROUNDS = 3
 
 #: a fit whose residual variance is more than this many times its line-to-line noise
 #: (checks.residual_structure) has a smooth misfit: its truncation shift is measured
@@ -90,10 +95,12 @@ def fit_bands(frf, bands, power, omega_n0, damping_ratio0, channels=None, data=N
     """
     omega, response, region = band_data(frf, bands, channels) if data is None else data
     weight = line_weight(frf, bands)
+    whitening = line_whitening(frf, bands)
+    lags = correlated_lags(frf, omega, damping_ratio0, omega_n0)
     scale = None if band_peak is None else band_peak.max(axis=0)  # max |H| of each channel on the lines
     with np.errstate(all="ignore"):
         fit = fit_modes(omega, response, power, omega_n0, damping_ratio0, region=region, line_weight=weight,
-                        channel_scale=scale)
+                        channel_scale=scale, whitening=whitening, correlated_lags=lags)
     if len(bands) < 2:
         return fit
     for r in range(len(bands)):
@@ -112,10 +119,23 @@ def fit_bands(frf, bands, power, omega_n0, damping_ratio0, channels=None, data=N
         start_wn[r], start_zeta[r] = start
         with np.errstate(all="ignore"):
             restart = fit_modes(omega, response, power, start_wn, start_zeta, region=region, line_weight=weight,
-                                channel_scale=scale)
+                                channel_scale=scale, whitening=whitening, correlated_lags=lags)
         if fit_cost(restart) < fit_cost(fit):
             fit = restart
     return fit
+
+
+def correlated_lags(frf, omega, damping_ratio, omega_n) -> int:
+    """Lags over which an estimate's errors may correlate beyond its noise model: the half-power width of the
+    narrowest mode in lines (at least 2, at most a sixth of the lines), for an FRF estimated from time records
+    (it carries a :class:`~modal.noise_model.NoiseModel`); 0 otherwise."""
+    if frf.noise_model is None or omega.size < 12:
+        return 0
+    spacing = float(np.median(np.diff(omega)))
+    width = 2 * np.asarray(damping_ratio, float) * np.asarray(omega_n, float) / spacing
+    width = width[np.isfinite(width) & (width > 0)]
+    lines = int(np.ceil(width.min())) if width.size else 2
+    return int(np.clip(lines, 2, omega.size // 6))
 
 
 def truncation(frf, bands, power, fit, channels=None, residual=None, data=None):
@@ -144,3 +164,38 @@ def with_shift(cov, pole_shift, constant_shift):
     d = np.column_stack([np.broadcast_to(pole_shift, (constant_shift.size, 2)),
                          constant_shift.real, constant_shift.imag])
     return cov + d[:, :, None] * d[:, None, :]
+
+
+def without_window_bias(frf, bands, power, data, band_peak, fit):
+    """The fit of the model convolved with the estimate's lag window (:mod:`modal.leakage`), when its window
+    biases these modes: the data less the window's bias of the fitted modes, refitted, a few rounds (a fixed
+    point; the bias changes little with the poles, each round takes its error down by the bias's own
+    relative change).
+
+    Returns (data, fit, note): the corrected lines of the bands, their fit, and what was done (a sentence for
+    the result's settings), or the arguments unchanged and None when the FRF carries no lag window or it
+    does not bias these modes.
+    """
+    model = frf.noise_model
+    if model is None or not bias_matters(model.lag_window, model.sample_interval_s, fit.omega_n,
+                                         fit.damping_ratio):
+        return data, fit, None
+    omega, response, region = data
+    first, corrected = fit, data
+    for _ in range(WINDOW_BIAS_ROUNDS):
+        with np.errstate(all="ignore"):
+            bias = window_bias(omega, power, fit.omega_n, fit.damping_ratio, fit.modal_constant, model.lag_window,
+                               model.sample_interval_s)
+        if not np.all(np.isfinite(bias)):
+            return data, first, None
+        corrected = (omega, response - bias, region)
+        fit = fit_bands(frf, bands, power, fit.omega_n, fit.damping_ratio, data=corrected, band_peak=band_peak)
+        if not (np.all(np.isfinite(fit.omega_n)) and np.all(np.isfinite(fit.damping_ratio))):
+            return data, first, None
+    with np.errstate(all="ignore"):
+        s_zeta = np.sqrt(np.abs(fit.mode_cov[:, 0, 1, 1]))
+        moved = np.abs(np.sort(fit.damping_ratio) - np.sort(first.damping_ratio)) / s_zeta[np.argsort(fit.omega_n)]
+    largest = float(np.nanmax(moved)) if np.any(np.isfinite(moved)) else 0.0
+    note = (f"fitted the model convolved with the estimate's lag window (leakage of {model.lag_window.size}-sample "
+            f"records); damping moved by up to {largest:.2g} standard errors")
+    return corrected, fit, note

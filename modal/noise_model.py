@@ -1,0 +1,163 @@
+"""What an FRF estimated from time records knows about its own errors, beyond each line's noise level.
+
+An estimate's errors are not independent from line to line: a window correlates
+neighbouring lines (Hann: the noise of lines k and k + 1 correlates by 4/9 in an H1
+estimate from white excitation; an exponential window over tens of lines), and the
+windowed records smooth the spectrum, which biases the damping (leakage). The
+:class:`NoiseModel` that :func:`modal.estimate_frf` attaches to its FRF carries both,
+computed from the windows and the excitation actually recorded, so that
+:func:`modal.identify` can weight the lines with their covariance and take the
+window's bias out.
+
+The bias follows from the lag window ρ(τ) (Bendat & Piersol, *Random Data*, ch. 11):
+for an excitation whose samples are uncorrelated (white random, or a pulse shorter
+than any window change), the expected estimate at every line is the transform of the
+impulse response times ρ, E[Ĥ](ω) = Σ_τ h[τ] ρ(τ) e^{−iωτT}, with
+
+    ρ(τ) = Σ_n w_out[n] w_in[n − τ] v[n − τ] / Σ_n w_in[n]² v[n],
+
+w_in, w_out the windows of excitation and response and v the excitation's mean square
+at each sample of a record (averaged over the records). A rectangular window on
+stationary excitation gives ρ(τ) = 1 − τ/N, a Hann window ≈ 1 − (2π²/3)(τ/N)² near
+τ = 0, an exponential window e^{−τT/τ_w} until the record ends.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from .errors import FRFValidationError
+
+__all__ = ["NoiseModel", "window_line_correlation", "lag_window", "MAX_LAGS", "CORRELATION_FLOOR"]
+
+#: neighbouring lines whose noise correlation is carried, at most
+MAX_LAGS = 64
+#: a window's line correlation |c(m)| below this at every lag from m on ends the lags carried
+CORRELATION_FLOOR = 0.01
+#: at most this many correlation values per FRF (lags × lines): long FRFs carry fewer lags
+MAX_CORRELATION_VALUES = 4_000_000
+
+
+@dataclass(frozen=True, eq=False)
+class NoiseModel:
+    """The errors of an FRF estimated from time records, beyond ``FRF.noise_std``.
+
+    Attributes
+    ----------
+    averages : int
+        Records (segments or accepted hits) averaged.
+    degrees_of_freedom : float
+        Of each line's variance estimate (``noise_std``): averages less inputs, over
+        the variance inflation of overlapping records; 0 where no variance was estimated.
+    line_correlation : ndarray, shape (n_lags, n_freq), complex, or None
+        Correlation coefficient of the random errors of line k and line k + m
+        (row m − 1), E[e_k e*_{k+m}] / (σ_k σ_{k+m}), shared by every channel; zero
+        past the last line. None when unknown (MIMO estimates).
+    lag_window : ndarray, shape (n_samples,), or None
+        ρ(τ) for τ = 0 … n − 1 samples (see the module): the expected estimate is the
+        transform of the impulse response times it. An exponential window's own
+        decay is left out of it (the FRF's ``exponential_decay_s`` says it).
+    sample_interval_s : float
+        Time between samples, s (the lag window's step).
+    """
+
+    averages: int
+    degrees_of_freedom: float
+    line_correlation: np.ndarray | None
+    lag_window: np.ndarray | None
+    sample_interval_s: float
+
+    def __post_init__(self) -> None:
+        if self.line_correlation is not None:
+            corr = np.array(self.line_correlation, dtype=complex)
+            if corr.ndim != 2:
+                raise FRFValidationError(f"field 'line_correlation' has shape {corr.shape}; expected (n_lags, n_freq)")
+            if not np.all(np.isfinite(corr)) or np.any(np.abs(corr) > 1 + 1e-9):
+                raise FRFValidationError("field 'line_correlation' holds values that are not correlation "
+                                         "coefficients; expected finite |values| <= 1")
+            corr.setflags(write=False)
+            object.__setattr__(self, "line_correlation", corr)
+        if self.lag_window is not None:
+            lag = np.array(self.lag_window, dtype=float)
+            if lag.ndim != 1 or not np.all(np.isfinite(lag)):
+                raise FRFValidationError("field 'lag_window' must be a finite 1-D array (one value per lag)")
+            lag.setflags(write=False)
+            object.__setattr__(self, "lag_window", lag)
+        if not (np.isfinite(self.sample_interval_s) and self.sample_interval_s > 0):
+            raise FRFValidationError(f"field 'sample_interval_s' is {self.sample_interval_s!r}; expected a time in s")
+
+    @property
+    def n_lags(self) -> int:
+        """Neighbouring lines whose correlation is carried."""
+        return 0 if self.line_correlation is None else self.line_correlation.shape[0]
+
+    def smoothing_inflation(self, lines: int) -> float:
+        """Variance inflation 1 + 2 Σ (1 − m/K)|ρ(m)|² of a noise power averaged over K = ``lines`` neighbouring
+        lines whose errors correlate by ρ (the median over the lines)."""
+        if lines <= 1 or self.line_correlation is None:
+            return 1.0
+        m = np.arange(1, min(lines, self.n_lags + 1))
+        rho = np.median(np.abs(self.line_correlation[m - 1]), axis=1) if m.size else np.zeros(0)
+        return 1.0 + 2.0 * float(np.sum((1 - m / lines) * rho**2))
+
+    def cropped(self, keep: np.ndarray) -> "NoiseModel":
+        """The model on the lines ``keep`` (bool over the lines, a contiguous run keeps every correlation).
+
+        Lines dropped from inside the run break the neighbour relation: the correlation is then dropped.
+        """
+        if self.line_correlation is None:
+            return self
+        lines = np.flatnonzero(keep)
+        if lines.size and np.any(np.diff(lines) != 1):
+            return replace(self, line_correlation=None)
+        corr = self.line_correlation[:, keep].copy()
+        for m in range(1, corr.shape[0] + 1):  # the last m lines have no neighbour m lines on
+            corr[m - 1, max(corr.shape[1] - m, 0):] = 0
+        return replace(self, line_correlation=corr)
+
+    def correlation_band(self, lines: np.ndarray) -> np.ndarray | None:
+        """The correlation matrix R of the errors on the lines with indices ``lines`` (ascending), in LAPACK's
+        lower banded storage: ``band[d, j] = R[j + d, j]`` for d = 0 … n_lags (R is zero beyond: lines more
+        than ``n_lags`` apart do not correlate, and neither do lines further apart in ``lines``)."""
+        if self.line_correlation is None:
+            return None
+        lines = np.asarray(lines, int)
+        n = lines.size
+        band = np.zeros((self.n_lags + 1, n), complex)
+        band[0] = 1.0
+        for d in range(1, min(self.n_lags, n - 1) + 1):
+            gap = lines[d:] - lines[:-d]  # lines j + d and j are gap lines apart
+            ok = gap <= self.n_lags
+            j = np.flatnonzero(ok)
+            band[d, j] = np.conj(self.line_correlation[gap[j] - 1, lines[j]])
+        return band
+
+
+def window_line_correlation(window: np.ndarray) -> np.ndarray:
+    """c(m) = Σ w[n]² e^{2πimn/N} / Σ w²: the correlation of line k with line k + m of a windowed white
+    noise's DFT, for m = 0 … N − 1 (c(0) = 1)."""
+    power = np.asarray(window, float) ** 2
+    return np.conj(np.fft.fft(power)) / power.sum()
+
+
+def lags_carried(correlation: np.ndarray, n_lines: int) -> int:
+    """Lags to carry: up to the last m with |c(m)| at or above :data:`CORRELATION_FLOOR`, within the caps."""
+    half = correlation[1:correlation.size // 2 + 1]
+    above = np.flatnonzero(np.abs(half) >= CORRELATION_FLOOR)
+    wanted = 0 if above.size == 0 else int(above[-1]) + 1
+    return int(min(wanted, MAX_LAGS, MAX_CORRELATION_VALUES // max(n_lines, 1)))
+
+
+def lag_window(input_window: np.ndarray, output_window: np.ndarray, mean_square: np.ndarray) -> np.ndarray:
+    """ρ(τ), τ = 0 … N − 1, from the windows and the excitation's mean square at each sample of a record.
+
+    ρ(τ) = Σ_n w_out[n] u[n − τ] / Σ_n w_in[n] u[n], u = w_in · v (see the module).
+    """
+    u = np.asarray(input_window, float) * np.asarray(mean_square, float)
+    n = u.size
+    size = 1 << int(np.ceil(np.log2(2 * n)))
+    # Σ_n w_out[n] u[n − τ]: the cross-correlation, by one product of transforms
+    corr = np.fft.irfft(np.fft.rfft(output_window, size) * np.conj(np.fft.rfft(u, size)), size)[:n]
+    scale = float(np.dot(input_window, u))
+    return corr / scale if scale > 0 else np.ones(n)
