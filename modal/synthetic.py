@@ -10,7 +10,7 @@ import numpy as np
 from .errors import ParameterError
 from .frf import FRF, kind_factor
 from .units import TWO_PI
-from .validate import non_negative, one_of, positive
+from .validate import non_negative, one_of, positive, system_matrices
 
 __all__ = ["modal_frf", "matrix_frf", "add_noise", "sdof_frf", "frequency_axis"]
 
@@ -123,15 +123,8 @@ def matrix_frf(frequency_hz, mass, damping, stiffness, response_dofs=None, refer
     FRF
         Channels in ``response_dofs`` order; point ids are the dof indices.
     """
-    M, C, K = (np.atleast_2d(np.asarray(a, dtype=float)) for a in (mass, damping, stiffness))
+    M, C, K = system_matrices(mass, damping, stiffness)
     n = M.shape[0]
-    for name, a in (("mass", M), ("damping", C), ("stiffness", K)):
-        if a.shape != (n, n) or not np.all(np.isfinite(a)):
-            raise ParameterError(f"'{name}' must be a finite ({n}, {n}) matrix, got shape {a.shape}")
-    try:
-        np.linalg.cholesky(M)
-    except np.linalg.LinAlgError:
-        raise ParameterError("'mass' must be symmetric positive definite") from None
     if not 0 <= reference_dof < n:
         raise ParameterError(f"'reference_dof' must be in [0, {n}), got {reference_dof}")
     dofs = list(range(n)) if response_dofs is None else [int(d) for d in response_dofs]

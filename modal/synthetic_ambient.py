@@ -16,7 +16,7 @@ import numpy as np
 
 from .errors import ParameterError
 from .units import TWO_PI
-from .validate import positive
+from .validate import positive, system_matrices
 
 __all__ = ["AmbientRecord", "ambient_response", "ambient_modal_response", "chain_matrices"]
 
@@ -173,15 +173,8 @@ def ambient_response(mass, damping, stiffness, sample_rate_hz: float, n_samples:
     -------
     AmbientRecord
     """
-    M, C, K = (np.atleast_2d(np.asarray(a, dtype=float)) for a in (mass, damping, stiffness))
+    M, C, K = system_matrices(mass, damping, stiffness)
     n = M.shape[0]
-    for name, a in (("mass", M), ("damping", C), ("stiffness", K)):
-        if a.shape != (n, n) or not np.all(np.isfinite(a)):
-            raise ParameterError(f"'{name}' must be a finite ({n}, {n}) matrix, got shape {a.shape}")
-    try:
-        np.linalg.cholesky(M)
-    except np.linalg.LinAlgError:
-        raise ParameterError("'mass' must be symmetric positive definite") from None
     outs = list(range(n)) if output_dofs is None else [int(d) for d in output_dofs]
     ins = list(range(n)) if force_dofs is None else [int(d) for d in force_dofs]
     if not outs or not ins or any(not 0 <= d < n for d in outs + ins):

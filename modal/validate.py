@@ -13,7 +13,8 @@ import numpy as np
 
 from .errors import ParameterError
 
-__all__ = ["positive", "non_negative", "per_channel", "per_line", "positive_number", "one_of", "finite_samples", "channel_mask"]
+__all__ = ["positive", "non_negative", "per_channel", "per_line", "positive_number", "one_of", "finite_samples", "channel_mask",
+           "system_matrices"]
 
 
 def _where(source: str | None) -> str:
@@ -111,3 +112,18 @@ def channel_mask(name: str, value, n_channels: int, error: type[Exception] = Par
     mask = np.zeros(n_channels, bool)
     mask[indices] = True
     return mask
+
+
+def system_matrices(mass, damping, stiffness) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Mass, damping and stiffness matrices of a linear system, checked: finite, square, of one size,
+    the mass symmetric positive definite (kg, N s/m, N/m)."""
+    M, C, K = (np.atleast_2d(np.asarray(a, dtype=float)) for a in (mass, damping, stiffness))
+    n = M.shape[0]
+    for name, a in (("mass", M), ("damping", C), ("stiffness", K)):
+        if a.shape != (n, n) or not np.all(np.isfinite(a)):
+            raise ParameterError(f"'{name}' must be a finite ({n}, {n}) matrix, got shape {a.shape}")
+    try:
+        np.linalg.cholesky(M)
+    except np.linalg.LinAlgError:
+        raise ParameterError("'mass' must be symmetric positive definite") from None
+    return M, C, K
