@@ -16,7 +16,7 @@ from modal.io._atomic import atomic_path
 
 from .registry import REGISTRY, load
 
-__all__ = ["stage_figures", "save_stage_plot", "preload", "result_modules", "frf_figures", "identify_figures", "stability_figures", "response_figures",
+__all__ = ["stage_figures", "save_stage_plot", "preload", "frf_figures", "identify_figures", "stability_figures", "response_figures",
            "compressor_figures", "mounts_figures", "drive_figures", "balance_figures"]
 
 
@@ -127,7 +127,7 @@ def balance_figures(results):
 
 def preload(stages, modules=()) -> None:
     """Import what drawing the figures of ``stages`` needs (their ``plot_modules``), and their figures functions;
-    and ``modules`` (the modules of this run's result classes that its figures are handed: :func:`result_modules`).
+    and ``modules`` (the modules of this run's result classes that its figures are handed: :func:`.registry.result_modules`).
 
     The plotting process does this once, before it forks its helper, instead of each drawing process
     importing them for itself.
@@ -139,14 +139,6 @@ def preload(stages, modules=()) -> None:
             importlib.import_module(name)
         if REGISTRY[stage].figures:
             load(REGISTRY[stage].figures)
-
-
-def result_modules(scene, stages) -> tuple[str, ...]:
-    """Modules a plotting process needs beyond the ``plot_modules`` of ``stages`` to read what this scene's figures
-    are handed: an FRF estimated from a time record (``modal.estimate``'s EstimatedFRF) where a figure reads the
-    frf; nothing for an FRF file or a synthetic FRF."""
-    timed = scene.inputs.get("frf") is not None
-    return ("modal.estimate",) if timed and any("frf" in REGISTRY[s].plot_inputs for s in stages) else ()
 
 
 def stage_figures(stage: str, results) -> list[tuple[str, Figure]]:

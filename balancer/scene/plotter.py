@@ -251,7 +251,7 @@ class Plotter:
         The plot stages it will be handed (the modules their figures need are imported at once).
     modules : sequence of str
         Modules of the run's result classes the figures are handed, imported at once too
-        (:func:`.plots.result_modules`).
+        (:func:`.registry.result_modules`).
     """
 
     def __init__(self, jobs: int, folder: Path, stages=(), modules=()):

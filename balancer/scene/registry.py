@@ -24,7 +24,7 @@ from typing import Any, Mapping
 
 from .rules import BOOL, INT, NONNEG, NUM, POS, STR, choice, complex_value, list_of, ref_or
 
-__all__ = ["Stage", "REGISTRY", "STAGES", "load"]
+__all__ = ["Stage", "REGISTRY", "STAGES", "load", "result_modules"]
 
 _KINDS = choice("receptance", "mobility", "accelerance")
 #: modal.estimate.ESTIMATORS and WINDOWS (the time options' choices; a test keeps them equal)
@@ -308,3 +308,11 @@ REGISTRY: dict[str, Stage] = {stage.name: stage for stage in (
 
 #: the stages' names, in the order they run
 STAGES = tuple(REGISTRY)
+
+
+def result_modules(scene, stages) -> tuple[str, ...]:
+    """Modules a plotting process needs beyond the ``plot_modules`` of ``stages`` to read what this scene's figures
+    are handed: an FRF estimated from a time record (``modal.estimate``'s EstimatedFRF) where a figure reads the
+    frf; nothing for an FRF file or a synthetic FRF."""
+    timed = scene.inputs.get("frf") is not None
+    return ("modal.estimate",) if timed and any("frf" in REGISTRY[s].plot_inputs for s in stages) else ()

@@ -14,7 +14,7 @@ import modal
 from modal.errors import ArchiveError, ModalError, PlotError, SceneError
 
 from .plotter import Plotter, plot_error
-from .registry import REGISTRY, STAGES, load
+from .registry import REGISTRY, STAGES, load, result_modules
 from .rules import Reference
 from .schema import Scene, load_scene, parse_scene
 
@@ -202,8 +202,6 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, p
             earlier.close()
     plotter = None
     if plotted:
-        from .plots import result_modules
-
         plotter = Plotter(plot_jobs, folder, plotted, result_modules(scene, plotted))
     # plot stages not yet handed to the child, in output order (a stage without figures draws nothing)
     pending = [stage for stage in plotted if REGISTRY[stage].figures]

@@ -55,6 +55,22 @@ out = {"serial": list(serial.plot_paths), "forked": list(forked.plot_paths), "fo
     assert not list((tmp_path / "b").glob("*.tmp"))
 
 
+def test_a_forked_run_leaves_the_drawing_to_its_plotting_process(tmp_path):
+    # the parent computes while its plotting process imports matplotlib's figure machinery (about 0.6 s):
+    # the parent itself must not import it, or the two costs add up instead of overlapping
+    script = f"""
+import json, sys
+sys.path.insert(0, {str(ROOT)!r})
+from balancer.scene import run_scene
+run = run_scene({str(DEMO)!r}, out="c.h5", plots_dir="c", plot_jobs=2)
+print(json.dumps([len(run.plot_paths), "matplotlib.figure" in sys.modules]))
+"""
+    proc = subprocess.run([sys.executable, "-c", script], cwd=tmp_path, capture_output=True, text=True, timeout=300,
+                          env={**os.environ, "MPLBACKEND": "Agg"})
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    assert json.loads(proc.stdout.strip().splitlines()[-1]) == [6, False]
+
+
 def test_a_failing_plot_in_a_child_is_reported(tmp_path):
     # the identify plot is the one handed to a child as soon as its stage is done (no child
     # is running yet then), so the failure happens in the child and must reach the caller
@@ -105,7 +121,6 @@ def test_a_failing_plot_is_reported_with_its_stage(tmp_path, monkeypatch, jobs):
         run_scene(DEMO, out=tmp_path / "c.h5", plots_dir=tmp_path / "c", plot_jobs=jobs)
 
 
-
 def test_every_stage_figure_declares_the_results_it_reads():
     # a plotting process is handed only the stage's plot_inputs (the byte-for-byte test above shows the
     # demo's figures come out the same from that subset); a stage with figures must say what they read
@@ -127,7 +142,7 @@ def test_every_figure_draws_the_same_in_a_plotting_process_with_only_the_drawing
     import pickle
 
     from balancer.scene import parse_scene, plots, run_scene
-    from balancer.scene.registry import REGISTRY
+    from balancer.scene.registry import REGISTRY, result_modules
     from balancer.scene.schema import load_scene
     from support.scenes import DRIVE
 
@@ -144,7 +159,7 @@ def test_every_figure_draws_the_same_in_a_plotting_process_with_only_the_drawing
                 # what the run's plotting process imports for it beside the stage's plot_modules (a time record's
                 # estimate class, handed to the frf's and identify's figures)
                 checked = load_scene(scene) if isinstance(scene, Path) else parse_scene(scene)
-                modules[stage] = list(plots.result_modules(checked, [stage]))
+                modules[stage] = list(result_modules(checked, [stage]))
                 pickled[stage] = str(tmp_path / f"{stage}.pickle")
                 Path(pickled[stage]).write_bytes(pickle.dumps(given))
                 (tmp_path / "serial").mkdir(exist_ok=True)
