@@ -151,7 +151,7 @@ class Geometry:
         """
         nodes, directions = [], []
         known = set(self.node_id.tolist())
-        for k, point in enumerate(points):
+        for k, point in enumerate(points, start=1):  # channels counted from 1, as everywhere users see them
             try:
                 node, direction = direction_vector(point)
             except ValueError as exc:

@@ -21,9 +21,10 @@ def test_point_ids_place_channels_on_their_nodes_and_directions():
 
 
 def test_a_point_on_a_node_the_geometry_lacks_is_a_one_line_error():
-    with pytest.raises(ParameterError, match=r"square: channel 1 \(point '9\+Z'\) stands on node 9.*nodes 1\.\.4"):
+    # channels are counted from 1 in messages, as on the command line and in tables
+    with pytest.raises(ParameterError, match=r"square: channel 2 \(point '9\+Z'\) stands on node 9.*nodes 1\.\.4"):
         _square().with_channels(["1+Z", "9+Z"])
-    with pytest.raises(ParameterError, match="channel 0: point id 'abc'"):
+    with pytest.raises(ParameterError, match="channel 1: point id 'abc'"):
         _square().with_channels(["abc"])
 
 
