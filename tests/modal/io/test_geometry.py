@@ -82,7 +82,7 @@ def test_typed_csv_with_units_lines_and_channels(tmp_path):
     ("node, 1.5, 0, 0, 0\n", r"field 'id' is '1.5'; expected a positive node number"),
     ("units, furlong\nnode, 1, 0, 0, 0\n", r"line 1: length unit 'furlong'"),
     ("node, 1, 0, 0, 0\nline, 1, 5\n", r"trace line names node 5"),
-    ("node, 1, 0, 0, 0\nchannel, 2+Z\n", r"channel 0 \(point '2\+Z'\) stands on node 2"),
+    ("node, 1, 0, 0, 0\nchannel, 2+Z\n", r"channel 1 \(point '2\+Z'\) stands on node 2"),
     ("point, 1, 0, 0, 0\n", r"row type 'point'; expected node, line, channel or units"),
     ("# nothing\n", r"no 'node' rows"),
 ])

@@ -67,5 +67,5 @@ def test_a_geometry_without_the_channels_nodes_is_one_line(tmp_path, fitted):
     frf, result = fitted
     write_archive(tmp_path / "fit.h5", {"frf": frf, "identify_nls": result})
     geometry = modal.Geometry([1, 5], [[0, 0, 0], [1, 0, 0]], source="g.csv")
-    with pytest.raises(ModalError, match=r"g\.csv: channel 1 \(point '2\+Z'\) stands on node 2"):
+    with pytest.raises(ModalError, match=r"g\.csv: channel 2 \(point '2\+Z'\) stands on node 2"):
         report_content(tmp_path / "fit.h5", geometry)
