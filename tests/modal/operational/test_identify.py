@@ -144,6 +144,9 @@ def _record(n_channels=3, n=20_000, seed=0):
     (_record(n_channels=1), {}, "1 channel; operational modal analysis needs at least 2"),
     (np.vstack([_record(2), np.full(20_000, 3.0)]), {}, r"channel\(s\) 3 constant"),
     (np.where(np.arange(20_000) == 77, np.nan, _record(3)), {}, "channel 1, sample 77: nan"),
+    (np.vstack([_record(2), np.where(np.arange(20_000) == 5, -np.inf, 1.0)]), {}, "channel 3, sample 5: -inf"),
+    # finite samples whose sum overflows double precision: named, not turned into NaN correlations
+    (np.vstack([_record(2), np.full(20_000, 1e305) * (1 + np.arange(20_000) % 2)]), {}, "channel 3: samples up to 2e"),
     (_record(n=1500), {}, "the record lasts 15 s"),
     (_record(), {"band_hz": (1.0, 80.0)}, r"FMAX <= 50 Hz"),
     (_record(), {"band_hz": (10.0, 5.0)}, "0 <= FMIN < FMAX"),
