@@ -30,6 +30,11 @@ __all__ = ["oma", "OMA_METHODS"]
 OMA_METHODS = ("ssi", "plscf", "fdd", "efdd")
 #: at most this many reference (projection) channels are chosen automatically
 MAX_AUTO_REFERENCES = 8
+#: with more outputs than references, the outputs' block rows make the Hankel matrix about this many times as
+#: tall as wide. Square (1) was faster, but over 50 records of 32 sensors it left a weakly excited mode's
+#: frequency errors 1.5 times too large (z SD 0.67); at 2 every mode's z SD lies in 0.86-1.20, as with 8
+#: sensors (``python -m benchmarks.bench_oma --records 0 --calibration 50 --channels 32``)
+HANKEL_ASPECT = 2
 
 
 def _references(prepared: Prepared, reference_channels) -> tuple[int, ...]:
@@ -48,8 +53,9 @@ def _sweep_size(prepared: Prepared, n_refs: int, max_order, block_rows):
     """(max_order, block rows of the outputs, block columns of the references): the correlation lags span a
     period of the lowest frequency of interest (a tenth of the band's top, or its bottom if higher), the
     Hankel matrix has room for every order. With more outputs than references the outputs take fewer block
-    rows, as many as keep the Hankel matrix about square (and room for every order): its rows then cost
-    the error bars' products no more than its columns, and the lags still span the period."""
+    rows, as many as make the Hankel matrix about :data:`HANKEL_ASPECT` times as tall as wide (and room for
+    every order): its rows then cost the error bars' products little more than its columns, and the lags
+    still span the period."""
     fs = prepared.sample_rate_hz
     low, high = prepared.band_hz
     if max_order is None:
@@ -63,7 +69,8 @@ def _sweep_size(prepared: Prepared, n_refs: int, max_order, block_rows):
     cols = rows
     n_out = prepared.n_channels
     if block_rows is None and n_out > n_refs:
-        rows = min(cols, max(int(np.ceil(max_order / n_out)) + 1, int(np.ceil(n_refs * cols / n_out)), 2))
+        rows = min(cols, max(int(np.ceil(max_order / n_out)) + 1, int(np.ceil(HANKEL_ASPECT * n_refs * cols / n_out)),
+                             2))
     n_samples = prepared.signals.shape[1]
     if n_samples < MIN_LAGS_IN_RECORD * 2 * cols:
         need = MIN_LAGS_IN_RECORD * 2 * cols / fs
