@@ -20,8 +20,10 @@ __all__ = ["Correlations", "correlations", "decimation_factor", "decimate", "cho
 
 #: after decimation the band's upper edge lies at or below this fraction of the new Nyquist frequency
 BAND_FRACTION_OF_NYQUIST = 0.5
-#: the record is cut into this many blocks for the error bars (fewer when it is short)
-MAX_BLOCKS = 100
+#: the record is cut into at most this many blocks for the error bars (fewer when it is short): as many as
+#: the error bars use (:data:`modal.operational.modes.MAX_ERROR_BLOCKS`); every block costs an inverse FFT
+#: per pair of channels
+MAX_BLOCKS = 50
 
 
 @dataclass(frozen=True)
@@ -80,11 +82,12 @@ def decimate(signals: np.ndarray, factor: int) -> np.ndarray:
 
 
 def _segment_length(max_lag: int, n_samples: int) -> int:
-    """Samples per segment: a fast FFT length of at least 8 lags (the extension by the longest lag then
-    costs at most an eighth more), at least 1024, at most the record."""
+    """Samples per segment: a fast FFT length of at least 4 lags and 256 samples, less the longest lag, at
+    most the record. The extension by the longest lag then costs the forward FFTs at most a third more,
+    while the inverse FFTs, one per block and pair of channels, stay short."""
     from scipy.fft import next_fast_len
 
-    n_seg = next_fast_len(max(8 * max_lag, 1024), real=True) - max_lag
+    n_seg = next_fast_len(max(4 * max_lag, 256), real=True) - max_lag
     return int(max(min(n_seg, n_samples - max_lag), max_lag + 1))
 
 
@@ -137,23 +140,27 @@ def correlations(signals: np.ndarray, sample_rate_hz: float, references, max_lag
                         tuple(int(r) for r in refs))
 
 
-def choose_references(signals: np.ndarray, n_references: int, probe_lags: int = 8) -> tuple[int, ...]:
+def choose_references(signals: np.ndarray, n_references: int, probe_lags: int = 8,
+                      probe_samples: int = 1 << 14) -> tuple[int, ...]:
     """The channels that best span the outputs' correlations, for projection.
 
     Each channel is scaled to unit RMS; the correlations of every channel with every other
-    over a few lags (from at most 2¹⁶ samples) form the columns of one matrix, and a
-    column-pivoted QR picks the ``n_references`` channels that are the most independent and
-    carry the most correlated (not white) signal: white measurement noise only enters lag 0,
-    which is left out.
+    over a few lags (from the first ``probe_samples`` samples, one matrix product in single
+    precision) form the columns of one matrix, and a column-pivoted QR picks the
+    ``n_references`` channels that are the most independent and carry the most correlated
+    (not white) signal: white measurement noise only enters lag 0, which is left out. The
+    choice needs only the rough correlations that 2¹⁴ samples give (each within a few percent);
+    the identification then uses the whole record.
     """
     from scipy.linalg import qr
 
     n_out, n = signals.shape
     if n_references >= n_out:
         return tuple(range(n_out))
-    piece = signals[:, : min(n, 1 << 16)]
-    piece = piece / np.sqrt(np.mean(piece**2, axis=1, keepdims=True))
-    corr = correlations(piece, 1.0, range(n_out), probe_lags, max_blocks=1).mean[1:]  # (lags, n_out, n_out)
-    columns = np.moveaxis(corr, 2, 0).reshape(n_out, -1).T  # one column per candidate reference
-    _, _, pivots = qr(columns, mode="economic", pivoting=True)
+    piece = np.array(signals[:, : min(n, probe_samples + probe_lags)], dtype=np.float32)
+    piece /= np.sqrt(np.mean(piece**2, axis=1, keepdims=True))
+    m = piece.shape[1] - probe_lags
+    lagged = np.lib.stride_tricks.sliding_window_view(piece, m, axis=1)[:, 1:]  # (n_out, lags 1…, m)
+    columns = lagged.reshape(-1, m) @ piece[:, :m].T  # one column per candidate reference
+    _, _, pivots = qr(columns.astype(float), mode="economic", pivoting=True)
     return tuple(sorted(int(p) for p in pivots[:n_references]))

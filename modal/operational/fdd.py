@@ -113,7 +113,7 @@ def fdd(prepared: Prepared, refs, *, enhanced: bool, rotor_speed_hz=None):
             if found is not None:
                 pole, known = found, True
         estimates.append(PoleEstimate(pole, shape, np.nan, np.nan, nan_shape, 1, 1, 0, damping_known=known))
-    is_tone, estimates = separate_tones(estimates, prepared, rotor_speed_hz)
+    is_tone, estimates = separate_tones(estimates, prepared, rotor_speed_hz, 4 * (lines[1] - lines[0]))
     modes = [e for e, t in zip(estimates, is_tone) if not t]
     tones = [e.natural_frequency_hz for e, t in zip(estimates, is_tone) if t]
     method = "efdd" if enhanced else "fdd"

@@ -30,6 +30,11 @@ __all__ = ["oma", "OMA_METHODS"]
 OMA_METHODS = ("ssi", "plscf", "fdd", "efdd")
 #: at most this many reference (projection) channels are chosen automatically
 MAX_AUTO_REFERENCES = 8
+#: with more outputs than references, the outputs' block rows make the Hankel matrix about this many times as
+#: tall as wide. Square (1) was faster, but over 50 records of 32 sensors it left a weakly excited mode's
+#: frequency errors 1.5 times too large (z SD 0.67); at 2 every mode's z SD lies in 0.86-1.20, as with 8
+#: sensors (``python -m benchmarks.bench_oma --records 0 --calibration 50 --channels 32``)
+HANKEL_ASPECT = 2
 
 
 def _references(prepared: Prepared, reference_channels) -> tuple[int, ...]:
@@ -48,8 +53,9 @@ def _sweep_size(prepared: Prepared, n_refs: int, max_order, block_rows):
     """(max_order, block rows of the outputs, block columns of the references): the correlation lags span a
     period of the lowest frequency of interest (a tenth of the band's top, or its bottom if higher), the
     Hankel matrix has room for every order. With more outputs than references the outputs take fewer block
-    rows, as many as keep the Hankel matrix about square (and room for every order): its rows then cost
-    the error bars' products no more than its columns, and the lags still span the period."""
+    rows, as many as make the Hankel matrix about :data:`HANKEL_ASPECT` times as tall as wide (and room for
+    every order): its rows then cost the error bars' products little more than its columns, and the lags
+    still span the period."""
     fs = prepared.sample_rate_hz
     low, high = prepared.band_hz
     if max_order is None:
@@ -63,7 +69,8 @@ def _sweep_size(prepared: Prepared, n_refs: int, max_order, block_rows):
     cols = rows
     n_out = prepared.n_channels
     if block_rows is None and n_out > n_refs:
-        rows = min(cols, max(int(np.ceil(max_order / n_out)) + 1, int(np.ceil(n_refs * cols / n_out)), 2))
+        rows = min(cols, max(int(np.ceil(max_order / n_out)) + 1, int(np.ceil(HANKEL_ASPECT * n_refs * cols / n_out)),
+                             2))
     n_samples = prepared.signals.shape[1]
     if n_samples < MIN_LAGS_IN_RECORD * 2 * cols:
         need = MIN_LAGS_IN_RECORD * 2 * cols / fs
@@ -163,8 +170,9 @@ def oma(data, sample_rate_hz: float | None = None, *, band_hz=None, method: str 
         from .plscf import plscf
 
         estimates, chosen, clusters, flat, stable, corr, settings = plscf(prepared, refs, max_order)
+    resolution_hz = corr.sample_rate_hz / corr.max_lag  # what the correlation lags tell apart
     estimates, tones, dropped, diagram = _sort_out(estimates, chosen, clusters, flat, stable, prepared,
-                                                   rotor_speed_hz, method)
+                                                   rotor_speed_hz, method, resolution_hz)
     if not estimates and not tones:
         raise IdentificationError(f"{prepared.source}: no stable pole in the band {prepared.band_hz[0]:g}-"
                                   f"{prepared.band_hz[1]:g} Hz (orders {settings['orders'][0]}-"
@@ -178,7 +186,8 @@ def oma(data, sample_rate_hz: float | None = None, *, band_hz=None, method: str 
                       stabilisation=diagram, settings=settings, harmonics_hz=tones, source=prepared.source)
 
 
-def _sort_out(estimates, chosen, clusters, flat, stable, prepared: Prepared, rotor_speed_hz, method: str):
+def _sort_out(estimates, chosen, clusters, flat, stable, prepared: Prepared, rotor_speed_hz, method: str,
+              resolution_hz: float):
     """Modes, tones (Hz), dropped noise poles (Hz) and the stabilisation diagram from the method's estimates.
 
     Noise poles (frequency not determined within their bandwidth) are dropped, except poles of nearly zero
@@ -188,7 +197,7 @@ def _sort_out(estimates, chosen, clusters, flat, stable, prepared: Prepared, rot
     keep = [resolved(e, prepared.duration_s) or nearly_undamped(e) for e in estimates]
     dropped = [e.natural_frequency_hz for e, k in zip(estimates, keep) if not k]
     estimates, clusters = ([x for x, k in zip(seq, keep) if k] for seq in (estimates, clusters))
-    is_tone, estimates = separate_tones(estimates, prepared, rotor_speed_hz)
+    is_tone, estimates = separate_tones(estimates, prepared, rotor_speed_hz, resolution_hz)
     keep = [t or resolved(e, prepared.duration_s) for e, t in zip(estimates, is_tone)]
     dropped = sorted(dropped + [e.natural_frequency_hz for e, k in zip(estimates, keep) if not k])
     estimates, clusters, is_tone = ([x for x, k in zip(seq, keep) if k] for seq in (estimates, clusters, is_tone))

@@ -27,7 +27,7 @@ class Prepared:
 
     Attributes
     ----------
-    signals : ndarray, shape (n_channels, n_samples)
+    signals : ndarray, shape (n_channels, n_samples), float32
     sample_rate_hz : float
         After decimation.
     scale : ndarray, shape (n_channels,)
@@ -82,7 +82,7 @@ def _record(data, sample_rate_hz):
     if sample_rate_hz is None:
         raise ParameterError("<array>: 'sample_rate_hz' is missing; expected the sampling rate in Hz for an array")
     names = tuple(str(k) for k in range(arr.shape[0])) if arr.ndim == 2 else ()
-    return arr.astype(float), float(sample_rate_hz), None, names, "<array>"
+    return np.asarray(arr, float), float(sample_rate_hz), None, names, "<array>"
 
 
 def check_band(band_hz, nyquist_hz: float, src: str) -> tuple[float, float]:
@@ -99,24 +99,40 @@ def check_band(band_hz, nyquist_hz: float, src: str) -> tuple[float, float]:
     return low, high
 
 
-def check_channels(signals: np.ndarray, src: str, names=()) -> None:
-    """Two or more channels of finite samples, none constant."""
+def check_channels(signals: np.ndarray, src: str, names=(), dtype=float) -> tuple[np.ndarray, np.ndarray]:
+    """Two or more channels of finite samples, none constant.
+
+    Returns
+    -------
+    (centred, rms) : ndarray (n_channels, n_samples) of ``dtype``, ndarray (n_channels,)
+        The channels with their means removed (in double precision, a new array) and their RMS about the mean.
+    """
     if signals.ndim != 2:
         raise ParameterError(f"{src}: 'data' has shape {signals.shape}; expected (n_channels, n_samples)")
     if signals.shape[0] < 2:
         raise ParameterError(f"{src}: {signals.shape[0]} channel; operational modal analysis needs at least 2 "
                              "response channels (data of shape (n_channels, n_samples))")
-    bad = ~np.isfinite(signals)
-    if bad.any():
-        ch, i = (int(v) for v in np.argwhere(bad)[0])
-        raise ParameterError(f"{src}: channel {ch + 1}{_name(names, ch)}, sample {i}: {signals[ch, i]}; expected "
-                             f"finite samples ({int(bad.sum())} are not)")
-    spread = signals.std(axis=1)
-    constant = np.flatnonzero(spread <= CONSTANT_CHANNEL * spread.max())
+    centred = np.empty(signals.shape, dtype)
+    rms = np.empty(signals.shape[0])
+    for ch, row in enumerate(signals):  # channel by channel: no temporary as large as the record
+        mean = row.mean()
+        if not np.isfinite(mean):  # a NaN or infinite sample (or finite ones whose sum overflows)
+            bad = ~np.isfinite(signals)
+            if bad.any():
+                ch, i = (int(v) for v in np.argwhere(bad)[0])
+                raise ParameterError(f"{src}: channel {ch + 1}{_name(names, ch)}, sample {i}: {signals[ch, i]}; "
+                                     f"expected finite samples ({int(bad.sum())} are not)")
+            raise ParameterError(f"{src}: channel {ch + 1}{_name(names, ch)}: samples up to {np.abs(row).max():g}; "
+                                 "expected values whose sum fits double precision (rescale the record)")
+        row = row - mean
+        rms[ch] = np.sqrt(np.dot(row, row) / row.size)
+        centred[ch] = row
+    constant = np.flatnonzero(~(rms > CONSTANT_CHANNEL * rms.max()))
     if constant.size:
         listing = ", ".join(f"{k + 1}{_name(names, k)}" for k in constant)
         raise ParameterError(f"{src}: channel(s) {listing} constant; expected a varying response on every channel "
                              "(drop dead channels)")
+    return centred, rms
 
 
 def _name(names, ch) -> str:
@@ -140,15 +156,18 @@ def prepare(data, sample_rate_hz=None, band_hz=None, quantity: str | None = None
     signals, rate, file_quantity, names, src = _record(data, sample_rate_hz)
     if not (np.isfinite(rate) and rate > 0):
         raise ParameterError(f"{src}: 'sample_rate_hz' is {rate!r}; expected a positive number of samples per second")
-    check_channels(signals, src, names)
     low, high = check_band(band_hz, rate / 2, src)
     factor = decimation_factor(rate, high)
-    centred = signals - signals.mean(axis=1, keepdims=True)
-    work = decimate(centred, factor)
-    if work.shape[1] < 2:
-        raise ParameterError(f"{src}: {signals.shape[1]} samples; too short a record for the band up to {high:g} Hz")
-    scale = np.sqrt(np.mean(work**2, axis=1))
-    if np.any(scale <= 0):
-        check_channels(work, src, names)
-    return Prepared(work / scale[:, None], rate / factor, scale, (low, high), factor, rate,
-                    quantity or file_quantity, names, src)
+    # single precision from here on (the correlations' FFTs are single precision anyway: their rounding, 1e-7,
+    # lies far below the estimates' scatter); a record to be decimated is filtered in double first
+    centred, scale = check_channels(signals, src, names, dtype=np.float32 if factor == 1 else float)
+    if factor > 1:
+        work = decimate(centred, factor)
+        if work.shape[1] < 2:
+            raise ParameterError(f"{src}: {signals.shape[1]} samples; too short a record for the band up to "
+                                 f"{high:g} Hz")
+        work, scale = check_channels(work, src, names, dtype=np.float32)
+    else:
+        work = centred
+    work /= scale[:, None].astype(np.float32)
+    return Prepared(work, rate / factor, scale, (low, high), factor, rate, quantity or file_quantity, names, src)

@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..units import TWO_PI
+from .correlations import MAX_BLOCKS
 from .pole import PoleEstimate
 from .selection import Cluster, shape_mac
 
@@ -21,7 +22,7 @@ __all__ = ["pole_errors", "estimates_from_clusters", "error_blocks", "resolved"]
 #: slowest-decaying mode (their correlation estimates are then nearly independent)...
 DECAY_TIMES_PER_BLOCK = 10
 #: ... and there are between these many blocks
-MIN_ERROR_BLOCKS, MAX_ERROR_BLOCKS = 8, 50
+MIN_ERROR_BLOCKS, MAX_ERROR_BLOCKS = 8, MAX_BLOCKS
 #: a chain's pole is reported from an order whose frequency and damping lie within this many of their
 #: standard errors from the chain's medians (an under-fitted low order can hold a biased pole of small error)
 CONSENSUS_SIGMAS = 2.0

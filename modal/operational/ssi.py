@@ -153,12 +153,15 @@ class Perturbation:
         self.scale = w * np.sqrt(n_blocks / (n_blocks - 1.0))  # var of the weighted mean from the blocks' scatter
         top = int(min(max_order or model.max_order, model.max_order))
         self.top = top
-        U, V = model.U, model.V
-        dH = hankel(block_R, model.block_rows, model.block_cols) - model.hankel[None]  # (blocks, p, q)
+        # the deviations are formed in double precision and carried through these products in single: their
+        # rounding (1e-7 of the deviations) lies far below the deviations' own scatter, which is what they measure
+        U, V = model.U.astype(np.float32), model.V.astype(np.float32)
+        dH = (hankel(block_R, model.block_rows, model.block_cols) - model.hankel[None]).astype(np.float32)
         G = dH @ V[:, :top]  # (blocks, p, top): ΔH V₁ for every order up to top
-        self.B_right = np.swapaxes(U.T @ G, 1, 2)  # (blocks, top, k): (Uᵀ ΔH V₁)ᵀ
-        self.E = G - U @ np.swapaxes(self.B_right, 1, 2)  # the part of ΔH V₁ outside the range of H
-        self.B_left = (np.swapaxes(U[:, :top], 0, 1) @ dH) @ V  # (blocks, top, k): U₁ᵀ ΔH V
+        B_right = np.swapaxes(U.T @ G, 1, 2)  # (blocks, top, k): (Uᵀ ΔH V₁)ᵀ
+        self.B_right = B_right.astype(float)
+        self.E = (G - U @ np.swapaxes(B_right, 1, 2)).astype(float)  # the part of ΔH V₁ outside the range of H
+        self.B_left = ((np.swapaxes(U[:, :top], 0, 1) @ dH) @ V).astype(float)  # (blocks, top, k): U₁ᵀ ΔH V
 
     def at(self, order: int, indices) -> dict[str, np.ndarray]:
         """Deviations of the poles ``indices`` of :func:`poles_at` (``order``).

@@ -7,7 +7,11 @@ say that a pole is a tone (Brincker, Andersen & Møller, IMAC 2000; Jacobsen 200
 * its damping is nearly zero: below :data:`TONE_DAMPING` (where few structures are) either with its
   error (ζ + 3σ_ζ) or indistinguishable from zero (ζ < 3σ_ζ);
 * the response band-passed around it is not Gaussian: a sinusoid's kurtosis is 1.5 where a
-  structural mode driven by random forces gives 3 (:data:`KURTOSIS_LIMIT`);
+  structural mode driven by random forces gives 3 (:data:`KURTOSIS_LIMIT`). The band is the pole's
+  own (4 half-power widths) or :data:`MIN_BANDWIDTH_TIME` lines, whichever is wider; a pole of nearly
+  zero damping stands for the strongest line within its resolution (a tone that wanders, or two close
+  lines the correlation lags cannot tell apart, give one pole between them), and the band is centred
+  on that line, so that the tone dominates it;
 * it lies on a harmonic ``k × f₀`` of the running speed (``rotor_speed_hz``, or the fundamental
   that the tones found by the first two pieces of evidence share).
 
@@ -24,17 +28,30 @@ from ..flags import HARMONIC_SIGMAS, HARMONIC_TOLERANCE
 from .inputs import Prepared
 from .pole import PoleEstimate
 
-__all__ = ["separate_tones", "nearly_undamped", "band_kurtosis", "harmonic_of", "KURTOSIS_LIMIT", "TONE_DAMPING"]
+__all__ = ["separate_tones", "nearly_undamped", "band_kurtosis", "strongest_line_hz", "harmonic_of", "KURTOSIS_LIMIT",
+           "TONE_DAMPING"]
 
 #: a pole whose damping ratio is below this with its error (ζ + 3σ_ζ) has nearly zero damping
 TONE_DAMPING = 0.002
 ZERO_DAMPING_SIGMAS = 3.0
 #: kurtosis of the band-passed response below which it holds a sinusoid: 3 for Gaussian narrow-band
-#: response, 1.5 for a pure tone; the estimate of 3 scatters by √(24/N) with N = B·T independent
-#: samples, B·T ≥ :data:`MIN_BANDWIDTH_TIME` making that at most 0.35, so the limit lies 3 of those below 3
+#: response, 1.5 for a pure tone, 2.25 for two equal tones. The estimate (from the band's lines, never
+#: below 1.5) has a short lower tail: for Gaussian response over :data:`MIN_BANDWIDTH_TIME` = 64 lines
+#: its 10⁻⁴ quantile is 2.27 with a flat spectrum and 2.18 with a mode's bell spanning the band
+#: (10⁵ draws each; ``tests/modal/operational/test_tones.py`` checks the margin)
 KURTOSIS_LIMIT = 1.95
-#: the band-pass spans at least this many over the record's duration (Hz·s), and 4 half-power widths
-MIN_BANDWIDTH_TIME = 200.0
+#: the band-pass spans at least this many lines, i.e. this bandwidth times the record's duration (Hz·s)
+MIN_BANDWIDTH_TIME = 64.0
+
+
+def strongest_line_hz(spectrum: np.ndarray, n_samples: int, sample_rate_hz: float, low_hz: float,
+                      high_hz: float) -> float:
+    """Frequency (Hz) of the strongest line of an ``rfft`` ``spectrum`` (``n_samples`` long) between ``low_hz``
+    and ``high_hz`` (the nearest line when none lies between)."""
+    spacing = sample_rate_hz / n_samples
+    lo = min(max(int(np.ceil(low_hz / spacing)), 1), spectrum.size - 1)
+    hi = max(min(int(np.floor(high_hz / spacing)), spectrum.size - 1), lo)
+    return float((lo + int(np.argmax(np.abs(spectrum[lo:hi + 1])))) * spacing)
 
 
 def band_kurtosis(spectrum: np.ndarray, n_samples: int, sample_rate_hz: float, centre_hz: float,
@@ -93,22 +110,34 @@ def nearly_undamped(estimate: PoleEstimate) -> bool:
     return bool(zeta < TONE_DAMPING and (zeta + margin < TONE_DAMPING or zeta < margin))
 
 
-def _evidence(estimate: PoleEstimate, prepared: Prepared, spectra: dict) -> tuple[bool, bool]:
+def _evidence(estimate: PoleEstimate, prepared: Prepared, spectra: dict, resolution_hz: float | None):
     """(nearly zero damping, band-passed response non-Gaussian) for one estimate; ``spectra`` caches each
     channel's FFT."""
+    from scipy.fft import rfft
+
     zeta = estimate.damping_ratio if np.isfinite(estimate.damping_ratio) else 0.0
     undamped = nearly_undamped(estimate)
     f = estimate.natural_frequency_hz
     channel = int(np.argmax(np.abs(estimate.shape) / prepared.scale))  # where it is strongest against the rest
     width = max(4 * max(zeta, 0.0) * f, MIN_BANDWIDTH_TIME / prepared.duration_s)
+    n = prepared.signals.shape[1]
     if channel not in spectra:
-        spectra[channel] = np.fft.rfft(prepared.signals[channel])
-    kurtosis = band_kurtosis(spectra[channel], prepared.signals.shape[1], prepared.sample_rate_hz, f, width)
+        spectra[channel] = rfft(prepared.signals[channel])
+    centre = f
+    if (undamped or not estimate.damping_known) and resolution_hz:
+        centre = strongest_line_hz(spectra[channel], n, prepared.sample_rate_hz, f - resolution_hz / 2,
+                                   f + resolution_hz / 2)
+    kurtosis = band_kurtosis(spectra[channel], n, prepared.sample_rate_hz, centre, width)
     return bool(undamped), bool(np.isfinite(kurtosis) and kurtosis < KURTOSIS_LIMIT)
 
 
-def separate_tones(estimates: list[PoleEstimate], prepared: Prepared, rotor_speed_hz: float | None):
+def separate_tones(estimates: list[PoleEstimate], prepared: Prepared, rotor_speed_hz: float | None,
+                   resolution_hz: float | None = None):
     """Which estimates are machine tones, and the modes left on a harmonic flagged ``harmonic``.
+
+    ``resolution_hz``, the frequency resolution of the method's correlation lags (sample rate / lags):
+    a pole of nearly zero damping (or unknown damping) is judged on the strongest line within half of it
+    on either side. None: on the pole's own frequency.
 
     Returns
     -------
@@ -116,7 +145,7 @@ def separate_tones(estimates: list[PoleEstimate], prepared: Prepared, rotor_spee
         The estimates in the same order, those on a harmonic that are not tones with the flag added.
     """
     spectra: dict = {}
-    evidence = [_evidence(e, prepared, spectra) for e in estimates]
+    evidence = [_evidence(e, prepared, spectra, resolution_hz) for e in estimates]
     fundamental = rotor_speed_hz
     if fundamental is None:
         # the tones the data show clearly: nearly undamped and non-Gaussian (or non-Gaussian where the method

@@ -38,8 +38,9 @@ def anchor_shapes(n_sensors: int = N_SENSORS) -> np.ndarray:
 
 
 def anchor_record(seed: int = 0, noise: float = 0.1, duration_s: float = 1000.0, sample_rate_hz: float = 100.0,
-                  tones: bool = True, tone_rms: float = 0.5) -> AmbientRecord:
-    """The anchor case's record (accelerations), ``duration_s`` long at ``sample_rate_hz``."""
-    return ambient_modal_response(FN, ZETA, anchor_shapes(), sample_rate_hz, int(duration_s * sample_rate_hz),
+                  tones: bool = True, tone_rms: float = 0.5, n_sensors: int = N_SENSORS) -> AmbientRecord:
+    """The anchor case's record (accelerations), ``duration_s`` long at ``sample_rate_hz``, on ``n_sensors``
+    sensors along the frame."""
+    return ambient_modal_response(FN, ZETA, anchor_shapes(n_sensors), sample_rate_hz, int(duration_s * sample_rate_hz),
                                   modal_force_std=FORCE, noise=noise, tones_hz=TONES if tones else None,
                                   tone_rms=tone_rms, seed=seed)
