@@ -5,7 +5,8 @@ of killing or freezing the caller. Fuzzing found both (docs/stress.md).
 The child is made with ``os.fork`` itself, not with :mod:`multiprocessing`, which refuses
 to start children from daemonic processes (the worker processes of a ``multiprocessing.Pool``
 or of Dask's nanny). Where the OS cannot fork the reader runs in-process. Warnings raised in
-the child are re-issued in the parent; the toolkit's own errors come back as they were raised.
+the child are re-issued in the parent; the toolkit's own errors and a MemoryError (the file was too large
+for the memory the process may use, not damaged) come back as they were raised.
 """
 from __future__ import annotations
 
@@ -44,6 +45,8 @@ def _child(func: Callable, args: tuple, fd: int, timeout_s: float) -> None:  # p
             result: tuple = ("ok", func(*args))
         except ModalError as exc:
             result = ("error", exc)
+        except MemoryError as exc:  # the file is not damaged: the process ran out of memory reading it
+            result = ("error", MemoryError(f"{exc}"))
         except BaseException as exc:  # noqa: BLE001 - anything else is a damaged file too
             result = ("error", FormatError(f"{type(exc).__name__}: {exc}"))
     try:

@@ -103,14 +103,15 @@ def test_the_time_limit_must_be_a_positive_time(tmp_path):
 
 def test_a_file_needing_more_memory_than_its_budget_fails_alone(tmp_path):
     """The fitting process may grow by its budget (in a batch: the worker's memory limit) at most:
-    an 8-channel 100 000-line FRF (13 MB of data, several copies while it is identified) does not fit
-    in 60 MB and fails with one line; the same process then fits a small file."""
+    a 48-channel 100 000-line FRF (77 MB of complex data, more than the budget on its own, whatever the
+    BLAS's thread count adds) does not fit in 60 MB and fails with one line; the same process then fits a
+    small file."""
     import numpy as np
 
     from modal.synthetic import add_noise, modal_frf
 
     freq = np.linspace(10.0, 5010.0, 100_000)
-    big = add_noise(modal_frf(freq, [500.0, 2000.0], [0.01, 0.01], np.ones((8, 2)), kind="mobility"), 1e-3, seed=0)
+    big = add_noise(modal_frf(freq, [500.0, 2000.0], [0.01, 0.01], np.ones((48, 2)), kind="mobility"), 1e-3, seed=0)
     write_frf(big, tmp_path / "big.h5")
     write_frf(mobility(), tmp_path / "small.uff")
     proc = FitProcess(memory_budget_bytes=60e6)

@@ -75,3 +75,19 @@ def test_readers_work_in_a_daemonic_process(tmp_path):
         back = pool.map(read_frf, paths)
     for item in back:
         np.testing.assert_array_equal(item.response, frf.response)
+
+
+def _allocate_too_much(n_bytes):
+    raise MemoryError(f"Unable to allocate {n_bytes} bytes")
+
+
+@pytest.mark.skipif(not hasattr(os, "fork"), reason="POSIX fork")
+def test_a_reader_out_of_memory_is_a_memory_error_not_a_damaged_file():
+    # running out of memory says nothing about the file: the batch's fitting process reports it as
+    # "out of memory" (to be retried with more), never as a damaged file (kept as the file's verdict)
+    from modal.errors import FormatError
+    from modal.io._isolate import call_isolated
+
+    with pytest.raises(MemoryError, match="Unable to allocate 80000000 bytes") as caught:
+        call_isolated(_allocate_too_much, (80_000_000,), "x.h5", "HDF5 file")
+    assert not isinstance(caught.value, FormatError)
