@@ -359,7 +359,8 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
               background_powers: tuple[int, ...] = (0,), residual_terms: bool = False,
               line_weight: np.ndarray | None = None, channel_scale: np.ndarray | None = None,
               max_damping: float | None = None, errors: bool = True,
-              whitening: LineWhitening | None = None, correlated_lags: int = 0) -> NLSFit:
+              whitening: LineWhitening | None = None, correlated_lags: int = 0,
+              decrement_tol: float = 0.0) -> NLSFit:
     """Fit poles and modal constants of several modes to many channels at once.
 
     Parameters
@@ -410,6 +411,13 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
         Generalised least squares for errors correlated between lines: with the (weighted)
         errors' correlation matrix R, W with W R Wᴴ = I; the fit minimises ‖W r‖², ``noise_var``
         and the covariances are those of the whitened problem.
+    decrement_tol : float
+        Converged also where the Gauss–Newton step would lower the cost by less than this times the residual's
+        mean square per term (cost / degrees of freedom): the step is then sqrt(2 ``decrement_tol``)
+        standard errors long or less (in the norm of the poles' covariance). A pole the lines hardly
+        determine (outside them, its damping nearly collinear with the residual terms) converges linearly,
+        each step ~0.9 times the last, for tens of iterations below a hundredth of its standard error; this
+        stops it there. 0: only the relative step and the flatness decide.
     correlated_lags : int
         0: the poles' covariance is the inverse Fisher information (independent lines). Else the
         errors may correlate over this many neighbouring lines in ways no model gives (the leakage
@@ -475,6 +483,8 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
         parts *= np.repeat(inverse_scale, 2)
 
     y_energy = float(np.vdot(Y, Y).real)
+    # the cost's terms less the linear parameters and the poles: the residual's mean square is cost / cost_dof
+    cost_dof = max(Y.size - n_b * Y.shape[1] - n_theta, 1)
 
     def evaluate(p):
         Phi, dphi = design(p)
@@ -504,6 +514,17 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
                 damped = JtJ.copy()
                 damped[diagonal, diagonal] += lam * diag
                 step = np.linalg.solve(damped, -g)
+                # a damping ratio at its floor that the step would push below it stays there (the bound is
+                # active): the step is solved for the other parameters, so that the predicted decrease and the
+                # convergence tests see what can move. Else a pole collapsing onto ζ = 0 (outside the lines,
+                # where its damping is not determined) kept the fit going to max_iter, each step wanting a
+                # decrease it could not have
+                pinned = (params[1::2] <= zeta_lo) & (step[1::2] < 0)
+                if pinned.any():
+                    free = np.ones(n_theta, bool)
+                    free[1::2] = ~pinned
+                    step = np.zeros(n_theta)
+                    step[free] = np.linalg.solve(damped[np.ix_(free, free)], -g[free])
             except np.linalg.LinAlgError:
                 lam *= 10
                 continue
@@ -515,7 +536,7 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
             # ‖r‖²; it matches the actual decrease to 1e-3 near the optimum): below the flat test's
             # 1e-13 of the cost, the step is not worth an evaluation: converged where it stands
             predicted = -2.0 * float(g @ step) - float(step @ (JtJ @ step))
-            if lam <= 1e-2 and 0.0 <= predicted <= 1e-13 * cost:
+            if lam <= 1e-2 and 0.0 <= predicted <= max(1e-13 * cost, decrement_tol * cost / cost_dof):
                 converged_here = True
                 break
             # a pole the step would push to ζ ≤ 0 (a mode below the noise sliding onto a

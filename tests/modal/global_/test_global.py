@@ -176,6 +176,13 @@ def test_real_beam_modes_and_synthesis():
     band = (f >= 20) & (f <= 990)
     error = np.abs(result.synthesize(f[band]).channels - frf.channels[:, band]) / np.abs(frf.channels[:, band])
     assert np.median(error) < 0.06 and np.percentile(error, 90) < 0.35  # the 6 % and 35 % asked
+    # and no worse than the joint refinement gave when it came (3.8 % and 8.8 %): the 4 % and 9 % asked since.
+    # A pLSCF pole on the band's top edge (993.6 Hz, where the stabilisation picks 992.9 Hz as it stands: the
+    # choice turns on the rounding of pLSCF's sums) wanders above the lines with its damping collapsing onto
+    # its floor; that once kept the final fit going to its iteration limit (every mode did_not_converge), and
+    # the pole, kept at 1059 Hz with ζ = 0, takes the 90th percentile to 9.5 %
+    assert np.median(error) <= 0.04 and np.percentile(error, 90) <= 0.09
+    assert not any("did_not_converge" in m.flags for m in result)
 
 
 def test_cli_global_on_the_real_beam_with_a_stabilisation_plot(tmp_path):
@@ -339,6 +346,9 @@ def test_wide_band_every_mode_found_none_invented(seed):
         assert abs(m.natural_frequency_hz - fn[k]) < 4 * m.std.natural_frequency_hz, (fn[k], m)
         assert abs(m.damping_ratio - zeta[k]) < 4 * m.std.damping_ratio, (fn[k], m.damping_ratio, m.std.damping_ratio)
     assert len(set(matched)) == in_band.size  # the close pair is two modes
+    # a pole above the band whose damping collapsed onto its floor once kept the final fit going to its
+    # iteration limit, and every mode was flagged did_not_converge
+    assert not any("did_not_converge" in m.flags for m in result)
     for j, m in enumerate(result):
         if j not in matched:
             # only the modes above the band, reported as such: poles the lines barely determine (seen: 2325 ± 94 Hz
