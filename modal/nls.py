@@ -293,10 +293,20 @@ def orthonormal_factor(Phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.ascontiguousarray(Q), R
 
 
-def _project(Phi, Y):
-    """Q, R of ``Phi`` (:func:`orthonormal_factor`), QᴴY and the residual sum of squares ‖Y − Q QᴴY‖²."""
+def _project(Phi, Y, y_energy=None):
+    """Q, R of ``Phi`` (:func:`orthonormal_factor`), QᴴY and the residual sum of squares ‖Y − Q QᴴY‖².
+
+    Given ``y_energy`` ‖Y‖², the sum is ‖Y‖² − ‖QᴴY‖² where that keeps :data:`RSS_BY_DIFFERENCE` of ‖Y‖²
+    (its rounding then below 1e-11 of it): no product of Q with QᴴY, no residual formed (two thirds of the
+    projection's time on 4000 lines × 15 columns × 41 combinations of channels).
+    """
     Q, R = orthonormal_factor(Phi)
     QhY = Q.conj().T @ Y
+    if y_energy is not None:
+        fitted = QhY.view(float)
+        cost = y_energy - float(np.einsum("ij,ij->", fitted, fitted))
+        if cost >= RSS_BY_DIFFERENCE * y_energy:
+            return Q, R, QhY, cost
     res = Y - Q @ QhY
     return Q, R, QhY, float(np.vdot(res, res).real)
 
@@ -486,9 +496,13 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
     # the cost's terms less the linear parameters and the poles: the residual's mean square is cost / cost_dof
     cost_dof = max(Y.size - n_b * Y.shape[1] - n_theta, 1)
 
+    # the cost by difference (rounding ~1e-11 of it) where the convergence tests look no closer: a decrement
+    # tolerance stops at decreases of decrement_tol / (lines × combinations) of the cost, 6e-10 or more here
+    by_difference = y_energy if decrement_tol > 0 else None
+
     def evaluate(p):
         Phi, dphi = design(p)
-        Q, R, QhY, cost = _project(Phi, Y)
+        Q, R, QhY, cost = _project(Phi, Y, by_difference)
         return Phi, dphi, Q, R, QhY, cost
 
     state = evaluate(params)

@@ -175,3 +175,26 @@ def test_decrement_tolerance_stops_within_a_small_fraction_of_a_standard_error()
     assert np.all(np.abs(early.omega_n - full.omega_n) < 0.1 * s_wn)
     assert np.all(np.abs(early.damping_ratio - full.damping_ratio)[~pinned] < 0.1 * s_zeta[~pinned])
     assert np.all(early.damping_ratio[pinned] == full.damping_ratio[pinned])
+
+
+def test_projection_cost_by_difference_matches_the_residual_it_stands_for():
+    # with ‖Y‖² given, the projection's cost is ‖Y‖² − ‖QᴴY‖² where that keeps 1e-4 of ‖Y‖² (nls.RSS_BY_DIFFERENCE):
+    # the rounding of the two sums (~1e-16 of ‖Y‖² per term, 1e-12 over 4000 × 8 terms at most) is then below
+    # 1e-8 of the cost; near-exact data (cost below that share) take the residual's own sum
+    from modal.nls import _project
+
+    rng = np.random.default_rng(2)
+    x = np.linspace(0.5, 2.0, 4000)
+    Phi = np.column_stack([1 / (w**2 - x**2 + 2j * 0.01 * w * x) for w in (0.8, 1.3, 1.7)] + [np.ones_like(x)])
+    coef = rng.standard_normal((4, 8)) + 1j * rng.standard_normal((4, 8))
+    exact = Phi @ coef
+    for noise, direct in ((1.0, False), (1e-9, True)):
+        Y = exact + noise * (rng.standard_normal(exact.shape) + 1j * rng.standard_normal(exact.shape))
+        energy = float(np.vdot(Y, Y).real)
+        *_, plain = _project(Phi, Y)
+        *_, quick = _project(Phi, Y, energy)
+        assert (plain < 1e-4 * energy) == direct
+        if direct:
+            assert quick == plain  # formed and summed as without the energy
+        else:
+            assert abs(quick - plain) < 1e-8 * plain
