@@ -235,14 +235,14 @@ def _lag_covariance(scores: np.ndarray, lags: int, region) -> np.ndarray:
     return out
 
 
-def _compress(rows: np.ndarray, scale: np.ndarray, probes: np.ndarray) -> np.ndarray:
+def _compress(rows: np.ndarray, scale: np.ndarray, design: np.ndarray, derivatives: np.ndarray) -> np.ndarray:
     """Many channels: replace Y (n_freq, n_ch) by Y V with V (n_ch, k) orthonormal, where Y is
     ``rows`` (n_ch, n_freq) transposed with each channel times its ``scale``.
 
     The cost ||P⊥ Y V||² and its gradient depend on the channels only through
     the row space kept by V. The fitted coefficients Φ⁺Y and, to first order, their
-    change with the poles are combinations of the rows of Q₀ᴴY, Q₀ an orthonormal
-    basis of ``probes`` (n_freq, k): the start's design and its pole derivatives.
+    change with the poles are combinations of the rows of Q₀ᴴY, Q₀ a basis of the
+    start's ``design`` (n_freq, n_b) and its pole ``derivatives`` (n_freq, n_theta).
     V is an orthonormal basis of that row space: two products with Y, no random
     numbers. With exact data this is lossless; with noise it drops directions that
     carry no information on the poles (on the 1000-channel benchmark the poles
@@ -250,10 +250,14 @@ def _compress(rows: np.ndarray, scale: np.ndarray, probes: np.ndarray) -> np.nda
     randomised range finder of 20 columns with a power iteration, five products
     with Y, stayed within 3e-3). Modal constants and noise levels are computed
     afterwards on the full data. Both products read ``rows`` as they are (BLAS takes
-    the transpose): no scaled copy of every channel. Both bases by :func:`orthonormal_factor` (CholeskyQR2 where
-    the columns are well apart, 3x faster than Householder's QR with its explicit Q here).
+    the transpose): no scaled copy of every channel. The bases by :func:`orthonormal_factor` (CholeskyQR2 where
+    the columns are well apart, 3x faster than Householder's QR with its explicit Q here): Q₀ is that of the
+    design beside that of the derivatives projected off it (design and derivatives side by side are too
+    close to parallel for CholeskyQR2: Householder's QR of them was a quarter of the compression's time).
     """
-    basis, _ = orthonormal_factor(probes)
+    Q, _ = orthonormal_factor(design)
+    off, _ = orthonormal_factor(derivatives - Q @ (Q.conj().T @ derivatives))
+    basis = np.hstack([Q, off])
     V, _ = orthonormal_factor((rows @ basis.conj()).conj() * scale[:, None])  # (n_ch, k) orthonormal: of (Q₀ᴴY)ᴴ
     return rows.T @ (V * scale[:, None])
 
@@ -486,7 +490,7 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
         return Phi, dphi
 
     if n_ch > 2 * (2 * n_b + 8):  # many channels: fit on fewer combinations
-        Y = _compress(rows, inverse_scale, np.hstack(design(params)))
+        Y = _compress(rows, inverse_scale, *design(params))
     else:  # (n_freq, n_ch), each channel scaled: a transposed copy, multiplied on its real view
         Y = np.array(rows.T, order="C")  # (numpy multiplies complex by real as complex by complex)
         parts = Y.view(float)
