@@ -428,10 +428,8 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
     decrement_tol : float
         Converged also where the Gauss–Newton step would lower the cost by less than this times the residual's
         mean square per term (cost / degrees of freedom): the step is then sqrt(2 ``decrement_tol``)
-        standard errors long or less (in the norm of the poles' covariance). A pole the lines hardly
-        determine (outside them, its damping nearly collinear with the residual terms) converges linearly,
-        each step ~0.9 times the last, for tens of iterations below a hundredth of its standard error; this
-        stops it there. 0: only the relative step and the flatness decide.
+        standard errors long or less (in the norm of the poles' covariance): a pole the lines hardly determine
+        converges linearly, for tens of iterations below a tenth of its error. 0: the relative step decides.
     correlated_lags : int
         0: the poles' covariance is the inverse Fisher information (independent lines). Else the
         errors may correlate over this many neighbouring lines in ways no model gives (the leakage
@@ -497,11 +495,8 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
         parts *= np.repeat(inverse_scale, 2)
 
     y_energy = float(np.vdot(Y, Y).real)
-    # the cost's terms less the linear parameters and the poles: the residual's mean square is cost / cost_dof
-    cost_dof = max(Y.size - n_b * Y.shape[1] - n_theta, 1)
-
-    # the cost by difference (rounding ~1e-11 of it) where the convergence tests look no closer: a decrement
-    # tolerance stops at decreases of decrement_tol / (lines × combinations) of the cost, 6e-10 or more here
+    cost_dof = max(Y.size - n_b * Y.shape[1] - n_theta, 1)  # the residual's mean square is cost / cost_dof
+    # the cost by difference (rounding ~1e-11 of it) where the decrement test stops far above that
     by_difference = y_energy if decrement_tol > 0 else None
 
     def evaluate(p):
@@ -532,11 +527,9 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
                 damped = JtJ.copy()
                 damped[diagonal, diagonal] += lam * diag
                 step = np.linalg.solve(damped, -g)
-                # a damping ratio at its floor that the step would push below it stays there (the bound is
-                # active): the step is solved for the other parameters, so that the predicted decrease and the
-                # convergence tests see what can move. Else a pole collapsing onto ζ = 0 (outside the lines,
-                # where its damping is not determined) kept the fit going to max_iter, each step wanting a
-                # decrease it could not have
+                # a damping ratio on its floor that the step would push below it stays there (an active bound):
+                # the step is solved for the others, so that the convergence tests see what can move (else a pole
+                # outside the lines collapsing onto ζ = 0 kept the fit going to max_iter)
                 pinned = (params[1::2] <= zeta_lo) & (step[1::2] < 0)
                 if pinned.any():
                     free = np.ones(n_theta, bool)
