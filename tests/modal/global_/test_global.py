@@ -176,6 +176,13 @@ def test_real_beam_modes_and_synthesis():
     band = (f >= 20) & (f <= 990)
     error = np.abs(result.synthesize(f[band]).channels - frf.channels[:, band]) / np.abs(frf.channels[:, band])
     assert np.median(error) < 0.06 and np.percentile(error, 90) < 0.35  # the 6 % and 35 % asked
+    # and no worse than the joint refinement gave when it came (3.8 % and 8.8 %): the 4 % and 9 % asked since.
+    # A pLSCF pole on the band's top edge (993.6 Hz, where the stabilisation picks 992.9 Hz as it stands: the
+    # choice turns on the rounding of pLSCF's sums) wanders above the lines with its damping collapsing onto
+    # its floor; that once kept the final fit going to its iteration limit (every mode did_not_converge), and
+    # the pole, kept at 1059 Hz with ζ = 0, takes the 90th percentile to 9.5 %
+    assert np.median(error) <= 0.04 and np.percentile(error, 90) <= 0.09
+    assert not any("did_not_converge" in m.flags for m in result)
 
 
 def test_cli_global_on_the_real_beam_with_a_stabilisation_plot(tmp_path):
@@ -339,6 +346,9 @@ def test_wide_band_every_mode_found_none_invented(seed):
         assert abs(m.natural_frequency_hz - fn[k]) < 4 * m.std.natural_frequency_hz, (fn[k], m)
         assert abs(m.damping_ratio - zeta[k]) < 4 * m.std.damping_ratio, (fn[k], m.damping_ratio, m.std.damping_ratio)
     assert len(set(matched)) == in_band.size  # the close pair is two modes
+    # a pole above the band whose damping collapsed onto its floor once kept the final fit going to its
+    # iteration limit, and every mode was flagged did_not_converge
+    assert not any("did_not_converge" in m.flags for m in result)
     for j, m in enumerate(result):
         if j not in matched:
             # only the modes above the band, reported as such: poles the lines barely determine (seen: 2325 ± 94 Hz
@@ -366,3 +376,42 @@ def test_under_resolved_mode_is_reported_flagged_with_honest_errors():
                   (m.damping_ratio - zeta[0]) / m.std.damping_ratio])
     rms2 = np.mean(np.square(z), axis=0)
     assert np.all(rms2 > 0.4 / 6) and np.all(rms2 < 22.5 / 6), z
+
+
+def test_loose_stages_sample_the_lines_far_from_every_mode():
+    """The loose stages of the joint refinement fit every line within two half-power bandwidths of a pole and in
+    the band's top and bottom 5 %, and every 4th line elsewhere with weight 2 (its share of the cost kept in
+    expectation); every line where that would keep more than 80 % of them. The sampled fit only starts the
+    final one, to every line: on the wide-band structure the final fit from the sampled loose fit and from a
+    loose fit to every line end within 0.1 of a standard error of each other, the distance the final stage's
+    decrement test leaves (a step under 0.014 errors, ~0.1 of one for a pole converging linearly)."""
+    from modal.frf import KIND_POWER
+    from modal.global_.identify import LOOSE_DECREMENT, TIGHT_DECREMENT, _loose_lines
+    from modal.nls import fit_modes
+
+    fn, zeta, clean = wide_band_structure()
+    noisy = modal.add_noise(clean, 0.005, seed=3)
+    omega, H = noisy.omega_rad_s, noisy.channels
+    wn0, zeta0 = 2 * np.pi * fn[:13] * 1.0005, zeta[:13] * 1.05
+    index, weight = _loose_lines(omega, wn0, zeta0)
+    near = np.zeros(omega.size, bool)
+    for w, z in zip(wn0, zeta0):
+        near |= np.abs(omega - w) <= max(4 * z * w, 3 * (omega[1] - omega[0]))
+    near[:200] = near[-200:] = True  # 5 % of 4000 lines at either end
+    assert set(np.flatnonzero(near)) <= set(index) and np.all(weight[near[index]] == 1.0)
+    far = index[~near[index]]
+    assert np.all(far % 4 == 0) and np.all(weight[~near[index]] == 2.0)
+    assert index.size < 0.8 * omega.size
+    common = dict(region=None, residual_terms=True, step_tol=1e-9, decrement_tol=LOOSE_DECREMENT)
+    power = KIND_POWER[noisy.kind]
+    every = fit_modes(omega, H, power, wn0, zeta0, **common)
+    sampled = fit_modes(omega[index], H[:, index], power, wn0, zeta0, line_weight=weight,
+                        channel_scale=np.abs(H).max(axis=1), **common)
+    final = dict(common, decrement_tol=TIGHT_DECREMENT)
+    after_every = fit_modes(omega, H, power, every.omega_n, every.damping_ratio, **final)
+    after_sampled = fit_modes(omega, H, power, sampled.omega_n, sampled.damping_ratio, **final)
+    s_wn, s_zeta = np.sqrt(after_every.mode_cov[:, 0, 0, 0]), np.sqrt(after_every.mode_cov[:, 0, 1, 1])
+    assert np.all(np.abs(after_sampled.omega_n - after_every.omega_n) < 0.1 * s_wn)
+    assert np.all(np.abs(after_sampled.damping_ratio - after_every.damping_ratio) < 0.1 * s_zeta)
+    # a line spacing as wide as the modes: nothing far from them to sample, every line
+    assert _loose_lines(omega[::100], wn0, zeta0) is None
