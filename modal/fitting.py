@@ -86,9 +86,9 @@ class FitOptions:
 
             if not isinstance(self.oma, OMAOptions):
                 raise ParameterError(f"'oma' is {self.oma!r}; expected modal.operational.files.OMAOptions")
-        from .work_budget import checked_max_evaluations
-
-        checked_max_evaluations(self.max_evaluations)
+        budget = self.max_evaluations
+        if budget is not None and (isinstance(budget, bool) or not isinstance(budget, int) or budget < 1):
+            raise ParameterError(f"--max-evaluations {budget}: expected a whole number of model evaluations >= 1")
         if self.max_evaluations is not None and self.method in ("circle", "halfpower"):
             raise ParameterError(f"--max-evaluations applies to methods auto, nls, global and all (its nls fit), "
                                  f"not {self.method}")
