@@ -21,8 +21,8 @@ __all__ = ["EvaluationBudget", "REFINEMENT_WORK", "MIN_EVALUATIONS", "evaluation
 
 #: the default budget: evaluations of the start's model of at most this many line-column products in all
 #: (:func:`evaluation_size` each). The ordinary files use a tenth of it at most (the benchmarks' wide case, 120
-#: channels × 4000 lines × 15 modes: 112 evaluations of 4.3e6 products, 4.8e8); single-threaded, 1e9 products
-#: take about 4 s
+#: channels × 4000 lines × 15 modes: 112 evaluations of 4.3e6 products, 4.8e8), while 100 modes on 50 000
+#: lines by nls reach it after 28 evaluations instead of running for minutes (benchmarks/bench_caps.py)
 REFINEMENT_WORK = 5e9
 #: ... and at least this many evaluations, however large each: a fit takes a few steps from its start
 MIN_EVALUATIONS = 20
