@@ -15,6 +15,7 @@ from .peaks import _indicator_and_peak, bands_from_hz, estimate_noise_std, find_
 from .results import IdentificationResult
 from .sdof import BANDWISE_METHODS, identify_bands
 from .validate import channel_mask, one_of, per_channel
+from .work_budget import checked_max_evaluations
 
 __all__ = ["identify", "choose_method", "METHODS", "BANDWISE_METHODS"]
 
@@ -58,7 +59,8 @@ def _auto_choice(frf: FRF, bands_hz, min_prominence_db: float,
 
 
 def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, driving_point=None,
-             min_prominence_db: float = 6.0, max_modes: int | None = None, **global_options) -> IdentificationResult:
+             min_prominence_db: float = 6.0, max_modes: int | None = None, max_evaluations: int | None = None,
+             **global_options) -> IdentificationResult:
     """Identify every mode of an FRF.
 
     Parameters
@@ -95,6 +97,11 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
         Peak detection threshold when ``bands_hz`` is not given.
     max_modes : int, optional
         Keep at most this many (strongest) peaks.
+    max_evaluations : int, optional
+        ``"nls"`` and ``"global"``: model evaluations the least-squares refinement may take, all its fits
+        together (default scaled to the size of one: :func:`modal.work_budget.default_max_evaluations`, never
+        reached by ordinary files); where they run out it stops, its modes flagged ``work_capped`` with a
+        warning. ``result.settings`` gives the budget and the evaluations used.
 
     Returns
     -------
@@ -117,10 +124,16 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
     if global_options and method not in ("global", "auto"):
         raise TypeError(f"identify() got options {', '.join(sorted(global_options))} that only method='global' takes")
     one_of("method", method, METHODS + ("auto",), IdentificationError)
+    if max_evaluations is not None:
+        if method in ("circle", "halfpower"):
+            raise TypeError(f"identify() got max_evaluations, which method={method!r} does not take (nls, global)")
+        max_evaluations = checked_max_evaluations(max_evaluations, IdentificationError)
     if noise_std is not None:
         noise_std = per_channel("noise_std", noise_std, frf.n_channels, IdentificationError)
     if driving_point is not None:
         driving_point = channel_mask("driving_point", driving_point, frf.n_channels, IdentificationError)
+    if max_evaluations is not None:
+        global_options = {**global_options, "max_evaluations": max_evaluations}
     result = _identify(frf, method, bands_hz, noise_std, driving_point, min_prominence_db, max_modes, global_options)
     _check_kind(frf, result, driving_point)
     return result
@@ -159,7 +172,7 @@ def _identify(frf: FRF, method: str, bands_hz, noise_std, driving_point, min_pro
         return unscale_result(result, gain)
     found = None  # peak bands the automatic choice already searched
     if method == "auto":  # chosen on the (possibly rescaled) data, so the choice never overflows
-        method, found = (("global", None) if global_options
+        method, found = (("global", None) if set(global_options) - {"max_evaluations"}
                          else _auto_choice(frf, bands_hz, min_prominence_db, indicator, raw))
     if method == "global":
         from .global_ import identify_global
@@ -173,5 +186,6 @@ def _identify(frf: FRF, method: str, bands_hz, noise_std, driving_point, min_pro
     else:
         bands = find_modes(frf, min_prominence_db=min_prominence_db, max_modes=max_modes, noise_std=raw,
                            line_noise_std=frf.noise_std, indicator=indicator)
-    return identify_bands(frf, method, bands, raw_noise=raw, noise_std=noise_std, driving_point=driving_point)
+    return identify_bands(frf, method, bands, raw_noise=raw, noise_std=noise_std, driving_point=driving_point,
+                          max_evaluations=global_options.get("max_evaluations"))
 

@@ -48,6 +48,10 @@ class NLSFit:
     escaped : ndarray of bool, shape (n_modes,)
         The poles within the lines whose damping ratio grew past ``max_damping`` (the fit stopped there,
         not converged).
+    n_evaluations : int
+        Evaluations of the model (a design and its projection) after the start's.
+    capped : bool
+        The fit stopped at ``max_evaluations`` before converging: the poles are where it stood then.
     """
 
     omega_n: np.ndarray
@@ -62,6 +66,8 @@ class NLSFit:
     channel_scale: np.ndarray | None = None
     line_weighted: bool = False
     escaped: np.ndarray | None = None
+    n_evaluations: int = 0
+    capped: bool = False
 
 
 class RowResidual:
@@ -374,7 +380,7 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
               line_weight: np.ndarray | None = None, channel_scale: np.ndarray | None = None,
               max_damping: float | None = None, errors: bool = True,
               whitening: LineWhitening | None = None, correlated_lags: int = 0,
-              decrement_tol: float = 0.0) -> NLSFit:
+              decrement_tol: float = 0.0, max_evaluations: int | None = None) -> NLSFit:
     """Fit poles and modal constants of several modes to many channels at once.
 
     Parameters
@@ -437,6 +443,10 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
         F⁻¹ B F⁻¹ with B the lag-window (Bartlett) sum of the products of each line's score with
         those of its neighbours within these lags, from the fit's own residual (Newey & West 1987),
         when a Ljung–Box test finds the residual correlated over the lags.
+    max_evaluations : int, optional
+        Evaluations of the model (each a design and its projection, the unit of the fit's work) after the
+        start's, at most; the fit stops there, not converged, with ``capped`` set (None: no limit but
+        ``max_iter``; 0: the start's poles, with their errors).
     """
     omega = np.asarray(omega, float)
     rows = np.ascontiguousarray(np.atleast_2d(np.asarray(response, complex)))  # (n_ch, n_freq), the FRF's unit
@@ -509,8 +519,8 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
     mode_of = np.repeat(np.arange(n_modes), 2)
     diagonal = np.arange(n_theta)
     lam = 1e-4
-    converged = False
-    n_iter = 0
+    converged = capped = False
+    n_iter = n_evaluations = 0
     for n_iter in range(1, max_iter + 1):
         Phi, dphi, Q, R, QhY, cost = state
         C = np.linalg.solve(R, QhY)  # (n_b, n_ch)
@@ -564,12 +574,18 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
                 trial[0::2], trial[1::2] = x_r, zeta_t
                 step = trial - params
                 rel_step = float(np.max(np.abs(step) / np.maximum(np.abs(params), 1e-300)))
+            if max_evaluations is not None and n_evaluations >= max_evaluations:
+                capped = True  # the budget is spent: the fit stays where it stands
+                break
             if np.isfinite(trial).all():
+                n_evaluations += 1
                 new_state = evaluate(trial)
                 if new_state[-1] <= cost:
                     accepted = True
                     break
             lam *= 4
+        if capped:
+            break
         if not accepted:
             small = converged_here or rel_step < step_tol
             converged = bool(small or cost <= 1e-28 * y_energy)
@@ -630,6 +646,8 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
         channel_scale=peak,
         line_weighted=weight is not None or whitening is not None,
         escaped=escaped,
+        n_evaluations=n_evaluations,
+        capped=capped,
     )
 
 

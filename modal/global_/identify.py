@@ -25,6 +25,7 @@ from ..nls import fit_modes, orthonormal_factor
 from ..peaks import estimate_noise_std, find_modes
 from ..results import IdentificationResult
 from ..units import TWO_PI
+from ..work_budget import EvaluationBudget, checked_max_evaluations, default_max_evaluations
 from .plscf import MAX_DAMPING, plscf_poles
 from .stabilisation import SelectedPole, outside_band_poles, select_poles, stabilisation
 
@@ -207,7 +208,7 @@ def _loose_lines(omega, wn, zeta):
     return index, np.where(near[index], 1.0, np.sqrt(LOOSE_EVERY))
 
 
-def _fit_within(omega, H, power, wn, zeta, step_tol):
+def _fit_within(omega, H, power, wn, zeta, step_tol, budget=None):
     """The joint fit with residual terms, without the poles that widen past :data:`MAX_DAMPING`.
 
     A pole that the stabilisation kept on the tail of a mode outside the lines (or on noise) has no
@@ -216,7 +217,8 @@ def _fit_within(omega, H, power, wn, zeta, step_tol):
     significance test then kept: together they explain the out-of-band modes' leakage). The fit stops
     when a pole within the lines leaves the physical damping range, or ends outside it anywhere; it is
     dropped and the others go on from where they are.
-    Returns the fit and the dropped poles' frequencies (Hz).
+    Returns the fit and the dropped poles' frequencies (Hz). ``budget``: the identification's
+    :class:`~modal.work_budget.EvaluationBudget` (each fit takes what is left of it; a fit it stops is returned).
     """
     removed: list[float] = []
     while True:
@@ -224,16 +226,21 @@ def _fit_within(omega, H, power, wn, zeta, step_tol):
             # standard errors only for the final model (the loose fits only start others)
             tight = step_tol <= TIGHT_STEP_TOL
             lines = None if tight else _loose_lines(omega, wn, zeta)
+            allowed = None if budget is None else budget.for_fit()
             if lines is None:
                 fit = fit_modes(omega, H, power, wn, zeta, region=None, residual_terms=True, step_tol=step_tol,
-                                max_damping=MAX_DAMPING, errors=tight,
+                                max_damping=MAX_DAMPING, errors=tight, max_evaluations=allowed,
                                 decrement_tol=TIGHT_DECREMENT if tight else LOOSE_DECREMENT)
             else:
                 index, line_weight = lines
                 fit = fit_modes(omega[index], H[:, index], power, wn, zeta, region=None, residual_terms=True,
                                 step_tol=step_tol, max_damping=MAX_DAMPING, errors=False,
                                 decrement_tol=LOOSE_DECREMENT, line_weight=line_weight,
-                                channel_scale=np.abs(H).max(axis=1))
+                                channel_scale=np.abs(H).max(axis=1), max_evaluations=allowed)
+        if budget is not None:
+            budget.spend(fit)
+            if fit.capped:
+                return fit, removed
         # a pole outside the lines may pass through wide ones on its way to a mode there: only where it
         # converges does its damping say it is background
         wide = fit.escaped | (fit.damping_ratio > MAX_DAMPING)
@@ -243,7 +250,7 @@ def _fit_within(omega, H, power, wn, zeta, step_tol):
         wn, zeta = fit.omega_n[~wide], fit.damping_ratio[~wide]
 
 
-def _refine(omega, H, power, wn0, zeta0, noise, step_tol=LOOSE_STEP_TOL):
+def _refine(omega, H, power, wn0, zeta0, noise, step_tol=LOOSE_STEP_TOL, budget=None):
     """Joint refinement of the poles (rad/s, 1) to ``step_tol``, with the significance test at the refined
     poles: the modes that only fit noise are dropped and the others refitted, until none is.
 
@@ -254,11 +261,14 @@ def _refine(omega, H, power, wn0, zeta0, noise, step_tol=LOOSE_STEP_TOL):
     (:data:`TIGHT_STEP_TOL`): far below any standard error the data give (1e-6 at best), far above
     rounding. A collapsing noise mode creeps for tens of iterations (its ζ shrinking by ~20 % each); the
     loose stages stop it early (benchmark case: 53 -> 24 iterations).
-    Returns the fit and the frequencies (Hz) of the poles dropped.
+    Returns the fit and the frequencies (Hz) of the poles dropped. ``budget``: as for :func:`_fit_within`;
+    once it is spent, no mode is tested or dropped.
     """
     n_ch = H.shape[0]
-    fit, dropped = _fit_within(omega, H, power, wn0, zeta0, step_tol)
+    fit, dropped = _fit_within(omega, H, power, wn0, zeta0, step_tol, budget)
     for _ in range(3):
+        if budget is not None and budget.spent:
+            break
         statistic = _significance(omega, H, power, fit.omega_n, fit.damping_ratio, noise)
         weak = np.zeros(fit.omega_n.size, bool) if statistic is None else statistic <= _significance_threshold(n_ch)
         if weak.all():
@@ -267,7 +277,7 @@ def _refine(omega, H, power, wn0, zeta0, noise, step_tol=LOOSE_STEP_TOL):
         if not weak.any():
             break
         dropped += [float(w / TWO_PI) for w in fit.omega_n[weak]]
-        fit, removed = _fit_within(omega, H, power, fit.omega_n[~weak], fit.damping_ratio[~weak], step_tol)
+        fit, removed = _fit_within(omega, H, power, fit.omega_n[~weak], fit.damping_ratio[~weak], step_tol, budget)
         dropped += removed
     return fit, dropped
 
@@ -337,7 +347,7 @@ def _residual_peaks(omega, H, misfit, noise, omega_n):
     return np.array(wn), np.array(zeta)
 
 
-def _add_missing(omega, H, power, fit, misfit, coef, noise):
+def _add_missing(omega, H, power, fit, misfit, coef, noise, budget=None):
     """One round of the search for modes the model misses: (fit, misfit, coef, dropped Hz), or the inputs
     with None when no candidate was kept.
 
@@ -348,7 +358,8 @@ def _add_missing(omega, H, power, fit, misfit, coef, noise):
     candidates enter the refinement together, and each is kept where the model with it explains the data
     around it (the ``model_inadequate`` test passes there: misfit at the noise or within
     :data:`~modal.flags.RELATIVE_MISFIT` of the data): a residual of real data that one more mode does not
-    explain is the model's limit, not a mode, and its candidate is taken out again.
+    explain is the model's limit, not a mode, and its candidate is taken out again. ``budget``: as for
+    :func:`_refine`.
     """
     wn_new, zeta_new = _residual_peaks(omega, H, misfit, noise, fit.omega_n)
     regions = [np.abs(omega - w) <= 3.5 * float(np.median(np.diff(omega))) for w in wn_new]
@@ -368,7 +379,7 @@ def _add_missing(omega, H, power, fit, misfit, coef, noise):
         keep = ~(split & take_split)
         wn0 = np.concatenate([fit.omega_n[keep], wn_new[take_new], pairs_wn[np.tile(take_split[split], 2)]])
         zeta0 = np.concatenate([fit.damping_ratio[keep], zeta_new[take_new], pairs_zeta[np.tile(take_split[split], 2)]])
-        trial, removed = _refine(omega, H, power, wn0, zeta0, noise)
+        trial, removed = _refine(omega, H, power, wn0, zeta0, noise, budget=budget)
         return (trial, removed, *_lsfd(omega, H, power, trial.omega_n, trial.damping_ratio))
 
     trial, removed, coef_t, misfit_t = refit(np.ones(wn_new.size, bool), split)
@@ -382,17 +393,40 @@ def _add_missing(omega, H, power, fit, misfit, coef, noise):
     return trial, misfit_t, coef_t, removed
 
 
-def _default_max_order(frf: FRF, m: int) -> int:
-    """Enough poles for about three times the visible peaks, plus margin, within 10–120 orders."""
+#: the highest model order the sweep takes by default (``max_order`` lifts it): pLSCF's work grows with the
+#: order squared times the lines
+MAX_DEFAULT_ORDER = 120
+
+
+def _default_max_order(frf: FRF, m: int) -> tuple[int, int]:
+    """Enough poles for about three times the visible peaks, plus margin, within 10–:data:`MAX_DEFAULT_ORDER`
+    orders; and the order the peaks call for (above the cap when it binds)."""
     try:
         peaks = len(find_modes(frf, min_prominence_db=3.0))
     except IdentificationError:
         peaks = 1
-    return int(np.clip(np.ceil((6 * peaks + 20) / m), 10, 120))
+    wanted = int(np.ceil((6 * peaks + 20) / m))
+    return int(np.clip(wanted, 10, MAX_DEFAULT_ORDER)), wanted
+
+
+def _warn_caps(src: str, budget: EvaluationBudget, wanted_order: int | None, max_order: int) -> None:
+    """One warning per work cap that bound: the joint refinement's evaluations, the sweep's model order."""
+    from ..errors import QualityWarning, warn_caller
+
+    if budget.capped:
+        warn_caller(f"{src}: global: the joint refinement stopped at its budget of {budget.limit} model evaluations "
+                    "before converging; its modes are flagged work_capped; identify(..., max_evaluations=N) or "
+                    "--max-evaluations N with N above it lets it go on", QualityWarning)
+    if wanted_order is not None:
+        warn_caller(f"{src}: global: the stabilisation sweep stopped at model order {max_order} (its default "
+                    f"ceiling) where the peaks call for {wanted_order}: modes may be missing; identify(..., "
+                    f"max_order={wanted_order}) or --max-order {wanted_order} sweeps further, or fit bands "
+                    "(method nls)", QualityWarning)
 
 
 def identify_global(frf: FRF, *, modes_hz=None, order: int | None = None, max_order: int | None = None,
-                    band_hz=None, noise_std=None, driving_point=None) -> IdentificationResult:
+                    band_hz=None, noise_std=None, driving_point=None,
+                    max_evaluations: int | None = None) -> IdentificationResult:
     """Identify every mode of a (multi-reference) FRF with one global model.
 
     Parameters
@@ -413,7 +447,12 @@ def identify_global(frf: FRF, *, modes_hz=None, order: int | None = None, max_or
         Known noise σ per channel (default: the FRF's own ``noise_std`` or the estimate).
     driving_point : bool, array_like of bool or channel indices, optional
         Declares which channels are driving points (:func:`modal.assemble.driving_points`).
+    max_evaluations : int, optional
+        Model evaluations the joint refinement may take, all its fits together (default
+        :func:`modal.work_budget.default_max_evaluations`, scaled to the size of one). Where they run out
+        the refinement stops where it stands: its modes are flagged ``work_capped``, with a warning.
     """
+    max_evaluations = checked_max_evaluations(max_evaluations, IdentificationError)
     src = frf.source
     power = KIND_POWER[frf.kind]
     low, high = (0.0, np.inf) if band_hz is None else (float(band_hz[0]), float(band_hz[1]))
@@ -430,10 +469,14 @@ def identify_global(frf: FRF, *, modes_hz=None, order: int | None = None, max_or
     weight = 1.0 / np.sqrt(np.mean(np.abs(H) ** 2, axis=1))  # each channel to RMS 1: the small ones count too
     weight[~np.isfinite(weight)] = 0.0
     matrix = (H * weight[:, None])[index]  # (n_out, m, n_f)
+    wanted_order = None  # the order the peaks call for, where the default's ceiling cut it
     if order is not None:
         orders = [int(order) - 1, int(order)] if order > 1 else [int(order)]
     else:
-        p_max = max_order or _default_max_order(work, m)
+        p_max = max_order
+        if not p_max:
+            p_max, wanted = _default_max_order(work, m)
+            wanted_order = wanted if wanted > p_max else None
         # a long sweep in steps of 2: the diagram compares each order with the previous one computed
         step = 2 if p_max - p_max // 4 > 30 else 1
         orders = list(range(max(1, p_max // 4), p_max + 1, step))
@@ -469,20 +512,24 @@ def identify_global(frf: FRF, *, modes_hz=None, order: int | None = None, max_or
         outside += outside_band_poles(packs, diagram, work.frequency_hz[0], work.frequency_hz[-1], selected)
     wn0 = np.array([p.omega_n for p in inside])
     zeta0 = np.array([p.damping_ratio for p in inside])
-    fit, removed = _refine(omega, H, power, wn0, zeta0, noise)
+    budget = EvaluationBudget(max_evaluations or default_max_evaluations(omega.size, len(inside) + len(outside), n_ch))
+    fit, removed = _refine(omega, H, power, wn0, zeta0, noise, budget=budget)
     dropped += removed
     coef, misfit = _lsfd(omega, H, power, fit.omega_n, fit.damping_ratio)
     # with hints or one order the user chose the modes: none is added
     for _ in range(MISSING_ROUNDS if modes_hz is None and order is None else 0):
-        fit, misfit, coef, removed = _add_missing(omega, H, power, fit, misfit, coef, noise)
+        if budget.spent:
+            break
+        fit, misfit, coef, removed = _add_missing(omega, H, power, fit, misfit, coef, noise, budget)
         if removed is None:
             break
         dropped += removed
-    if outside:
+    if outside and not budget.spent:
         fit, removed = _refine(omega, H, power, np.concatenate([fit.omega_n, [p.omega_n for p in outside]]),
-                               np.concatenate([fit.damping_ratio, [p.damping_ratio for p in outside]]), noise)
+                               np.concatenate([fit.damping_ratio, [p.damping_ratio for p in outside]]), noise,
+                               budget=budget)
         dropped += removed
-    fit, removed = _refine(omega, H, power, fit.omega_n, fit.damping_ratio, noise, TIGHT_STEP_TOL)
+    fit, removed = _refine(omega, H, power, fit.omega_n, fit.damping_ratio, noise, TIGHT_STEP_TOL, budget)
     dropped += removed
     coef, misfit = _lsfd(omega, H, power, fit.omega_n, fit.damping_ratio)
     residuals = coef[-2:].T  # (n_ch, 2): upper, lower: the residual terms in physical form
@@ -508,7 +555,9 @@ def identify_global(frf: FRF, *, modes_hz=None, order: int | None = None, max_or
         cov = fit.mode_cov[r]
         const = fit.modal_constant[r]
         flags: set[str] = set()
-        if not fit.converged:
+        if budget.capped:  # a fit of the refinement stopped at the budget: the poles are where it stood
+            flags.add("work_capped")
+        elif not fit.converged:
             flags.add("did_not_converge")
         chi2, relative = _local_misfit(omega, H, misfit, noise, wn, zeta)
         # Clean real data (data/real beam: 1-2 % misfit at 170-33 000 times a noise the lines hardly show)
@@ -557,6 +606,9 @@ def identify_global(frf: FRF, *, modes_hz=None, order: int | None = None, max_or
                 "band_hz": [float(work.frequency_hz[0]), float(work.frequency_hz[-1])],
                 "modes_hz": None if modes_hz is None else [float(f) for f in np.atleast_1d(modes_hz)],
                 "order": None if order is None else int(order),
-                "dropped_insignificant_hz": dropped}
+                "dropped_insignificant_hz": dropped,
+                "max_evaluations": int(budget.limit), "evaluations": int(budget.used),
+                "order_wanted": wanted_order}
+    _warn_caps(src, budget, wanted_order, orders[-1])
     return IdentificationResult(tuple(modes), "global", frf.kind, n_ch, noise_std=noise,
                                 residuals=residuals, stabilisation=diagram, settings=settings)

@@ -27,6 +27,7 @@ from .checks import fit_residual, fit_residual_noise_std
 from .estimates import bandwise_covariance, rescaled, sdof_estimates, without_neighbours
 from .quality import chi2_of, constant_distance, fit_noise, local_misfit, missing_mode_in_bands, refinement_check
 from .refine import nls_fit, truncation, with_shift, without_window_bias
+from ..work_budget import EvaluationBudget, default_max_evaluations
 
 __all__ = ["BANDWISE_METHODS", "identify_bands"]
 
@@ -37,7 +38,7 @@ REFINEMENT_PRECISION = 1e-13
 
 
 def identify_bands(frf, method: str, bands, *, raw_noise: np.ndarray, noise_std=None,
-                   driving_point=None) -> IdentificationResult:
+                   driving_point=None, max_evaluations: int | None = None) -> IdentificationResult:
     """Identify one mode per band with a band-wise method.
 
     Parameters
@@ -53,6 +54,10 @@ def identify_bands(frf, method: str, bands, *, raw_noise: np.ndarray, noise_std=
         Known noise σ per channel (finite, >= 0); default: the FRF's own per line, else ``raw_noise``.
     driving_point : bool, array_like of bool or channel indices, optional
         Declares which channels are driving points (:func:`modal.assemble.driving_points`).
+    max_evaluations : int, optional
+        ``"nls"``: model evaluations its least-squares fits may take together (default
+        :func:`modal.work_budget.default_max_evaluations`); where they run out the modes are flagged
+        ``work_capped``, with a warning.
     """
     power = KIND_POWER[frf.kind]
     n_ch = frf.n_channels
@@ -68,8 +73,17 @@ def identify_bands(frf, method: str, bands, *, raw_noise: np.ndarray, noise_std=
                                                     rescale=noise_std is None and not known_noise)
         settings = {}
     else:
-        estimates, missing_mode, note = _least_squares_fits(frf, bands, power, noise, estimated_noise, known_noise)
+        estimates, missing_mode, note, budget = _least_squares_fits(frf, bands, power, noise, estimated_noise,
+                                                                    known_noise, max_evaluations)
         settings = {} if note is None else {"window_bias": note}
+        settings.update(max_evaluations=int(budget.limit), evaluations=int(budget.used))
+        if budget.capped:
+            from ..errors import QualityWarning, warn_caller
+
+            warn_caller(f"{frf.source}: nls: the least-squares fit stopped at its budget of {budget.limit} model "
+                        "evaluations before converging (the missing-mode and truncation checks were not run); its "
+                        "modes are flagged work_capped; identify(..., max_evaluations=N) or --max-evaluations N with "
+                        "N above it lets it go on", QualityWarning)
     for index, (band, estimate) in enumerate(zip(bands, estimates)):
         if missing_mode is not None and (missing_mode.band == index or index in missing_mode.moved_bands):
             estimate.flags.add("missing_mode")
@@ -171,17 +185,22 @@ def _single_mode_fits(frf, bands, power, method, noise, estimated_noise, known_n
     return estimates, missing_mode
 
 
-def _least_squares_fits(frf, bands, power, noise, estimated_noise, known_noise):
+def _least_squares_fits(frf, bands, power, noise, estimated_noise, known_noise, max_evaluations=None):
     """The joint least-squares fit of every band's mode (method ``"nls"``) and its checks.
 
-    Returns the modes' :class:`~modal.assemble.ModeEstimate`, the missing mode found (or None), and what was
-    done about the window's bias of an estimate from time records (a sentence, or None).
+    Returns the modes' :class:`~modal.assemble.ModeEstimate`, the missing mode found (or None), what was
+    done about the window's bias of an estimate from time records (a sentence, or None), and the
+    :class:`~modal.work_budget.EvaluationBudget` of the fits (``max_evaluations`` its limit, default scaled to
+    the size of one evaluation); where the fits spent it, the checks that refit are not run.
     """
     data = band_data(frf, bands)  # the lines of the bands, taken out once
     band_peak = band_peaks(bands, data)
-    fit = nls_fit(frf, bands, power, noise, data, band_peak)
+    n_regions = int(data[2].max()) + 1 if data[2] is not None and data[2].size else 0
+    budget = EvaluationBudget(max_evaluations or default_max_evaluations(data[0].size, len(bands), frf.n_channels,
+                                                                         n_regions))
+    fit = nls_fit(frf, bands, power, noise, data, band_peak, budget)
     # an estimate from windowed records: fit the model as the window shows it (its bias is the window's)
-    data, fit, note = without_window_bias(frf, bands, power, data, band_peak, fit)
+    data, fit, note = without_window_bias(frf, bands, power, data, band_peak, fit, budget)
     # the checks all measure the residual of the same modes on the same lines: the fit's own when it is
     # unweighted (no second solve), else computed once
     own = fit.residual is not None and not fit.line_weighted
@@ -210,18 +229,22 @@ def _least_squares_fits(frf, bands, power, noise, estimated_noise, known_noise):
             chi2_noise = np.fmax(residual_noise, neighbour_noise_rms(data[0], fit.residual[rows]))
     chi2 = chi2_of(fit.noise_var[rows], chi2_noise)
     # the check's noise is the residual's own (of every channel, when at hand; else it measures its own)
-    missing_mode = missing_mode_in_bands(frf, bands, power, fit.omega_n, fit.damping_ratio, estimated_noise, residual,
-                                         None if known_noise or isinstance(rows, np.ndarray) else residual_noise,
-                                         data, fit.channel_scale)
-    # near-exact data: the offset's truncation (modes outside the bands) biases the poles
-    # beyond their white-noise errors; its measured shift is added to them
-    shift = truncation(frf, bands, power, fit, residual=residual, data=data)
+    missing_mode = shift = None  # (neither check, each a refit, where the fits spent their budget)
+    if not budget.capped:
+        missing_mode = missing_mode_in_bands(frf, bands, power, fit.omega_n, fit.damping_ratio, estimated_noise,
+                                             residual, None if known_noise or isinstance(rows, np.ndarray)
+                                             else residual_noise, data, fit.channel_scale)
+        # near-exact data: the offset's truncation (modes outside the bands) biases the poles
+        # beyond their white-noise errors; its measured shift is added to them
+        shift = truncation(frf, bands, power, fit, residual=residual, data=data)
     order = np.argsort(fit.omega_n)  # two close poles may cross during the fit
     relative = local_misfit(frf, bands, power, fit.omega_n[order], fit.damping_ratio[order], data, band_peak)
     estimates = []
     for b, (band, r) in enumerate(zip(bands, order)):
         flags: set[str] = set()
-        if not fit.converged:
+        if budget.capped:  # a fit stopped at the budget: the poles are where it stood
+            flags.add("work_capped")
+        elif not fit.converged:
             flags.add("did_not_converge")
         if not np.all(np.isfinite(fit.noise_var)):
             flags.add("too_few_points")  # no lines left over for a residual: no errors
@@ -236,4 +259,4 @@ def _least_squares_fits(frf, bands, power, noise, estimated_noise, known_noise):
         if not (band.low_hz <= wn / TWO_PI <= band.high_hz):
             flags.add("band_edge_peak")
         estimates.append(_estimate(frf, band, wn, zeta, fit.modal_constant[r], cov, s_wn, s_z, flags, chi2, chi2))
-    return estimates, missing_mode, note
+    return estimates, missing_mode, note, budget

@@ -43,7 +43,7 @@ def doubtful(fit, bands) -> bool:
                 and np.all(s_zeta <= REL_STD_LIMIT * zeta))
 
 
-def nls_fit(frf, bands, power, noise, data=None, band_peak=None):
+def nls_fit(frf, bands, power, noise, data=None, band_peak=None, budget=None):
     """The band-wise NLS fit of every band's mode, from the cheapest start that serves.
 
     Each band starts from its one-mode rational fit (a few linear solves); a band where
@@ -52,20 +52,21 @@ def nls_fit(frf, bands, power, noise, data=None, band_peak=None):
     :func:`~modal.sdof.starts.principal_start`, one curve per band, for many channels), and the fit
     with the lower residual is kept.
     ``data``: the :func:`band_data` of the bands, when the caller has it; ``band_peak``: its
-    :func:`band_peaks`.
+    :func:`band_peaks`. ``budget``: the identification's :class:`~modal.work_budget.EvaluationBudget`
+    (where the quick fit spends it, the careful starts are not tried).
     """
     quick = [starts.quick_start(frf, band, power, noise) for band in bands]
     if all(q is not None for q in quick):
         fit = fit_bands(frf, bands, power, [q[0] for q in quick], [q[1] for q in quick], data=data,
-                        band_peak=band_peak)
-        if not doubtful(fit, bands):
+                        band_peak=band_peak, budget=budget)
+        if not doubtful(fit, bands) or (budget is not None and budget.spent):
             return fit
     else:
         fit = None
     start = starts.principal_start if frf.n_channels > 1 else starts.start_pole
     careful_starts = [start(frf, band, power, noise) for band in bands]
     careful = fit_bands(frf, bands, power, [s[0] for s in careful_starts], [s[1] for s in careful_starts], data=data,
-                        band_peak=band_peak)
+                        band_peak=band_peak, budget=budget)
     if fit is None or fit_cost(careful) <= fit_cost(fit):
         return careful
     return fit
@@ -79,7 +80,7 @@ def fit_cost(fit) -> float:
     return float(np.sum(fit.noise_var / scale**2))
 
 
-def fit_bands(frf, bands, power, omega_n0, damping_ratio0, channels=None, data=None, band_peak=None):
+def fit_bands(frf, bands, power, omega_n0, damping_ratio0, channels=None, data=None, band_peak=None, budget=None):
     """:func:`modal.nls.fit_modes` of every band's mode together, with collapsed modes reseated.
 
     A weak mode whose start lies on a noise spike can collapse there inside the
@@ -91,7 +92,8 @@ def fit_bands(frf, bands, power, omega_n0, damping_ratio0, channels=None, data=N
     fit runs again. The restart is kept only when its residual is lower: the
     reported fit is the better least-squares optimum of the same model. ``data``: the
     :func:`band_data` of these bands and channels, when the caller has it; ``band_peak``: its
-    :func:`band_peaks`.
+    :func:`band_peaks`. ``budget``: an :class:`~modal.work_budget.EvaluationBudget` each fit takes what is left
+    of (no restart once it is spent).
     """
     omega, response, region = band_data(frf, bands, channels) if data is None else data
     weight = line_weight(frf, bands)
@@ -100,10 +102,15 @@ def fit_bands(frf, bands, power, omega_n0, damping_ratio0, channels=None, data=N
     scale = None if band_peak is None else band_peak.max(axis=0)  # max |H| of each channel on the lines
     with np.errstate(all="ignore"):
         fit = fit_modes(omega, response, power, omega_n0, damping_ratio0, region=region, line_weight=weight,
-                        channel_scale=scale, whitening=whitening, correlated_lags=lags)
+                        channel_scale=scale, whitening=whitening, correlated_lags=lags,
+                        max_evaluations=None if budget is None else budget.for_fit())
+    if budget is not None:
+        budget.spend(fit)
     if len(bands) < 2:
         return fit
     for r in range(len(bands)):
+        if budget is not None and budget.spent:
+            break
         zeta, s_zeta = fit.damping_ratio[r], np.sqrt(abs(fit.mode_cov[r, 0, 1, 1]))
         if zeta < 1 and s_zeta <= REL_STD_LIMIT * zeta:
             continue
@@ -119,7 +126,10 @@ def fit_bands(frf, bands, power, omega_n0, damping_ratio0, channels=None, data=N
         start_wn[r], start_zeta[r] = start
         with np.errstate(all="ignore"):
             restart = fit_modes(omega, response, power, start_wn, start_zeta, region=region, line_weight=weight,
-                                channel_scale=scale, whitening=whitening, correlated_lags=lags)
+                                channel_scale=scale, whitening=whitening, correlated_lags=lags,
+                                max_evaluations=None if budget is None else budget.for_fit())
+        if budget is not None:
+            budget.spend(restart)
         if fit_cost(restart) < fit_cost(fit):
             fit = restart
     return fit
@@ -166,7 +176,7 @@ def with_shift(cov, pole_shift, constant_shift):
     return cov + d[:, :, None] * d[:, None, :]
 
 
-def without_window_bias(frf, bands, power, data, band_peak, fit):
+def without_window_bias(frf, bands, power, data, band_peak, fit, budget=None):
     """The fit of the model convolved with the estimate's lag window (:mod:`modal.leakage`), when its window
     biases these modes: the data less the window's bias of the fitted modes, refitted, a few rounds (a fixed
     point; the bias changes little with the poles, each round takes its error down by the bias's own
@@ -174,22 +184,27 @@ def without_window_bias(frf, bands, power, data, band_peak, fit):
 
     Returns (data, fit, note): the corrected lines of the bands, their fit, and what was done (a sentence for
     the result's settings), or the arguments unchanged and None when the FRF carries no lag window or it
-    does not bias these modes.
+    does not bias these modes. ``budget``: as for :func:`fit_bands` (no round once it is spent).
     """
     model = frf.noise_model
     if model is None or not bias_matters(model.lag_window, model.sample_interval_s, fit.omega_n,
                                          fit.damping_ratio):
         return data, fit, None
     omega, response, region = data
+    if budget is not None and budget.spent:
+        return data, fit, None
     first, corrected = fit, data
     for _ in range(WINDOW_BIAS_ROUNDS):
+        if budget is not None and budget.spent:
+            break
         with np.errstate(all="ignore"):
             bias = window_bias(omega, power, fit.omega_n, fit.damping_ratio, fit.modal_constant, model.lag_window,
                                model.sample_interval_s)
         if not np.all(np.isfinite(bias)):
             return data, first, None
         corrected = (omega, response - bias, region)
-        fit = fit_bands(frf, bands, power, fit.omega_n, fit.damping_ratio, data=corrected, band_peak=band_peak)
+        fit = fit_bands(frf, bands, power, fit.omega_n, fit.damping_ratio, data=corrected, band_peak=band_peak,
+                        budget=budget)
         if not (np.all(np.isfinite(fit.omega_n)) and np.all(np.isfinite(fit.damping_ratio))):
             return data, first, None
     with np.errstate(all="ignore"):

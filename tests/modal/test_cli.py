@@ -111,3 +111,17 @@ def test_real_beam_files_and_time_data_refused():
     refused = run("fit", time_file)
     # time data without a force channel: refused with what it holds and how to name the force
     assert refused.returncode == 1 and "no channel marked as force" in refused.stderr and "--excitation" in refused.stderr
+
+
+def test_a_budget_of_evaluations_on_the_command_line(three_mode_file):
+    # one evaluation cannot take the nls fit to convergence: its modes are flagged work_capped, with the warning
+    # naming the budget and the option that lifts it
+    capped = run("fit", three_mode_file, "--method", "nls", "--max-evaluations", 1, "--json")
+    assert capped.returncode == 0, capped.stderr
+    assert all("work_capped" in row["flags"] for row in json.loads(capped.stdout)["modes"])
+    assert "stopped at its budget of 1 model evaluations" in capped.stderr and "--max-evaluations N" in capped.stderr
+    for args, message in ((("--max-evaluations", 0), "--max-evaluations 0: expected a whole number"),
+                          (("--method", "circle", "--max-evaluations", 5), "--max-evaluations applies to methods")):
+        bad = run("fit", three_mode_file, *args)
+        assert bad.returncode == 1 and bad.stderr.startswith("error: ") and message in bad.stderr
+        assert len(bad.stderr.strip().splitlines()) == 1

@@ -166,3 +166,42 @@ def test_linear_solves_do_not_depend_on_the_units(method):
         # receptance A' = s_h s_f² A = A here: the same masses, up to rounding and LM paths
         assert abs(b.mass_kg / a.mass_kg - 1) < 1e-9
         assert a.flags == b.flags
+
+
+def _three_modes_noisy():
+    f = np.linspace(1.0, 120.0, 1200)
+    return add_noise(modal_frf(f, THREE_FN, THREE_ZETA, THREE_A, kind="mobility", response_points=["1"],
+                               reference_points=["1"]), 0.01, seed=2)
+
+
+def _numbers(result):
+    return [np.asarray(v) for m in result.modes for v in (m.natural_frequency_hz, m.damping_ratio, m.modal_constant,
+                                                          m.std.natural_frequency_hz, m.std.damping_ratio)]
+
+
+def test_the_nls_fits_share_a_budget_of_evaluations_that_ordinary_data_never_reach():
+    frf = _three_modes_noisy()
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        free = identify(frf, "nls")
+        uncapped = identify(frf, "nls", max_evaluations=10**9)  # the work identify did before it had a budget
+    assert not caught and not any("work_capped" in m.flags for m in free.modes)
+    assert all(np.array_equal(a, b) for a, b in zip(_numbers(free), _numbers(uncapped)))
+    assert 0 < free.settings["evaluations"] <= free.settings["max_evaluations"] / 10
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        capped = identify(frf, "nls", max_evaluations=1)
+    messages = [str(w.message) for w in caught]
+    assert capped.settings["max_evaluations"] == 1 and capped.settings["evaluations"] <= 1 + 1  # the start counts
+    assert all("work_capped" in m.flags and "did_not_converge" not in m.flags for m in capped.modes)
+    assert sum("nls: the least-squares fit stopped at its budget of 1 model evaluations" in m for m in messages) == 1
+    # the choice of method does not change with a budget: three peaks are an nls fit under auto as well
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", modal.ModalWarning)  # its flags, as above
+        assert identify(frf, "auto", max_evaluations=1).method == "nls"
+
+
+def test_a_budget_is_refused_by_the_methods_that_do_not_refine():
+    for method in ("circle", "halfpower"):
+        with pytest.raises(TypeError, match=f"max_evaluations, which method='{method}' does not take"):
+            identify(_three_modes_noisy(), method, max_evaluations=10)

@@ -198,3 +198,25 @@ def test_projection_cost_by_difference_matches_the_residual_it_stands_for():
             assert quick == plain  # formed and summed as without the energy
         else:
             assert abs(quick - plain) < 1e-8 * plain
+
+
+def test_a_budget_of_evaluations_stops_the_fit_where_it_stands():
+    # two modes started 2 % and 30 % off: unbounded, the fit converges in a few evaluations; a budget below that
+    # stops it not converged and marks it capped, after exactly the evaluations allowed; a budget above it
+    # changes nothing (the same steps, bit for bit)
+    f = np.linspace(20, 400, 761)
+    frf = add_noise(modal_frf(f, [100.0, 250.0], [0.02, 0.02], [1.0, 0.5]), 0.01, seed=5)
+    omega, region = frf.omega_rad_s, np.zeros(f.size, int)
+    start = (2 * np.pi * np.array([102.0, 250.0 * 1.3]), [0.03, 0.01])
+    free = fit_modes(omega, frf.channels, 0, *start, region=region)
+    assert free.converged and not free.capped and free.n_evaluations > 3
+    roomy = fit_modes(omega, frf.channels, 0, *start, region=region, max_evaluations=free.n_evaluations)
+    assert roomy.converged and not roomy.capped
+    assert np.array_equal(roomy.omega_n, free.omega_n) and np.array_equal(roomy.mode_cov, free.mode_cov, equal_nan=True)
+    capped = fit_modes(omega, frf.channels, 0, *start, region=region, max_evaluations=2)
+    assert capped.capped and not capped.converged and capped.n_evaluations == 2
+    assert np.all(np.isfinite(capped.omega_n)) and not np.array_equal(capped.omega_n, free.omega_n)
+    at_start = fit_modes(omega, frf.channels, 0, *start, region=region, max_evaluations=0)
+    assert at_start.capped and at_start.n_evaluations == 0
+    np.testing.assert_array_equal(at_start.omega_n, start[0])  # no step taken: the start, with its errors
+    assert np.all(np.isfinite(at_start.mode_cov))

@@ -148,10 +148,6 @@ def write_many_modes(path: Path, n_modes: int = 150, n_lines: int = 60_000) -> N
     """An FRF that is slow to identify by construction: ``n_modes`` well-separated modes on a long
     axis (each found, banded and fitted in turn; 150 modes on 60 000 lines take minutes)."""
     from modal.io import write_frf
-    from modal.synthetic import add_noise, modal_frf
+    from support.manymodes import many_modes_frf
 
-    freq = np.linspace(10.0, 10.0 + 0.25 * n_lines, n_lines)
-    modes = np.linspace(freq[0], freq[-1], n_modes + 2)[1:-1]
-    frf = modal_frf(freq, list(modes), [0.005] * n_modes, [1.0] * n_modes, kind="mobility",
-                    response_points=["1+Z"], reference_points=["1+Z"])
-    write_frf(add_noise(frf, NOISE, seed=3), path, format="hdf5")
+    write_frf(many_modes_frf(n_modes, n_lines, "even", seed=3), path, format="hdf5")
