@@ -204,8 +204,14 @@ class FRF:
             if corr is not None and corr.shape[1] != freq.size:
                 raise FRFValidationError(f"{src}: field 'noise_model' has a line correlation over {corr.shape[1]} "
                                          f"lines; expected {freq.size} (one per line)")
+            variance = self.noise_model.variance_model
+            if variance is not None and variance.size != freq.size:
+                raise FRFValidationError(f"{src}: field 'noise_model' has a variance model over {variance.size} "
+                                         f"lines; expected {freq.size} (one per line)")
             if order is not None and corr is not None:  # the lines were reordered: neighbours are not neighbours
                 object.__setattr__(self, "noise_model", replace(self.noise_model, line_correlation=None))
+            if order is not None and variance is not None:
+                object.__setattr__(self, "noise_model", replace(self.noise_model, variance_model=variance[order]))
         if self.exponential_decay_s is not None:
             object.__setattr__(self, "exponential_decay_s", positive_number(
                 "exponential_decay_s", self.exponential_decay_s, "time in s", FRFValidationError, src))

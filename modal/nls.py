@@ -16,7 +16,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["LineWhitening", "NLSFit", "RowResidual", "fit_modes", "orthonormal_factor", "truncation_shift"]
+from .whitening import LineWhitening
+
+__all__ = ["NLSFit", "RowResidual", "fit_modes", "orthonormal_factor", "truncation_shift"]
 
 
 @dataclass(frozen=True)
@@ -427,7 +429,7 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
         there may pass through wide ones: it is left to go on (the caller judges where it converges).
     errors : bool
         Compute ``mode_cov`` (False: NaN; a fit whose poles only start another needs none).
-    whitening : LineWhitening, optional
+    whitening : modal.whitening.LineWhitening, optional
         Generalised least squares for errors correlated between lines: with the (weighted)
         errors' correlation matrix R, W with W R Wᴴ = I; the fit minimises ‖W r‖², ``noise_var``
         and the covariances are those of the whitened problem.
@@ -649,58 +651,6 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
         n_evaluations=n_evaluations,
         capped=capped,
     )
-
-
-#: a line correlation matrix that is not positive definite even when tapered (a correlation carried over a few
-#: lags only, or measured from few records) is blended towards the identity, (R + εI)/(1 + ε), ε from this up
-CORRELATION_RIDGE = 0.01
-#: a correlation carried over this many lags or more is tapered at once (cut off in its tail, it is rarely
-#: positive definite as it stands: the exponential window's)
-TAPER_FROM = 8
-
-
-class LineWhitening:
-    """Whitening of errors correlated between neighbouring lines: W = L⁻¹ for the banded Cholesky factor L
-    of their correlation matrix R = L Lᴴ (W R Wᴴ = I); ``whitening(X)`` is W X for X (n_lines, k).
-
-    Parameters
-    ----------
-    band : ndarray, shape (bandwidth + 1, n_lines)
-        R in LAPACK's lower banded storage, ``band[d, j] = R[j + d, j]``
-        (:meth:`modal.noise_model.NoiseModel.correlation_band`).
-    """
-
-    def __init__(self, band: np.ndarray):
-        from scipy.linalg import cholesky_banded
-
-        nonzero = np.flatnonzero(np.any(np.abs(band[1:]) > 0, axis=1))
-        bandwidth = int(nonzero[-1]) + 1 if nonzero.size else 0
-        band = np.asarray(band[:bandwidth + 1], complex)
-        # a correlation cut off after a few lags may be indefinite: then it is tapered (1 − d/(b + 1), which
-        # keeps a stationary correlation positive definite), and blended towards the identity if need be
-        taper = 1.0 - np.arange(bandwidth + 1)[:, None] / (bandwidth + 1.0)
-        attempts = [(band, 0.0)] if bandwidth < TAPER_FROM else []
-        attempts += [(band * taper, 0.0)]
-        attempts += [(band * taper, CORRELATION_RIDGE * 4.0**k) for k in range(8)]
-        for trial, ridge in attempts:
-            try:
-                shifted = trial.copy()
-                shifted[0] += ridge
-                self._factor = cholesky_banded(shifted / (1.0 + ridge), lower=True, check_finite=False)
-                break
-            except np.linalg.LinAlgError:
-                continue
-        else:
-            raise np.linalg.LinAlgError("the lines' correlation matrix is far from positive definite")
-        self.bandwidth = bandwidth
-        self.ridge = ridge
-
-    def __call__(self, values: np.ndarray) -> np.ndarray:
-        from scipy.linalg import solve_banded
-
-        if self.bandwidth == 0:
-            return values / self._factor[0][:, None] if values.ndim == 2 else values / self._factor[0]
-        return solve_banded((self.bandwidth, 0), self._factor, values)
 
 
 #: background powers of the check in :func:`truncation_shift`: offset, slope, curvature

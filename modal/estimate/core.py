@@ -21,7 +21,8 @@ import numpy as np
 
 from ..errors import FRFValidationError, ParameterError, QualityWarning, warn
 from ..frf import FRF, FRF_KINDS, KIND_POWER
-from ..noise_model import NoiseModel, lag_window, lags_carried, window_line_correlation
+from ..noise_model import (INPUT_NOISE_LIMIT, NoiseModel, input_noise_split, lag_window, lags_carried,
+                           window_line_correlation)
 from ..validate import finite_samples, one_of, per_line, positive_number
 from . import spectra
 from .hits import find_hits
@@ -147,13 +148,22 @@ def _as_signals(value, name: str, source: str):
 
 
 def _noise_model(sums, output_correlation, input_window, output_window, sample_rate_hz, overlap_factor,
-                 decay_s=None) -> NoiseModel:
+                 decay_s=None, frf=None) -> NoiseModel:
     """The estimate's :class:`~modal.noise_model.NoiseModel` from its sums and windows.
 
     One input: the errors of lines k and k + m correlate by c_out(m) Σ conj(X_k) X_{k+m} / √(S_xx,k S_xx,k+m)
     (the response noise's window correlation times the excitation's own, over the records), and the lag window
     follows from the excitation's mean square per sample; an exponential window's decay is divided out of it
     (identification removes that damping exactly). Several inputs: the averages only.
+
+    One input and one output with ``frf`` (H1, shape (1, 1, n_lines)) and more than one record: the
+    excitation's own noise enters the estimate as −H N_x X*/S_xx, an error in proportion to H that correlates
+    through the input window (c_in) and turns with H's phase. Its share of each line's error follows from the
+    residual (:func:`~modal.noise_model.input_noise_split`: power a + b|H|² per record), the correlation is the
+    two parts' sum, (a c_out(m) + b c_in(m) H_k H*_{k+m}) g_km / √((a + b|H_k|²)(a + b|H_{k+m}|²)), g_km the
+    excitation's term above, and the model's variance per line, (a + b|H_k|²)/S_xx,k, is the noise level's
+    shape (``variance_model``). A hammer test's force noise, over the force window's few dozen samples, is
+    nearly the same on every line of a band: at the peaks it is most of the error.
     """
     n_in = sums.sxx.shape[0]
     dof = max(sums.n_records - n_in, 0) / overlap_factor
@@ -163,16 +173,35 @@ def _noise_model(sums, output_correlation, input_window, output_window, sample_r
     power = sums.sxx[0, 0].real
     n_lags, n_lines = sums.sxx_lag.shape
     correlation = np.zeros((n_lags, n_lines), complex)
+    response_part, input_part, variance = np.ones(n_lines), np.zeros(n_lines, complex), None
+    if frf is not None and frf.shape[:2] == (1, 1) and sums.n_records > 1:
+        h = frf[0, 0]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            residual = (sums.syy[0] - np.abs(sums.syx[0, 0]) ** 2 / power) / (sums.n_records - 1)
+        a, b = input_noise_split(residual, np.abs(h) ** 2)
+        # where the excitation's noise is not small against the excitation (above a hammer's band, at the
+        # zeros of its spectrum) H1 is biased towards zero and the model does not hold: fitted without them
+        holds = b * sums.n_records < INPUT_NOISE_LIMIT * power
+        a, b = input_noise_split(residual, np.abs(h) ** 2, holds)
+        holds = b * sums.n_records < INPUT_NOISE_LIMIT * power
+        total = a + b * np.abs(h) ** 2
+        if b > 0 and np.any(holds) and np.all(total[holds] > 0):
+            response_part = np.where(holds, np.sqrt(a / np.where(holds, total, 1.0)), 1.0)
+            input_part = np.where(holds, np.sqrt(b / np.where(holds, total, 1.0)) * h, 0.0)
+            variance = np.where(holds, total / power * overlap_factor, np.nan)
+    input_correlation = window_line_correlation(input_window)
     for m in range(1, n_lags + 1):
         with np.errstate(divide="ignore", invalid="ignore"):
-            value = output_correlation[m] * sums.sxx_lag[m - 1, :-m] / np.sqrt(power[:-m] * power[m:])
+            mixed = (output_correlation[m] * response_part[:-m] * response_part[m:]
+                     + input_correlation[m] * input_part[:-m] * np.conj(input_part[m:]))
+            value = mixed * sums.sxx_lag[m - 1, :-m] / np.sqrt(power[:-m] * power[m:])
         correlation[m - 1, :-m] = np.where(np.isfinite(value), value, 0.0)
     magnitude = np.abs(correlation)
     correlation = np.where(magnitude > 1, correlation / np.maximum(magnitude, 1e-300), correlation)
     lags = lag_window(input_window, output_window, sums.excitation_square / sums.n_records)
     if decay_s is not None:
         lags = lags * np.exp(np.arange(lags.size) * interval / decay_s)
-    return NoiseModel(sums.n_records, dof, correlation, lags, interval)
+    return NoiseModel(sums.n_records, dof, correlation, lags, interval, variance)
 
 
 def _default_segment_length(n_samples: int) -> int:
@@ -345,7 +374,8 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
     noise = None
     if variance3 is not None:
         noise = np.sqrt(variance3.reshape(n_out * n_in, n_lines) * factor)
-    model = _noise_model(sums, output_correlation, in_w, out_w, fs, factor, decay_s=exponential_decay_s)
+    model = _noise_model(sums, output_correlation, in_w, out_w, fs, factor, decay_s=exponential_decay_s,
+                         frf=frf3 if estimator == "H1" else None)
 
     if response_quantity is not None:
         delta = KIND_POWER[kind] - RESPONSE_QUANTITIES[response_quantity]
@@ -358,7 +388,7 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
             multiple = multiple[:, keep]
             if noise is not None:
                 noise = noise[:, keep] * np.abs(scale)
-            model = model.cropped(keep)
+            model = model.cropped(keep).scaled(np.abs(scale) ** 2)
 
     single = n_out * n_in == 1
     return EstimatedFRF(

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..model import mode_basis, solve_linear
-from ..nls import LineWhitening
+from ..whitening import LineWhitening
 from ..peaks import ModeBand
 from ..units import TWO_PI
 
@@ -146,7 +146,19 @@ def line_weight(frf, bands):
     variance = np.mean(np.atleast_2d(np.asarray(line_noise, float)) ** 2, axis=0)
     model = frf.noise_model
     if model is not None and 0 < model.degrees_of_freedom < NOISE_DOF_TARGET:
-        variance = _smoothed(variance, smoothing_lines(model))
+        lines = smoothing_lines(model)
+        plain = _smoothed(variance, lines)
+        shape = model.variance_model
+        if shape is not None:
+            # where the model holds, the variance's own shape (it rises as |H|² at the peaks where the
+            # excitation's noise dominates) is kept and only its ratio to it, which scatters from line to
+            # line, is averaged (over the neighbours where it holds)
+            holds = np.isfinite(shape) & (shape > 0)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                ratio = _smoothed(np.where(holds, variance / shape, 0.0), lines) / _smoothed(holds * 1.0, lines)
+            variance = np.where(holds, shape * ratio, plain)
+        else:
+            variance = plain
     sigma = np.sqrt(variance[keep])
     ref = float(np.sqrt(np.mean(sigma**2))) if sigma.size else 0.0
     if not (np.all(np.isfinite(sigma)) and ref > 0):
@@ -155,7 +167,7 @@ def line_weight(frf, bands):
 
 
 def line_whitening(frf, bands):
-    """:class:`modal.nls.LineWhitening` of the bands' lines for an FRF whose noise model carries the
+    """:class:`modal.whitening.LineWhitening` of the bands' lines for an FRF whose noise model carries the
     correlation of neighbouring lines (an estimate from time data), else None."""
     model = frf.noise_model
     if model is None or model.line_correlation is None or model.n_lags == 0 or frf.noise_std is None:

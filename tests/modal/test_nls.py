@@ -73,7 +73,7 @@ def test_whitened_fit_on_the_cholesky_qr_projection(monkeypatch):
     # columns): errors correlated between neighbouring lines by a/(1 + a²) ≈ 0.49 (a moving average of white
     # noise), whitened by the banded Cholesky factor of that correlation
     import modal.nls as nls
-    from modal.nls import LineWhitening
+    from modal.whitening import LineWhitening
 
     f = np.linspace(20, 400, 4001)
     exact = modal_frf(f, [100.0, 250.0], [0.02, 0.02], np.array([1.0, 0.5 + 0.2j]))

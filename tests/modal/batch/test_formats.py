@@ -54,10 +54,12 @@ def test_every_format_is_fitted_on_a_cluster_with_daemonic_workers(every, where,
     for path, modes_hz in truth.items():
         # every file's modes where the file put them: within 5 of their standard errors (a file read
         # wrongly, or another file's result, is off by hertz; the FRF files' errors are ~1e-3 Hz,
-        # the time files' (an estimate from 32 s of noisy random excitation) ~0.03 Hz)
+        # the time files' (an estimate from 32 s of random excitation, its errors the records' leakage)
+        # 0.03 Hz at 40 Hz and 0.10 Hz at 95 Hz (ζ 2 %): below 0.15 Hz, 5 of them stay below 0.75 Hz,
+        # under the hertz a misread file is off by)
         assert len(found[path]) == len(modes_hz), path
         for (value, sigma), expected in zip(sorted(found[path]), modes_hz):
-            assert 0 < sigma < 0.1 and abs(value - expected) < 5 * sigma, (path, value, sigma, expected)
+            assert 0 < sigma < 0.15 and abs(value - expected) < 5 * sigma, (path, value, sigma, expected)
     fits = read_archive(out)["files"]
     assert all(fit.ok and fit.sha256 == file_sha256(fit.source) for fit in fits)
 
