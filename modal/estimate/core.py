@@ -25,7 +25,7 @@ from ..noise_model import (INPUT_NOISE_LIMIT, NoiseModel, input_noise_split, lag
                            window_line_correlation)
 from ..validate import finite_samples, one_of, per_line, positive_number
 from . import spectra
-from .hits import find_hits
+from .hits import find_hits, pulse_train
 from .overload import find_overloads
 from .windows import WINDOWS, exponential_window, force_window, segment_window
 
@@ -318,7 +318,8 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
         pre = None if pretrigger_s is None else pretrigger_s
         probe = find_hits(force, np.asarray(y, dtype=float), fs, threshold=threshold, pretrigger_s=pre,
                           record_length=segment_length, double_hit_window_s=double_hit_window_s,
-                          decay_fraction=decay_fraction, full_scale=full_scale, channel_names=labels)
+                          decay_fraction=decay_fraction, full_scale=full_scale, channel_names=labels,
+                          source=source)
         length = probe.record_length
         pre_samples = int(probe.trigger_index[0] - probe.record_start[0])
         decay = (None if exponential_decay_s is None
@@ -326,7 +327,7 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
         hits = probe if decay is None else find_hits(
             force, np.asarray(y, dtype=float), fs, threshold=threshold, pretrigger_s=pre, record_length=length,
             double_hit_window_s=double_hit_window_s, decay_fraction=decay_fraction, decay_window=decay,
-            full_scale=full_scale, channel_names=labels)
+            full_scale=full_scale, channel_names=labels, source=source)
         rejected = hits.rejected
         overloads = hits.overloads
         hit_times = tuple(float(t) / fs for t in hits.trigger_index[hits.accepted])
@@ -355,6 +356,14 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
         starts = np.arange(0, n - length + 1, step)
         in_w = out_w = segment_window(window, length)
         decay = None
+        for i in range(x.shape[0]):
+            train = pulse_train(np.asarray(x[i], dtype=float), fs)
+            if train.impulsive:
+                warn(f"{source}: {labels[i]} is {train.count} short pulse(s) holding {100 * train.energy_share:.0f} % "
+                     f"of its energy in {100 * train.duty:.2f} % of the record, as hammer hits are; estimated as a "
+                     f"continuous record (window {window!r}), which averages them with the noise between and cuts "
+                     "those that straddle segments: estimate it as an impact record (impact=True; modal fit "
+                     "--impact; scene key impact = true)", QualityWarning)
         overloads = find_overloads([x[i] for i in range(x.shape[0])] + [y[o] for o in range(y.shape[0])],
                                    full_scale)
         for item in overloads:

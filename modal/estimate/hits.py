@@ -30,13 +30,21 @@ import numpy as np
 from ..errors import ParameterError
 from .overload import find_overloads
 
-__all__ = ["Hits", "find_hits", "DECAY_LOOK_S", "NOISE_FACTOR"]
+__all__ = ["Hits", "find_hits", "PulseTrain", "pulse_train", "trigger_threshold", "DECAY_LOOK_S", "NOISE_FACTOR",
+           "PULSE_DUTY_LIMIT", "PULSE_ENERGY_SHARE"]
 
 #: how far back the response is looked at before a pulse to judge whether it has decayed, s
 #: (a whole period of any mode above 10 Hz; half the gap to the previous pulse when that is shorter)
 DECAY_LOOK_S = 0.1
 #: a response within this many times its noise floor (RMS of its quietest parts) counts as decayed
 NOISE_FACTOR = 6.0
+#: a force whose pulses above the trigger threshold fill at most this fraction of the record is a train of
+#: hits: hammer pulses of 1–10 ms, a few per second, fill well under 1 %; a shaker's continuous force has no
+#: sample above 8 robust standard deviations (Gaussian: probability 1e-15), a burst random one fills 10–90 %
+PULSE_DUTY_LIMIT = 0.02
+#: ... and those pulses hold at least this share of the force's energy (a few outliers of a heavy-tailed
+#: random force hold far less; the hits of a hammer record hold nearly all of it)
+PULSE_ENERGY_SHARE = 0.5
 
 
 @dataclass(frozen=True)
@@ -98,6 +106,57 @@ def _noise_floor(centred: np.ndarray) -> np.ndarray:
     return np.percentile(np.sqrt(np.mean(blocks**2, axis=2)), 10, axis=1)
 
 
+def trigger_threshold(force: np.ndarray) -> float:
+    """The default trigger level of a force record, in its unit: the larger of 5 % of the largest |force| and
+    8 robust standard deviations of its noise (median absolute deviation / 0.6745)."""
+    noise = float(np.median(np.abs(force - np.median(force)))) / 0.6745
+    return max(0.05 * float(np.max(np.abs(force))), 8.0 * noise)
+
+
+@dataclass(frozen=True)
+class PulseTrain:
+    """How much of a force record is short pulses above the trigger threshold.
+
+    Attributes
+    ----------
+    count : int
+        Pulses above the threshold (bounces within 0.5 ms merged).
+    duty : float
+        Fraction of the record's samples inside those pulses.
+    energy_share : float
+        Fraction of the force's energy above its noise (about its median) inside them.
+    """
+
+    count: int
+    duty: float
+    energy_share: float
+
+    @property
+    def impulsive(self) -> bool:
+        """Whether the force is a train of hits (an impact record) rather than a continuous excitation."""
+        return self.count >= 1 and self.duty <= PULSE_DUTY_LIMIT and self.energy_share >= PULSE_ENERGY_SHARE
+
+
+def pulse_train(force, sample_rate_hz: float) -> PulseTrain:
+    """Measure how much of ``force`` is pulses above :func:`trigger_threshold` (hammer hits), Hz for the rate."""
+    force = np.asarray(force, dtype=float)
+    if force.size == 0 or not np.any(force):
+        return PulseTrain(0, 0.0, 0.0)
+    above = np.abs(force) > trigger_threshold(force)
+    pulses = _pulses(above, max(2, int(round(0.0005 * float(sample_rate_hz)))))
+    inside = np.zeros(force.size, bool)
+    for first, last in pulses:
+        inside[first:last + 1] = True
+    centred = force - np.median(force)
+    noise_variance = (float(np.median(np.abs(centred))) / 0.6745) ** 2
+    # energies above the noise's (the noise's expected energy taken off both), so that a noisy force
+    # channel still shows its hits
+    energy = float(np.sum(centred**2)) - noise_variance * force.size
+    pulse_energy = float(np.sum(centred[inside] ** 2)) - noise_variance * np.count_nonzero(inside)
+    share = float(np.clip(pulse_energy / energy, 0.0, 1.0)) if energy > 0 else 0.0
+    return PulseTrain(len(pulses), float(np.mean(inside)), share)
+
+
 def _names(channel_names, n_outputs: int) -> list[str]:
     if channel_names is None:
         return ["force"] + [f"response {k + 1}" for k in range(n_outputs)]
@@ -111,7 +170,7 @@ def find_hits(force, response, sample_rate_hz: float, *, threshold: float | None
               pretrigger_s: float | None = None, record_length: int | None = None,
               double_hit_window_s: float = 0.05, decay_fraction: float = 0.05,
               decay_window: np.ndarray | None = None, full_scale=None, channel_names=None,
-              channel_units=None) -> Hits:
+              channel_units=None, source: str = "<array>") -> Hits:
     """Find, cut and screen the hits of a continuous impact record.
 
     A pulse belongs to the hit before it when it starts within ``double_hit_window_s``
@@ -150,6 +209,13 @@ def find_hits(force, response, sample_rate_hz: float, *, threshold: float | None
         99.9 % of it are overloads, as are flat tops (:mod:`modal.estimate.overload`).
     channel_names, channel_units : sequence of str, optional
         Force first, then the responses: how the reasons name the channels.
+    source : str
+        The record's name in messages (the file).
+
+    Raises
+    ------
+    ParameterError
+        A force that is zero everywhere, or one with no pulse above the threshold (a continuous force).
     """
     force = np.asarray(force, dtype=float)
     response = np.atleast_2d(np.asarray(response, dtype=float))
@@ -159,16 +225,18 @@ def find_hits(force, response, sample_rate_hz: float, *, threshold: float | None
     units = [None] * len(names) if channel_units is None else list(channel_units)
     peak = float(np.max(np.abs(force))) if n else 0.0
     if peak == 0:
-        raise ParameterError("field 'excitation' is zero everywhere: no hit to find (is it the force channel?)")
-    if threshold is None:
-        noise = float(np.median(np.abs(force - np.median(force)))) / 0.6745
-        threshold = max(0.05 * peak, 8.0 * noise)
-    threshold = float(threshold)
+        raise ParameterError(f"{source}: field 'excitation' is zero everywhere: no hit to find (is it the force "
+                             "channel?)")
+    threshold = trigger_threshold(force) if threshold is None else float(threshold)
     above = np.abs(force) > threshold
     merge_gap = max(2, int(round(0.0005 * fs)))
     pulses = _pulses(above, merge_gap)
     if not pulses:
-        raise ParameterError(f"field 'excitation': no sample exceeds the trigger threshold {threshold:g}")
+        unit = f" {units[0]}" if units[0] else ""
+        raise ParameterError(f"{source}: impact record expected, but {names[0]} has no hit: no sample rises above "
+                             f"the trigger threshold {threshold:g}{unit} (5 % of its peak or 8 times its noise, "
+                             "whichever is larger), as with a shaker's continuous force; expected hammer hits, or "
+                             "estimate it as a continuous record (without impact)")
     centred = response - np.median(response, axis=1, keepdims=True)
     floor = NOISE_FACTOR * _noise_floor(centred)
     bounce = max(1, int(round(double_hit_window_s * fs)))

@@ -254,3 +254,13 @@ def test_clipping_is_reported_on_the_command_line(tmp_path):
     out = run("frf", path, "--out", tmp_path / "s.h5")
     assert out.returncode == 0, out.stderr
     assert "warning: " in out.stderr and "response a1 clipped at 3 (flat tops" in out.stderr
+
+
+def test_a_hammer_record_fitted_without_impact_says_so(tmp_path):
+    # the shipped hammer record, read as a continuous one (the user forgot --impact): the fit runs, and a
+    # warning names the hits and the option that estimates them as such
+    out = run("fit", ROOT / "data" / "synthetic" / "hammer.csv")
+    assert out.returncode == 0, out.stderr
+    warning = [ln for ln in out.stderr.splitlines() if ln.startswith("warning: ")]
+    assert len(warning) == 1 and "short pulse(s)" in warning[0] and "--impact" in warning[0]
+    assert "warning: " not in run("fit", ROOT / "data" / "synthetic" / "hammer.csv", "--impact").stderr

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import modal
-from modal.estimate.hits import find_hits
+from modal.estimate.hits import find_hits, pulse_train
 from modal.synthetic import DigitalModes, hammer_force, impact_record
 
 FS = 2048.0
@@ -111,3 +111,45 @@ def test_no_false_rejection_on_unclipped_noisy_hits():
         reasons.update(r["reason"] for r in hits.rejected)
         assert hits.overloads == []
     assert reasons == collections.Counter()
+
+
+@pytest.mark.parametrize("force_noise", [0.0, 0.01, 0.03])
+def test_a_hammer_force_is_a_pulse_train(force_noise):
+    # six 2 ms pulses in 12 s fill 0.1 % of the record; with noise up to 3 % of the peak (far worse than a
+    # hammer's sensor) the pulses still hold nearly all of the force's energy above its noise
+    record = impact_record(PLANT, 0.5 + 2.0 * np.arange(6), 12.0, force_noise=force_noise, seed=4).record
+    train = pulse_train(record.signals[0], FS)
+    assert train.impulsive and train.count == 6 and train.duty < 0.002 and train.energy_share > 0.9
+
+
+@pytest.mark.parametrize("burst_fraction", [None, 0.1, 0.5])
+def test_a_shaker_force_is_no_pulse_train(burst_fraction):
+    # Gaussian random: no sample above 8 robust standard deviations (probability 1e-15 per sample);
+    # burst random: the bursts fill 10–50 % of the record, far above a hammer's duty
+    rng = np.random.default_rng(5)
+    force = rng.standard_normal(int(64 * FS))
+    if burst_fraction is not None:
+        force[np.arange(force.size) % 8192 >= burst_fraction * 8192] = 0.0
+    assert not pulse_train(force, FS).impulsive
+    assert not pulse_train(np.sin(2 * np.pi * 50.0 * np.arange(force.size) / FS), FS).impulsive
+
+
+def test_hits_estimated_as_a_continuous_record_are_named_and_a_continuous_force_refuses_impact():
+    import warnings
+
+    from modal.errors import ParameterError, QualityWarning
+    from modal.synthetic import random_record
+
+    hammer = impact_record(PLANT, 0.5 + 2.0 * np.arange(6), 12.0, force_noise=0.002, response_noise=0.002,
+                           seed=6).record
+    with pytest.warns(QualityWarning, match=r"hammer\.csv: force is 6 short pulse\(s\).*impact=True"):
+        modal.estimate_frf(hammer.signals[0], hammer.signals[1:], FS, kind="accelerance",
+                           response_quantity="acceleration", source="hammer.csv")
+    shaker = random_record(PLANT, 32.0, response_noise=0.01, seed=7).record
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # a shaker's record, estimated as one, raises no word
+        modal.estimate_frf(shaker.signals[0], shaker.signals[1:], FS, kind="accelerance",
+                           response_quantity="acceleration", source="shaker.csv")
+    with pytest.raises(ParameterError, match=r"^shaker\.csv: impact record expected, but force has no hit.*"
+                                             r"without impact\)$"):
+        _estimate(shaker, source="shaker.csv")
