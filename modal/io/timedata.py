@@ -29,13 +29,14 @@ from __future__ import annotations
 
 import csv as _csv
 import os
+import re
 import warnings
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-from ..errors import FormatError
+from ..errors import FormatError, QualityWarning, warn
 from ._common import check_file, source_name
 from .mat import _MAX_ELEMENTS_PER_BYTE
 
@@ -51,7 +52,13 @@ _QUANTITY_FROM_UNIT = {
 }
 #: factor from a channel's unit to SI (N, m, m/s, m/s²)
 _SI_FACTOR = {"kn": 1e3, "mm": 1e-3, "um": 1e-6, "µm": 1e-6, "mm/s": 1e-3, "g": 9.80665, "lbf": 4.4482216152605}
-_TIME_NAMES = ("time", "t", "time_s", "time [s]", "time (s)", "t [s]", "t (s)")
+#: a time column's header: ``time`` or ``t``, optionally with its unit (``time [ms]``, ``t (s)``, ``time_us``)
+_TIME_HEADER = re.compile(r"^(?:time|t)(?:\s*\[\s*(s|ms|us|µs|μs)\s*\]|\s*\(\s*(s|ms|us|µs|μs)\s*\)|_(s|ms|us))?$",
+                          re.IGNORECASE)
+_TIME_FACTOR = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6, "μs": 1e-6}
+#: a sample rate below this (Hz) from a time column that gives no unit is named: it is what a column in
+#: milliseconds read as seconds gives at rates up to 20 kHz, and below what vibration tests sample at
+LOW_RATE_HZ = 20.0
 
 
 @dataclass(frozen=True)
@@ -139,7 +146,7 @@ class TimeRecord:
         ModalWarning
             An excitation channel of unknown quantity (accepted as the force).
         """
-        from ..errors import ModalWarning, warn
+        from ..errors import ModalWarning
 
         both = sorted(set(inputs) & set(outputs))
         if both:
@@ -220,7 +227,15 @@ def _check(signals: np.ndarray, rate: float, src: str) -> None:
     _check_samples(signals, src, "field 'signals'")
 
 
-def _rate_from_time(time: np.ndarray, src: str, field: str = "time") -> float:
+def _time_column(header: str) -> str | None:
+    """The unit a time column's header gives (``""`` for none, then s), or None when it is not a time column."""
+    match = _TIME_HEADER.match(header.strip())
+    if match is None:
+        return None
+    return next((unit for unit in match.groups() if unit), "")
+
+
+def _rate_from_time(time: np.ndarray, src: str, field: str = "time", unit_given: bool = False) -> float:
     time = np.asarray(time, float).ravel()
     if time.size < 2 or not np.all(np.isfinite(time)):
         raise FormatError(f"{src}: field {field!r} holds {time.size} values or non-finite ones; expected a time axis in s")
@@ -229,7 +244,11 @@ def _rate_from_time(time: np.ndarray, src: str, field: str = "time") -> float:
     if mean <= 0 or np.max(np.abs(step - mean)) > 1e-6 * mean + 1e-9 * abs(time[-1]):
         raise FormatError(f"{src}: field {field!r} is not uniformly increasing; expected samples at one rate "
                           "(resample first)")
-    return 1.0 / mean
+    rate = 1.0 / mean
+    if not unit_given and rate < LOW_RATE_HZ:
+        warn(f"{src}: field {field!r} gives no unit and is read in s: a sample rate of {rate:.6g} Hz; if it "
+             "holds milliseconds, say so in its name ('time [ms]')", QualityWarning)
+    return rate
 
 
 def _uff_time_step(block, d: dict, src: str) -> float:
@@ -333,7 +352,8 @@ def _split_header(text: str) -> tuple[str, str | None]:
     return text.strip(), None
 
 
-_TIME_CSV = "expected a time file: a 'time' column (s) followed by one column per channel, 'name [unit]'"
+_TIME_CSV = ("expected a time file: a 'time' column (s, or 'time [ms]', 'time [us]') followed by one column per "
+             "channel, 'name [unit]'")
 
 
 def _csv_full_scale(comments: list[tuple[int, str]], n_channels: int, src: str) -> list[float | None] | None:
@@ -373,7 +393,8 @@ def _read_csv(path, src: str) -> TimeRecord:
     if len(rows) < 3:
         raise FormatError(f"{src}: {len(rows)} rows; {_TIME_CSV}, and at least 2 rows of samples")
     header_line, header = rows[0]
-    if header[0].lower() not in _TIME_NAMES:
+    time_unit = _time_column(header[0])
+    if time_unit is None:
         frf = header[0].lower().startswith(("freq", "f [", "f_hz", "f (", "omega"))
         what = "a frequency column: an FRF, not a time record" if frf else "not a time column"
         raise FormatError(f"{src}: line {header_line}, column 1 is {header[0]!r} ({what}); {_TIME_CSV}"
@@ -396,7 +417,8 @@ def _read_csv(path, src: str) -> TimeRecord:
                     raise FormatError(f"{src}: line {line_no}, column {column!r}: {cell!r} is not a number; "
                                       "expected numbers below the header") from None
         raise
-    rate = _rate_from_time(table[:, 0], src)
+    factor = _TIME_FACTOR[time_unit.lower()] if time_unit else 1.0
+    rate = _rate_from_time(table[:, 0] * factor, src, field=header[0], unit_given=bool(time_unit))
     scale = _csv_full_scale(comments, len(header) - 1, src)
     signals, names, quantities, units, scales = [], [], [], [], []
     for j, text in enumerate(header[1:], start=1):
@@ -610,7 +632,7 @@ def is_time_file(path: str | os.PathLike) -> bool:
             with open(path, encoding="utf-8-sig", errors="replace") as fh:
                 first = fh.readline()
             head = first.replace(";", ",").replace("\t", ",").split(",")[0].strip().lower()
-            return head in _TIME_NAMES
+            return _time_column(head) is not None
         if kind in ("hdf5", "mat73"):
             import h5py
             with h5py.File(path, "r") as fh:

@@ -256,6 +256,37 @@ def test_frf_csv_is_not_a_time_file(tmp_path):
     _fails(bare, "column 1 is 'frequency_hz'", "an FRF", "expected a time file")
 
 
+
+@pytest.mark.parametrize("header, factor", [("time [ms]", 1e3), ("t (ms)", 1e3), ("time_us", 1e6), ("Time [s]", 1.0)])
+def test_csv_time_column_in_its_own_unit(tmp_path, header, factor):
+    from modal.io.timedata import is_time_file
+
+    path = tmp_path / "unit.csv"
+    rows = [f"{factor * k / FS!r},{float(np.sin(k))!r},{float(np.cos(k))!r}" for k in range(64)]
+    path.write_text(f"{header},force [N],a [m/s^2]\n" + "\n".join(rows) + "\n")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # a unit given: no word about it
+        record = read_time(path)
+    assert is_time_file(path)
+    assert record.sample_rate_hz == pytest.approx(FS, rel=1e-9)
+
+
+def test_csv_time_column_without_unit_holding_milliseconds_is_named(tmp_path):
+    from modal.errors import QualityWarning
+
+    # milliseconds read as seconds: 1.024 Hz, far below what vibration is sampled at; said, with the fix
+    path = tmp_path / "ms.csv"
+    rows = [f"{1e3 * k / FS!r},{float(np.sin(k))!r},{float(np.cos(k))!r}" for k in range(64)]
+    path.write_text("time,force [N],a [m/s^2]\n" + "\n".join(rows) + "\n")
+    with pytest.warns(QualityWarning, match=r"ms\.csv: field 'time' gives no unit.*1\.024 Hz.*'time \[ms\]'"):
+        read_time(path)
+    seconds = tmp_path / "s.csv"
+    seconds.write_text("time,force [N],a [m/s^2]\n" + "\n".join(
+        f"{k / FS!r},{float(np.sin(k))!r},{float(np.cos(k))!r}" for k in range(64)) + "\n")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # seconds at 1024 Hz: no word
+        assert read_time(seconds).sample_rate_hz == pytest.approx(FS, rel=1e-9)
+
 # ------------------------------------------------------------------ channel roles
 def test_roles_refuse_an_accelerometer_as_the_excitation():
     record = read_time(REAL_58B)
