@@ -69,7 +69,8 @@ def build_parser(prog: str = "python -m modal") -> argparse.ArgumentParser:
     fit = sub.add_parser("fit", help="identify the modes of an FRF file",
                          description="Identify natural frequency, damping, modal constant and k, c, m of every mode.")
     fit.add_argument("path", nargs="+", help="FRF file(s) (UFF 58/58b, CSV, MAT, HDF5); several files on one "
-                     "frequency axis become one multi-channel FRF")
+                     "frequency axis become one multi-channel FRF; several time files are takes of one test "
+                     "(the same channels, e.g. one file per hammer hit), averaged as one")
     add_fit_options(fit)
     fit.add_argument("--stabilisation-plot", dest="stabilisation_plot", metavar="OUT.png",
                      help="global: write the stabilisation diagram over the summed FRF")
@@ -86,7 +87,8 @@ def build_parser(prog: str = "python -m modal") -> argparse.ArgumentParser:
     frf = sub.add_parser("frf", help="estimate FRFs from a time record (force and responses)",
                          description="Estimate FRFs with coherence and noise per line from a time file "
                                      "(UFF 58/58b function type 1, CSV with a time column, MAT, HDF5).")
-    frf.add_argument("path", help="time file")
+    frf.add_argument("path", nargs="+", help="time file(s); several are takes of one test (the same channels, "
+                     "e.g. one file per hammer hit), averaged as one")
     frf.add_argument("--out", required=True, metavar="FRF.h5",
                      help="output: .h5 keeps coherence, noise and settings; .uff/.csv/.mat the FRF only")
     frf.add_argument("--kind", choices=FRF_KINDS, help="FRF kind (default: from what the responses measured)")
@@ -127,7 +129,8 @@ def _fit(args) -> int:
                       report_estimate=_report_estimate, report=_note)
     frf, results = fitted.frf, list(fitted.results)
     time_data = None if fitted.time_data is None else (frf, *fitted.time_data)
-    label = args.path[0] if len(args.path) == 1 else f"{args.path[0]} (+{len(args.path) - 1} files)"
+    more = len(args.path) - 1
+    label = args.path[0] if not more else f"{args.path[0]} (+{more} file{'s' if more > 1 else ''})"
     methods = [r.method for r in results]  # what ran ("auto" chooses)
     points = None
     if frf.response_points is not None:
@@ -223,21 +226,22 @@ def _report_estimate(frf) -> None:
              if frf.exponential_decay_s else ""), file=sys.stderr)
     for item in frf.rejected:
         detail = f" ({item['detail']})" if item.get("detail") else ""
-        print(f"{frf.source}: hit {item['hit']} at {item['time_s']:.4g} s rejected: {item['reason']}{detail}",
+        where = item.get("take_name", frf.source)
+        print(f"{where}: hit {item['hit']} at {item['time_s']:.4g} s rejected: {item['reason']}{detail}",
               file=sys.stderr)
 
 
 def _frf(args) -> int:
     from .io import write_frf
 
-    frf, *record = frf_from_time(args.path, args, _note)
+    frf, *record = frf_from_time(args.path[0] if len(args.path) == 1 else args.path, args, _note)
     _report_estimate(frf)
     write_frf(frf, args.out)
     if args.plot:
         for path in save_time_plots(args.plot, frf, *record):
             print(f"plot: {path}", file=sys.stderr)
     if args.json:
-        doc = {"file": args.path, "out": args.out, "kind": frf.kind, "n_channels": frf.n_channels,
+        doc = {"file": args.path[0] if len(args.path) == 1 else list(args.path), "out": args.out, "kind": frf.kind, "n_channels": frf.n_channels,
                "n_lines": frf.n_freq, "averages": frf.averages, "estimator": frf.estimator, "window": frf.window,
                "exponential_decay_s": frf.exponential_decay_s, "rejected": frf.rejected,
                "response_points": list(frf.response_points or []),

@@ -185,7 +185,8 @@ def fit_path(path: str | os.PathLike | Sequence[str | os.PathLike], options: Fit
     Parameters
     ----------
     path : path-like or sequence of path-likes
-        One file, or several on one frequency axis (one multi-channel FRF).
+        One file, or several FRF files on one frequency axis (one multi-channel FRF), or several
+        time files: takes of one test (the same channels), estimated as one.
     options : FitOptions
     report_estimate : callable, optional
         Called with the estimate when the file held time data (the command line prints a line).
@@ -214,8 +215,8 @@ def fit_path(path: str | os.PathLike | Sequence[str | os.PathLike], options: Fit
         return FitOutput(frf=None, results=(oma_file(paths[0], options.oma),))
     args = options.namespace()
     time_data = None
-    if len(paths) == 1 and wants_time(args, paths[0]):
-        frf, *record = frf_from_time(paths[0], args, report)
+    if any(wants_time(args, p) for p in paths):  # several time files are takes of one test
+        frf, *record = frf_from_time(paths[0] if len(paths) == 1 else paths, args, report)
         time_data = tuple(record)
         if report_estimate is not None:
             report_estimate(frf)

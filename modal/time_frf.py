@@ -8,6 +8,7 @@ under the same names and calls :func:`plan_time_frf` (when the scene is checked)
 """
 from __future__ import annotations
 
+import os
 import re
 from dataclasses import dataclass, replace
 from typing import Callable
@@ -40,7 +41,9 @@ def frf_from_time(path, args, report: Callable[[str], None] | None = None):
 
     Parameters
     ----------
-    path : path-like
+    path : path-like or sequence of path-likes
+        One file, or several takes of one test (the same channels at one rate, such as one file
+        per hammer hit): estimated as one, no segment or hit record straddling two files.
     args : object
         The time options as attributes (:data:`TIME_OPTIONS`, and ``kind``): an ``argparse``
         namespace or :meth:`modal.fitting.FitOptions.namespace`.
@@ -53,8 +56,10 @@ def frf_from_time(path, args, report: Callable[[str], None] | None = None):
         The estimate, the record, and the excitation and response channel indices.
     """
     from .io.timedata import read_time
+    from .io.timejoin import join_takes
 
-    record = read_time(path)
+    paths = [path] if isinstance(path, (str, os.PathLike)) else list(path)
+    record = join_takes([read_time(p) for p in paths])
     plan = plan_time_frf(record, args, report)
     return estimate_time_frf(record, plan, args), record, list(plan.inputs), list(plan.outputs)
 
@@ -150,6 +155,7 @@ def estimate_time_frf(record, plan: TimePlan, args):
         exponential_decay_s=args.exponential_decay_s, impact=args.impact,
         response_quantity=plan.quantity, excitation_points=[record.names[k] for k in inputs],
         response_points=[record.names[k] for k in outputs], source=record.source,
+        take_lengths=record.take_lengths, take_names=record.take_sources,
         full_scale=None if record.full_scale is None else [record.full_scale[k] for k in inputs + outputs])
     if points is None:  # names, not point ids: they do not say where the force and the responses stood
         estimate = replace(estimate, reference_points=None)

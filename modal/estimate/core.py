@@ -27,6 +27,8 @@ from ..validate import finite_samples, one_of, per_line, positive_number
 from . import spectra
 from .hits import find_hits, pulse_train
 from .overload import find_overloads
+from .takes import find_hits_in_takes, segment_starts, take_bounds
+from .takes import take_names as _take_names
 from .windows import WINDOWS, exponential_window, force_window, segment_window
 
 __all__ = ["EstimatedFRF", "estimate_frf", "RESPONSE_QUANTITIES"]
@@ -215,7 +217,8 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
                  response_quantity: str | None = None, excitation_points=None, response_points=None,
                  threshold: float | None = None, pretrigger_s: float | None = None,
                  double_hit_window_s: float = 0.05, decay_fraction: float = 0.05,
-                 full_scale=None, source: str = "<array>") -> EstimatedFRF:
+                 full_scale=None, take_lengths=None, take_names: list[str] | None = None,
+                 source: str = "<array>") -> EstimatedFRF:
     """Estimate FRFs, coherence and per-line noise from excitation and response records.
 
     Parameters
@@ -260,6 +263,13 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
         99.9 % of it, and flat tops at a channel's extreme (clipping), are overloads:
         impact records reject the hits they touch, continuous records warn
         (:class:`~modal.errors.QualityWarning`); both list them in ``overloads``.
+    take_lengths : sequence of int, optional
+        Samples of each take when the records join several takes of one test end to end (hammer
+        hits saved one file per hit): no segment or hit record straddles two takes, and hits are
+        found take by take (:mod:`modal.estimate.takes`). ``hit_times_s`` then count on the joined
+        samples, and each rejection says its ``take`` (from 1) and ``take_name``.
+    take_names : sequence of str, optional
+        How messages name the takes (the files; default ``"take 1"``, …).
     source : str
         Name used in messages (the file).
 
@@ -285,6 +295,8 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
     n = x.shape[1]
     finite_samples(x, "excitation", source)
     finite_samples(y, "response", source)
+    bounds = take_bounds(take_lengths, n, source)
+    names_of_takes = _take_names(take_names, bounds.size - 1, source)
 
     def ids(points, count, name):
         if points is None:
@@ -316,15 +328,20 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
             raise ParameterError(f"{source}: impact=True takes one force channel, got {x.shape[0]}")
         force = np.asarray(x[0], dtype=float)
         pre = None if pretrigger_s is None else pretrigger_s
-        probe = find_hits(force, np.asarray(y, dtype=float), fs, threshold=threshold, pretrigger_s=pre,
-                          record_length=segment_length, double_hit_window_s=double_hit_window_s,
-                          decay_fraction=decay_fraction, full_scale=full_scale, channel_names=labels,
-                          source=source)
+
+        def find(force, response, rate, **options):
+            if take_lengths is None:
+                return find_hits(force, response, rate, **options)
+            return find_hits_in_takes(force, response, rate, bounds, names_of_takes, **options)
+
+        probe = find(force, np.asarray(y, dtype=float), fs, threshold=threshold, pretrigger_s=pre,
+                     record_length=segment_length, double_hit_window_s=double_hit_window_s,
+                     decay_fraction=decay_fraction, full_scale=full_scale, channel_names=labels, source=source)
         length = probe.record_length
         pre_samples = int(probe.trigger_index[0] - probe.record_start[0])
         decay = (None if exponential_decay_s is None
                  else exponential_window(length, fs, exponential_decay_s, pre_samples))
-        hits = probe if decay is None else find_hits(
+        hits = probe if decay is None else find(
             force, np.asarray(y, dtype=float), fs, threshold=threshold, pretrigger_s=pre, record_length=length,
             double_hit_window_s=double_hit_window_s, decay_fraction=decay_fraction, decay_window=decay,
             full_scale=full_scale, channel_names=labels, source=source)
@@ -333,7 +350,9 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
         hit_times = tuple(float(t) / fs for t in hits.trigger_index[hits.accepted])
         starts = hits.record_start[hits.accepted]
         if starts.size == 0:
-            reasons = "; ".join(f"hit {r['hit']} at {r['time_s']:.3f} s: {r['reason']}" for r in rejected)
+            where = [f"{r['take_name']} " if "take" in r else "" for r in rejected]
+            reasons = "; ".join(f"{at}hit {r['hit']} at {r['time_s']:.3f} s: {r['reason']}"
+                                for at, r in zip(where, rejected))
             raise ParameterError(f"{source}: every hit was rejected ({reasons})")
         in_w = np.ones(length)
         if window in ("force", "exponential"):
@@ -349,11 +368,14 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
                                  "a continuous record takes 'rect' or 'hann'")
         if exponential_decay_s is not None:
             raise ParameterError("field 'exponential_decay_s' applies to impact records (impact=True)")
-        length = _default_segment_length(n) if segment_length is None else int(segment_length)
-        if not (2 <= length <= n):
-            raise ParameterError(f"field 'segment_length' is {segment_length!r}; expected 2 to {n} samples")
+        shortest = int(np.min(np.diff(bounds)))
+        length = (min(_default_segment_length(n), 1 << int(np.floor(np.log2(shortest))))
+                  if segment_length is None else int(segment_length))
+        if not (2 <= length <= shortest):
+            what = f"{shortest} samples (the shortest take)" if bounds.size > 2 else f"{n} samples"
+            raise ParameterError(f"field 'segment_length' is {segment_length!r}; expected 2 to {what}")
         step = max(1, int(round(length * (1.0 - overlap))))
-        starts = np.arange(0, n - length + 1, step)
+        starts = segment_starts(bounds, length, step)
         in_w = out_w = segment_window(window, length)
         decay = None
         for i in range(x.shape[0]):

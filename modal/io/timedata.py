@@ -80,6 +80,11 @@ class TimeRecord:
     full_scale : tuple of float or None, or None
         Each channel's declared converter full scale in the channel's unit (SI where
         converted), None where the file does not say; None for no channel at all.
+    take_lengths : tuple of int, or None
+        Samples of each take when the record joins several (:func:`modal.io.timejoin.join_takes`);
+        None for one recording.
+    take_sources : tuple of str, or None
+        The file of each take.
     """
 
     signals: np.ndarray
@@ -89,6 +94,8 @@ class TimeRecord:
     units: tuple[str | None, ...]
     source: str = "<array>"
     full_scale: tuple[float | None, ...] | None = None
+    take_lengths: tuple[int, ...] | None = None
+    take_sources: tuple[str, ...] | None = None
 
     @property
     def n_channels(self) -> int:

@@ -264,3 +264,29 @@ def test_a_hammer_record_fitted_without_impact_says_so(tmp_path):
     warning = [ln for ln in out.stderr.splitlines() if ln.startswith("warning: ")]
     assert len(warning) == 1 and "short pulse(s)" in warning[0] and "--impact" in warning[0]
     assert "warning: " not in run("fit", ROOT / "data" / "synthetic" / "hammer.csv", "--impact").stderr
+
+
+def test_hammer_hits_saved_in_several_files_are_averaged_as_one_test(tmp_path):
+    # the shipped hammer record (eight hits, 1.25 s apart) saved as two files cut in the quiet between hits 4
+    # and 5: `modal fit` of the two files averages the same eight hits as the whole record, table for table
+    lines = (ROOT / "data" / "synthetic" / "hammer.csv").read_text().splitlines()
+    header, rows = lines[0], lines[1:]
+    cut = 5120  # 5.0 s: hit 4's record ends at 4.93 s, hit 5 starts at 5.2 s
+    first, second = tmp_path / "hit_a.csv", tmp_path / "hit_b.csv"
+    first.write_text("\n".join([header] + rows[:cut]) + "\n")
+    t0 = float(rows[cut].split(",")[0])
+    second.write_text("\n".join([header] + [",".join([repr(float(r.split(",")[0]) - t0)] + r.split(",")[1:])
+                                            for r in rows[cut:]]) + "\n")
+    both = run("fit", first, second, "--impact", "--json")
+    whole = run("fit", ROOT / "data" / "synthetic" / "hammer.csv", "--impact", "--json")
+    assert both.returncode == 0 and whole.returncode == 0, both.stderr
+    assert "8 average(s)" in both.stderr
+    modes = [json.loads(out.stdout)["modes"] for out in (both, whole)]
+    assert [m["natural_frequency_hz"] for m in modes[0]] == pytest.approx(
+        [m["natural_frequency_hz"] for m in modes[1]], rel=1e-9)
+    # a file of other channels is not a take of the same test
+    other = tmp_path / "other.csv"
+    other.write_text("\n".join([header.replace("1+Z [m/s^2]", "2+Z [m/s^2]")] + rows[:cut]) + "\n")
+    out = run("fit", first, other, "--impact")
+    assert out.returncode == 1 and out.stderr.count("\n") == 1
+    assert "other.csv: channel 2 (names) is '2+Z'" in out.stderr and "expected the same channels" in out.stderr

@@ -1,0 +1,47 @@
+"""Several time files as one record of takes (modal.io.timejoin.join_takes)."""
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from modal.errors import FormatError
+from modal.io.timejoin import join_takes
+from modal.synthetic import DigitalModes, impact_record
+
+PLANT = DigitalModes([40.0, 95.0], [0.03, 0.02], [[1.0, 0.5], [0.6, -0.8]], 1024.0)
+
+
+def _take(seed, source):
+    return replace(impact_record(PLANT, [0.5], 2.0, seed=seed, names=["hammer", "a1", "a2"]).record, source=source)
+
+
+def test_takes_are_joined_end_to_end_and_say_where_each_ends():
+    first, second = _take(1, "a.csv"), _take(2, "b.csv")
+    joined = join_takes([first, second])
+    np.testing.assert_array_equal(joined.signals, np.concatenate([first.signals, second.signals], axis=1))
+    assert joined.take_lengths == (first.n_samples, second.n_samples)
+    assert joined.take_sources == ("a.csv", "b.csv") and joined.source == "a.csv (+1 file)"
+    assert join_takes([first]) is first
+
+
+@pytest.mark.parametrize("change, fragment", [
+    ({"names": ("hammer", "a1", "a3")}, "b.csv: channel 3 (names) is 'a3' where a.csv has 'a2'"),
+    ({"units": ("N", "m/s^2", "m/s")}, "b.csv: channel 3 (units) is 'm/s' where a.csv has 'm/s^2'"),
+    ({"sample_rate_hz": 2048.0}, "b.csv: sample rate 2048 Hz where a.csv has 1024 Hz"),
+    ({"full_scale": (100.0, None, None)}, "b.csv: full scale"),
+])
+def test_a_take_with_other_channels_is_refused(change, fragment):
+    second = replace(_take(2, "b.csv"), **change)
+    with pytest.raises(FormatError) as info:
+        join_takes([_take(1, "a.csv"), second])
+    assert fragment in str(info.value) and "expected" in str(info.value) and "\n" not in str(info.value)
+
+
+def test_a_take_with_fewer_channels_is_refused():
+    second = _take(2, "b.csv")
+    second = replace(second, signals=second.signals[:2], names=second.names[:2], quantities=second.quantities[:2],
+                     units=second.units[:2])
+    with pytest.raises(FormatError, match="b.csv: 2 channel\\(s\\) where a.csv has 3"):
+        join_takes([_take(1, "a.csv"), second])
