@@ -22,7 +22,7 @@ import importlib
 from dataclasses import dataclass, field
 from typing import Any, Mapping
 
-from .rules import BOOL, INT, NONNEG, NUM, POS, STR, choice, complex_value, list_of, ref_or
+from .rules import BOOL, FILES, INT, NONNEG, NUM, POS, STR, choice, complex_value, list_of, ref_or
 
 __all__ = ["Stage", "REGISTRY", "STAGES", "load", "result_modules"]
 
@@ -175,7 +175,7 @@ REGISTRY: dict[str, Stage] = {stage.name: stage for stage in (
     Stage(
         "frf", run=f"{_STAGES}:stage_frf", needs=("frf",), files=("frf.file",), prepare=f"{_STAGES}:check_frf",
         config={"frf": {
-            "file": STR, "kind": _KINDS,
+            "file": FILES, "kind": _KINDS,
             # the read options of `python -m modal fit`, under the same names
             "frequency_axis": choice("hz", "khz", "rad/s", "cpm", "rpm"), "frequency_step": POS,
             "frequency_start": NONNEG, "layout": STR, "delimiter": STR, "decimal": STR, "dataset": INT,

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 from .._checks import scene_number
 
-__all__ = ["POS", "NONNEG", "NUM", "INT", "BOOL", "STR", "choice", "list_of", "ref_or", "complex_value",
+__all__ = ["POS", "NONNEG", "NUM", "INT", "BOOL", "STR", "FILES", "choice", "list_of", "ref_or", "complex_value",
            "Reference", "parse_reference", "IDENTIFIED_FIELDS", "DRIVE_FIELDS", "REFERENCE_STAGES"]
 
 IDENTIFIED_FIELDS = {
@@ -61,6 +61,15 @@ def BOOL(v):
 def STR(v):
     if not isinstance(v, str) or not v:
         raise ValueError("a non-empty string")
+    return v
+
+
+def FILES(v):
+    """One file name, or a list of them (takes of one test)."""
+    if isinstance(v, list):
+        return list_of(STR)(v)
+    if not isinstance(v, str) or not v:
+        raise ValueError("a file name or a list of file names")
     return v
 
 

@@ -88,12 +88,17 @@ def stage_hashes(scene: Scene, stages) -> dict[str, str]:
 
 
 def _file_sha256(scene: Scene, key: str) -> str:
-    path = scene.folder / scene.section(key)
-    try:
-        return hashlib.sha256(path.read_bytes()).hexdigest()
-    except OSError as exc:
-        raise SceneError(f"{scene.source}: key '{key}' = {scene.section(key)!r}: cannot read {path} "
-                         f"({exc.strerror})") from None
+    """SHA-256 of the file a key names, or of the files' own hashes in order when it names several."""
+    names = scene.section(key)
+    digests = []
+    for name in names if isinstance(names, list) else [names]:
+        path = scene.folder / name
+        try:
+            digests.append(hashlib.sha256(path.read_bytes()).hexdigest())
+        except OSError as exc:
+            raise SceneError(f"{scene.source}: key '{key}' = {names!r}: cannot read {path} "
+                             f"({exc.strerror})") from None
+    return digests[0] if len(digests) == 1 else hashlib.sha256(" ".join(digests).encode()).hexdigest()
 
 
 def plan(scene: Scene, earlier: h5py.File | None = None) -> tuple[dict[str, str], dict[str, str]]:

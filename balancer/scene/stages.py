@@ -205,18 +205,19 @@ def check_frf(scene: Scene):
     from modal.errors import ModalError
     from modal.time_frf import wants_time
 
-    path = scene.folder / cfg["file"]
-    if not wants_time(_time_options(cfg), path):
+    paths = _frf_paths(scene)
+    if not any(wants_time(_time_options(cfg), path) for path in paths):
         return None
     read_keys = [k for k in FRF_READ_OPTIONS if k in cfg and k != "kind"]
     if read_keys:
         raise SceneError(f"{scene.source}: key 'frf.{read_keys[0]}' applies to an FRF file, but {cfg['file']!r} is a "
                          f"time record; expected its time options ({', '.join(TIME_FRF_OPTIONS)}, kind)")
     from modal.io.timedata import read_time
+    from modal.io.timejoin import join_takes
     from modal.time_frf import plan_time_frf
 
     try:
-        record = read_time(path)
+        record = join_takes([read_time(path) for path in paths])  # several files: takes of one test
     except ModalError as exc:
         raise SceneError(f"{scene.source}: key 'frf.file' = {cfg['file']!r}: {exc}") from None
     # each named channel is looked up under its own key, so that an error names it
@@ -233,6 +234,12 @@ def check_frf(scene: Scene):
     except ModalError as exc:
         raise SceneError(f"{scene.source}: key 'frf': {exc}") from None
     return record, plan
+
+
+def _frf_paths(scene: Scene) -> list:
+    """The files [frf] file names: one, or several (FRFs on one axis, or takes of one test)."""
+    names = scene.section("frf")["file"]
+    return [scene.folder / name for name in (names if isinstance(names, list) else [names])]
 
 
 def _time_options(cfg: dict):
@@ -302,7 +309,8 @@ def stage_frf(scene: Scene) -> modal.FRF:
         from modal.io import read_frf
 
         hints = {k: cfg[k] for k in FRF_READ_OPTIONS if k in cfg}
-        return read_frf(scene.folder / cfg["file"], **hints)
+        paths = _frf_paths(scene)
+        return read_frf(paths[0] if len(paths) == 1 else paths, **hints)
     syn = cfg["synthetic"]
     from modal.synthetic import add_noise, modal_frf
 

@@ -162,3 +162,65 @@ def test_a_file_without_point_ids_gives_k_c_M_once_its_driving_point_is_declared
     assert done.results["rotor"].params.k == mode.stiffness_n_per_m
     # the modal mass of the first mode, 1/0.96 kg, within 3 of its standard errors
     assert abs(mode.mass_kg - 1 / 0.96) < 3 * mode.std.mass_kg
+
+
+def _split_hammer_record(tmp_path):
+    """The shipped hammer record saved as two files cut in the quiet between hits 4 and 5 (5.0 s)."""
+    from support.paths import SYNTHETIC
+
+    lines = (SYNTHETIC / "hammer.csv").read_text().splitlines()
+    header, rows = lines[0], lines[1:]
+    first, second = tmp_path / "hit_a.csv", tmp_path / "hit_b.csv"
+    first.write_text("\n".join([header] + rows[:5120]) + "\n")
+    t0 = float(rows[5120].split(",")[0])
+    second.write_text("\n".join([header] + [",".join([repr(float(r.split(",")[0]) - t0)] + r.split(",")[1:])
+                                            for r in rows[5120:]]) + "\n")
+    return first, second
+
+
+def test_a_scene_takes_a_hammer_test_saved_one_file_per_part(tmp_path):
+    """[frf] file = [...] of time records: takes of one test, estimated as one, as `modal fit a b` does; a file
+    of other channels is refused when the scene is read, naming it."""
+    import numpy as np
+
+    from balancer.scene import parse_scene
+    from modal.errors import SceneError
+    from modal.fitting import FitOptions
+    from modal.time_frf import frf_from_time
+
+    first, second = _split_hammer_record(tmp_path)
+    options = {"impact": True, "window": "force"}
+    config = scene(frf={"file": [str(first), str(second)], **options}, outputs={"tables": ["frf"]})
+    run = run_scene(config, out=tmp_path / "takes.h5")
+    expected, *_ = frf_from_time([first, second], FitOptions(**options).namespace())
+    got = run.results["frf"]
+    assert got.averages == expected.averages == 8
+    assert np.array_equal(got.response, expected.response)
+    # the archive's stage hash covers every take: a run on the same files reuses it, a changed take reruns
+    assert run_scene(config, out=tmp_path / "again.h5", archive=tmp_path / "takes.h5").stages["frf"] == "reused"
+    second.write_text("# the second take\n" + second.read_text())
+    assert run_scene(config, out=tmp_path / "changed.h5", archive=tmp_path / "takes.h5").stages["frf"] == "ran"
+    other = tmp_path / "other.csv"
+    other.write_text(first.read_text().replace("1+Z [m/s^2]", "2+Z [m/s^2]", 1))
+    with pytest.raises(SceneError, match=r"^s\.toml: key 'frf\.file' = .*other\.csv: channel 2 \(names\) is '2\+Z'"):
+        parse_scene(scene(frf={"file": [str(first), str(other)], **options}, outputs={"tables": ["frf"]}),
+                    source="s.toml")
+
+
+def test_a_scene_reads_frf_files_on_one_axis_as_one_frf(tmp_path):
+    """[frf] file = [...] of FRF files: their channels on one frequency axis, as `modal fit a b` reads them."""
+    import numpy as np
+
+    from modal.io import read_frf, write_frf
+    from modal.synthetic import modal_frf
+
+    frequency = np.linspace(1.0, 200.0, 400)
+    paths = []
+    for k, constant in enumerate([1.0, 0.4]):
+        path = tmp_path / f"point{k + 1}.csv"
+        write_frf(modal_frf(frequency, [40.0, 120.0], [0.02, 0.01], [constant, -constant], kind="accelerance"), path)
+        paths.append(path)
+    run = run_scene(scene(frf={"file": [str(p) for p in paths]}, outputs={"tables": ["frf"]}))
+    expected = read_frf(paths)
+    assert run.results["frf"].n_channels == 2
+    np.testing.assert_array_equal(run.results["frf"].response, expected.response)
