@@ -194,7 +194,8 @@ def find_hits(force, response, sample_rate_hz: float, *, threshold: float | None
         Time kept before each trigger, s. Default: 1/64 of the record, at least 2 samples.
     record_length : int, optional
         Samples per hit record. Default: the largest power of two not above the
-        shortest spacing between separate hits (or the data after the last hit).
+        shortest spacing between separate hits, or half of it when the data after the
+        last hit holds no more (for a single hit, the data after it).
     double_hit_window_s : float
         A pulse starting this soon after the previous pulse's end makes a double hit, s.
     decay_fraction : float
@@ -277,11 +278,16 @@ def find_hits(force, response, sample_rate_hz: float, *, threshold: float | None
         details.append(None)
     trigger = np.array([ev[0][0] for ev in events], dtype=np.int64)
     if record_length is None:
-        spacing = np.diff(np.append(trigger, n))
-        shortest = int(spacing.min()) if spacing.size else n
-        record_length = 1 << max(4, int(np.floor(np.log2(max(shortest, 16)))))
-        if record_length > shortest and trigger.size > 1:
-            record_length >>= 1
+        def power_of_two(samples: int) -> int:
+            return 1 << max(4, int(np.floor(np.log2(max(samples, 16)))))
+
+        # the spacing between hits sizes the records; the data after the last hit shortens them at most to
+        # half (every hit kept, at half the resolution): a shorter tail leaves its hit to be rejected as cut
+        # rather than cutting every other hit's response short
+        tail = power_of_two(n - int(trigger[-1]))
+        record_length = power_of_two(int(np.diff(trigger).min())) if trigger.size > 1 else tail
+        if tail < record_length and 2 * tail >= record_length:
+            record_length = tail
     record_length = int(record_length)
     pre = max(2, record_length // 64) if pretrigger_s is None else int(round(pretrigger_s * fs))
     start = trigger - pre

@@ -153,3 +153,13 @@ def test_hits_estimated_as_a_continuous_record_are_named_and_a_continuous_force_
     with pytest.raises(ParameterError, match=r"^shaker\.csv: impact record expected, but force has no hit.*"
                                              r"without impact\)$"):
         _estimate(shaker, source="shaker.csv")
+
+
+def test_a_hit_just_before_the_end_does_not_shorten_every_record():
+    # hits 2 s apart and a last one 0.1 s before the end of the data: the records keep the hits' spacing
+    # (4096 samples) and the last hit, which the end cuts, is rejected as cut; a record sized by that
+    # 0.1 s tail (128 samples, under a decay time of 0.13 s) would leave every response undecayed
+    synthetic = impact_record(PLANT, [0.5, 2.5, 4.5, 6.5], 6.6, force_noise=0.002, response_noise=0.002, seed=8)
+    hits = find_hits(synthetic.record.signals[0], synthetic.record.signals[1:], FS)
+    assert hits.record_length == 4096
+    assert [(r["hit"], r["reason"]) for r in hits.rejected] == [(4, "record cut by the start or end of the data")]
