@@ -382,6 +382,19 @@ def _csv_full_scale(comments: list[tuple[int, str]], n_channels: int, src: str) 
     return None
 
 
+def _delimiter(lines: list[str]) -> str | None:
+    """The delimiter of a time CSV: the first of ``,`` ``;`` tab found the same number of times on every one
+    of ``lines`` (the header and the first rows), else None (whitespace)."""
+    for candidate in (",", ";", "\t"):
+        counts = {line.count(candidate) for line in lines}
+        if len(counts) == 1 and counts != {0}:
+            return candidate
+    for candidate in (";", "\t", ","):  # quoted fields may hold the delimiter: the one most lines have
+        if all(candidate in line for line in lines):
+            return candidate
+    return None
+
+
 def _read_csv(path, src: str) -> TimeRecord:
     with open(path, newline="", encoding="utf-8-sig") as fh:
         text = fh.read()
@@ -391,12 +404,17 @@ def _read_csv(path, src: str) -> TimeRecord:
     if any("modalbal-frf-csv" in ln for _, ln in comments[:1]):
         raise FormatError(f"{src}: line 1: an FRF file (modalbal-frf-csv), not a time record; {_TIME_CSV} "
                           "(fit FRF files with 'modal fit')")
-    try:
-        dialect = _csv.Sniffer().sniff("\n".join(ln for _, ln in body[:50]), delimiters=",;\t ")
-    except _csv.Error:
-        dialect = _csv.excel
-    parsed = _csv.reader([ln for _, ln in body], dialect)
-    rows = [(k, [c.strip() for c in row]) for (k, _), row in zip(body, parsed)]
+    delimiter = _delimiter([ln for _, ln in body[:50]])
+    if delimiter is None:  # whitespace
+        rows = [(k, ln.split()) for k, ln in body]
+    else:
+        parsed = _csv.reader([ln for _, ln in body], delimiter=delimiter)
+        rows = [(k, [c.strip() for c in row]) for (k, _), row in zip(body, parsed)]
+    if rows and len(rows[0][1]) > 1 and all(row and not row[-1] for _, row in rows):
+        rows = [(k, row[:-1]) for k, row in rows]  # every line ends with the delimiter (a spreadsheet's export)
+    if delimiter in (";", "\t", None) and any("," in c for _, row in rows[1:51] for c in row) and not any(
+            "." in c for _, row in rows[1:] for c in row):
+        rows = rows[:1] + [(k, [c.replace(",", ".") for c in row]) for k, row in rows[1:]]  # a decimal comma
     if len(rows) < 3:
         raise FormatError(f"{src}: {len(rows)} rows; {_TIME_CSV}, and at least 2 rows of samples")
     header_line, header = rows[0]

@@ -79,7 +79,7 @@ def _write_csv(record: TimeRecord, tmp, binary: bool = False) -> None:
         if record.full_scale is not None:
             fh.write("# full_scale: " + ", ".join("nan" if np.isnan(v) else repr(float(v))
                                                   for v in _full_scale(record)) + "\n")
-        csv.writer(fh).writerow(header)
+        csv.writer(fh, lineterminator="\n").writerow(header)
         np.savetxt(fh, table, delimiter=",", fmt="%.17g")
 
 

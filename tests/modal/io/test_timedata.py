@@ -287,6 +287,32 @@ def test_csv_time_column_without_unit_holding_milliseconds_is_named(tmp_path):
         warnings.simplefilter("error")  # seconds at 1024 Hz: no word
         assert read_time(seconds).sample_rate_hz == pytest.approx(FS, rel=1e-9)
 
+
+@pytest.mark.parametrize("layout", ["trailing comma", "semicolon and decimal comma", "tab and decimal comma"])
+def test_csv_spreadsheet_exports_read_as_the_plain_file(tmp_path, layout):
+    # exports that end every line with the delimiter, or write a decimal comma with ';' or tab delimiters
+    # (European locales), hold the same numbers as the plain file
+    plain = tmp_path / "plain.csv"
+    write_time(_record(), plain)
+    lines = plain.read_text().splitlines()
+    if layout == "trailing comma":
+        text = [line + "," for line in lines]
+    else:
+        delimiter = ";" if layout.startswith("semicolon") else "\t"
+        text = [lines[0].replace(",", delimiter)] + [ln.replace(",", delimiter).replace(".", ",") for ln in lines[1:]]
+    path = tmp_path / "export.csv"
+    path.write_text("\n".join(text) + "\n")
+    got, expected = read_time(path), read_time(plain)
+    assert got.names == expected.names and got.units == expected.units
+    assert got.sample_rate_hz == expected.sample_rate_hz
+    np.testing.assert_array_equal(got.signals, expected.signals)
+
+
+def test_written_csv_has_one_line_ending(tmp_path):
+    path = tmp_path / "r.csv"
+    write_time(_record(), path)
+    assert b"\r" not in path.read_bytes()
+
 # ------------------------------------------------------------------ channel roles
 def test_roles_refuse_an_accelerometer_as_the_excitation():
     record = read_time(REAL_58B)
