@@ -71,6 +71,8 @@ FLAG_TEXT = {
     "driving_point_unknown": ("nothing says which channel was measured at the excitation point (no point ids, none "
                               "declared): k, c, m are not given"),
     "not_driving_point": "transfer FRF (response point differs from reference): k, c, m are not defined for it",
+    "units_unknown": ("the FRF's unit is neither the kind's SI unit nor one the toolkit converts (V/V: sensitivities "
+                      "not applied): k, c, m in N/m, N s/m, kg are not given"),
     "complex_mode": (f"modal constant of a driving point is far from real (phase > {COMPLEX_PHASE_DEG:g} deg): "
                      "k, c, m are approximate"),
     "non_positive_constant": "driving-point modal constant has a negative real part: k, c, m not defined",
@@ -157,6 +159,8 @@ FLAG_ACTION = {
                              "CHANNEL under [identify] in a scene, identify(frf, driving_point=...) in Python; or "
                              "give the file point ids (response point = reference point at the driving point)",
     "not_driving_point": "nothing to do: a transfer FRF gives frequency, damping and modal constant but no k, c, m",
+    "units_unknown": "give the channels in physical units (sensitivities applied) or label the FRF with a unit the "
+                     "readers convert (m, mm, in; m/s, mm/s, in/s; m/s^2, mm/s^2, g, in/s^2; over N, kN or lbf)",
     "complex_mode": "check for close modes or non-proportional damping; k, c, m use |A| and are approximate",
     "non_positive_constant": "check the sign convention of the force and response channels and the driving-point "
                              "declaration; k, c, m are not reported",
@@ -187,7 +191,7 @@ RULE_FLAGS = frozenset({"high_uncertainty", "close_modes", "driving_point_unknow
 #: before still carry it, and read back their modes as they were judged then.
 INFORMATIONAL = frozenset({"driving_point_unknown", "not_driving_point", "driving_point_assumed"})
 #: Flags about a driving-point channel's constant (never on a transfer channel).
-DRIVING_POINT_ONLY = frozenset({"complex_mode", "non_positive_constant"})
+DRIVING_POINT_ONLY = frozenset({"complex_mode", "non_positive_constant", "units_unknown"})
 #: Flags about a transfer channel (never on a driving-point channel).
 TRANSFER_ONLY = frozenset({"not_driving_point"})
 

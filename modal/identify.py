@@ -11,6 +11,7 @@ import numpy as np
 
 from .errors import IdentificationError
 from .frf import FRF
+from .frf_units import withhold_physical
 from .peaks import _indicator_and_peak, bands_from_hz, estimate_noise_std, find_modes
 from .results import IdentificationResult
 from .sdof import BANDWISE_METHODS, identify_bands
@@ -136,7 +137,7 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
         global_options = {**global_options, "max_evaluations": max_evaluations}
     result = _identify(frf, method, bands_hz, noise_std, driving_point, min_prominence_db, max_modes, global_options)
     _check_kind(frf, result, driving_point)
-    return result
+    return withhold_physical(result, frf)  # no k, c, m in SI from an FRF in a unit that is not
 
 
 def _check_kind(frf: FRF, result: IdentificationResult, driving_point) -> None:

@@ -158,7 +158,8 @@ def hint_points(hints: dict[str, Any], n_channels: int, src: str):
 def build_frf(frequency_hz: np.ndarray, response: np.ndarray, kind: str, src: str, *,
               response_points=None, reference_points=None, units: str | None = None,
               hints: dict[str, Any] | None = None, squeeze: bool = True) -> FRF:
-    """Make the :class:`FRF`: one channel becomes a 1-D response (if ``squeeze``), hints override.
+    """Make the :class:`FRF`: one channel becomes a 1-D response (if ``squeeze``), hints override, a unit
+    :func:`modal.frf_units.frf_in_si` knows is converted to the kind's SI unit.
 
     The FRF model validates (NaN, Inf, duplicates → FRFValidationError; unsorted
     lines are sorted with a ModalWarning).
@@ -169,13 +170,15 @@ def build_frf(frequency_hz: np.ndarray, response: np.ndarray, kind: str, src: st
         resp = resp[0]
     n_ch = 1 if resp.ndim == 1 else resp.shape[0]
     rsp_hint, ref_hint = hint_points(hints, n_ch, src)
+    from ..frf_units import frf_in_si
+
     units = hints.get("units") or units
-    return FRF(
+    return frf_in_si(FRF(  # a unit the toolkit knows (g/N, mm/s/N, in/lbf) becomes the kind's SI unit
         frequency_hz, resp, kind=kind,
         response_points=rsp_hint if rsp_hint is not None else response_points,
         reference_points=ref_hint if ref_hint is not None else reference_points,
         units=units, source=src,
-    )
+    ))
 
 
 def hint_frequency_axis(hints: dict[str, Any], n_lines: int, src: str, why: str) -> np.ndarray:

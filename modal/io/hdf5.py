@@ -281,11 +281,14 @@ def write_frf_hdf5(frf: FRF, path: str | os.PathLike, name: str = "0") -> None:
     h5py = _h5py()
     src = source_name(path)
 
+    from ..frf_units import frf_in_si
+
     def verify(tmp) -> None:
         with h5py.File(tmp, "r") as fh:
             check_schema(fh, src)
             back = read_frf_group(fh[FRF_GROUP][name], src)
-        if not (back == frf and back.response.shape == frf.response.shape):
+        expected = frf_in_si(frf)  # as the reader gives it: a unit it knows in SI
+        if not (back == expected and back.response.shape == frf.response.shape):
             raise OSError(f"{src}: verification after writing failed; the file was not replaced")
 
     with atomic_path(path, verify=verify) as tmp:

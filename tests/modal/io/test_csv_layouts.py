@@ -98,7 +98,9 @@ def test_complex_text_with_frequency_hints(tmp_path):
 def test_kind_aliases_and_units_hint(tmp_path):
     text = "# kind: inertance\n" + _table([F, H[0].real, H[0].imag], header=["f", "re", "im"])
     frf = read_frf(_write(tmp_path, "k.csv", text), units="g/N")
-    assert frf.kind == "accelerance" and frf.units == "g/N"
+    # g/N is converted to the kind's SI unit (1 g = 9.80665 m/s^2, exactly by definition)
+    assert frf.kind == "accelerance" and frf.units == "m/s^2/N"
+    np.testing.assert_allclose(frf.response, 9.80665 * H[0], rtol=1e-15)
 
 
 def test_trailing_delimiter_and_utf16(tmp_path):
