@@ -314,7 +314,8 @@ def _to_arrays(b: _Block, d: dict, src: str, hints: dict[str, Any]) -> dict:
     den = str(d.get("orddenom_axis_units_lab", "")).strip()
     units = None
     if num and num.upper() != "NONE":
-        units = f"{num}/{den}" if den and den.upper() != "NONE" else num
+        # a force denominator (data type 13) without a unit label is in N, UFF's default unit system (SI)
+        units = f"{num}/{den}" if den and den.upper() != "NONE" else (f"{num}/N" if pair[1] == 13 else num)
     rsp = (int(d.get("rsp_node", 0)), int(d.get("rsp_dir", 0)))
     ref = (int(d.get("ref_node", 0)), int(d.get("ref_dir", 0)))
     for name, (node, direction) in (("rsp_dir", rsp), ("ref_dir", ref)):

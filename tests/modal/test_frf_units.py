@@ -80,3 +80,31 @@ def test_an_frf_in_volts_gives_frequency_and_damping_but_no_k_c_m():
         assert np.isfinite(true.mass_kg[0])
         rows = {row["channel"]: row for row in result.rows() if row["mode"] == result.modes.index(mode) + 1}
         assert "units_unknown" in rows[0]["flags"] and "units_unknown" not in rows[1]["flags"]  # channels from 0
+
+
+@pytest.mark.parametrize("numerator, denominator, factor", [("g", "N", G), ("g", "NONE", G), ("m/s^2", "", 1.0),
+                                                             ("mm/s^2", "N", 1e-3)])
+def test_uff_unit_labels_are_converted(tmp_path, numerator, denominator, factor):
+    # UFF 58 keeps the numerator's and the denominator's unit labels apart; a force denominator (data type 13)
+    # without a label is in N, UFF's default unit system
+    import os
+
+    import pyuff
+
+    si = modal_frf(FREQUENCY, [40.0], [0.02], [1.0], kind="accelerance").response
+    path = tmp_path / "labels.uff"
+    open(path, "wb").close()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # pyuff leaves its file handles to the garbage collector
+        pyuff.UFF(os.fspath(path)).write_sets({
+            "type": 58, "binary": 1, "id1": "frf", "id2": "NONE", "id3": "NONE", "id4": "NONE", "id5": "NONE",
+            "func_type": 4, "func_id": 1, "ver_num": 0, "load_case_id": 0, "rsp_ent_name": "NONE", "rsp_node": 1,
+            "rsp_dir": 3, "ref_ent_name": "NONE", "ref_node": 1, "ref_dir": 3, "abscissa_spacing": 1,
+            "abscissa_min": FREQUENCY[0], "abscissa_inc": FREQUENCY[1] - FREQUENCY[0], "z_axis_value": 0.0,
+            "abscissa_spec_data_type": 18, "abscissa_axis_lab": "Frequency", "abscissa_axis_units_lab": "Hz",
+            "ordinate_spec_data_type": 12, "ordinate_axis_lab": "NONE", "ordinate_axis_units_lab": numerator,
+            "orddenom_spec_data_type": 13, "orddenom_axis_lab": "NONE", "orddenom_axis_units_lab": denominator,
+            "z_axis_spec_data_type": 0, "x": FREQUENCY, "data": si / factor}, mode="add", force_double=True)
+    frf = read_frf(path)
+    assert frf.units == "m/s^2/N"
+    np.testing.assert_allclose(frf.response, si, rtol=1e-12)
