@@ -170,12 +170,16 @@ def resolve(value, key: str, scene: Scene, identified=None, drive=None) -> float
                              "k, c, m; expected oma.mass_change and oma.added_mass_kg (a second record with known "
                              "masses added) to scale its modes")
         if not math.isfinite(number):
-            unknown = "driving_point_unknown" in mode.flags
+            if "units_unknown" in mode.flags:
+                advice = ("the FRF's unit is not one k, c, m can be given in: record the channels in physical units "
+                          "(N and m/s^2, m/s or m; g, mm/s and lbf are converted)")
+            elif "driving_point_unknown" in mode.flags:
+                advice = ("the FRF does not say which channel was measured at the excitation point: declare it with "
+                          "driving_point = CHANNEL under [identify] (counted from 1)")
+            else:
+                advice = "choose a driving-point channel"
             raise SceneError(f"{scene.source}: key '{key}' = {value.text!r} is not defined for that channel "
-                             f"(flags: {', '.join(mode.flags) or 'none'}); "
-                             + ("the FRF does not say which channel was measured at the excitation point: declare "
-                                "it with driving_point = CHANNEL under [identify] (counted from 1)" if unknown
-                                else "choose a driving-point channel"))
+                             f"(flags: {', '.join(mode.flags) or 'none'}); {advice}")
         return number
     handover = getattr(drive, "handover", None)
     if handover is None:

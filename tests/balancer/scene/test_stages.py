@@ -224,3 +224,24 @@ def test_a_scene_reads_frf_files_on_one_axis_as_one_frf(tmp_path):
     expected = read_frf(paths)
     assert run.results["frf"].n_channels == 2
     np.testing.assert_array_equal(run.results["frf"].response, expected.response)
+
+
+def test_a_hammer_record_in_volts_hands_no_k_c_m_to_the_studies(tmp_path):
+    """Force and response recorded in V (sensitivities not applied): the modes are identified, but k, c, M in SI
+    cannot be, so the rotor that refers to them is refused in one line saying why, even with accept_flagged."""
+    from modal.errors import SceneError
+    from support.paths import SYNTHETIC
+    from support.scenes import ROTOR
+
+    lines = (SYNTHETIC / "hammer.csv").read_text().splitlines()
+    volts = tmp_path / "volts.csv"
+    volts.write_text("\n".join(["time [s],1+Z [V],1+Z [V]"] + lines[1:]) + "\n")
+    config = scene(frf={"file": str(volts), "impact": True, "excitation": 1, "kind": "accelerance"},
+                   identify={"method": "nls", "accept_flagged": True}, rotor=dict(ROTOR), adb=dict(ADB),
+                   outputs={"tables": ["rotor"]})
+    with pytest.warns(UserWarning) as said, pytest.raises(
+            SceneError, match=r"key 'rotor\.(M|k|c)' = 'identified:mode1\.\w+' is not defined for that channel "
+                              r"\(flags: units_unknown\); the FRF's unit"):
+        run_scene(config)
+    messages = " ".join(str(w.message) for w in said)
+    assert "is taken as the excitation" in messages and "k, c, m are not given (flag units_unknown)" in messages
