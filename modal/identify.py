@@ -98,8 +98,8 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
     max_modes : int, optional
         Keep at most this many (strongest) peaks.
     max_evaluations : int, optional
-        ``"nls"`` and ``"global"``: model evaluations the least-squares refinement may take, all its fits
-        together (default scaled to the size of one: :func:`modal.work_budget.default_max_evaluations`, never
+        Model evaluations the least-squares refinement may take, all its fits together (``"circle"`` and
+        ``"halfpower"``: the refinement that checks their estimates) (default scaled to the size of one: :func:`modal.work_budget.default_max_evaluations`, never
         reached by ordinary files); where they run out it stops, its modes flagged ``work_capped`` with a
         warning. ``result.settings`` gives the budget and the evaluations used.
 
@@ -125,8 +125,6 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
         raise TypeError(f"identify() got options {', '.join(sorted(global_options))} that only method='global' takes")
     one_of("method", method, METHODS + ("auto",), IdentificationError)
     if max_evaluations is not None:
-        if method in ("circle", "halfpower"):
-            raise TypeError(f"identify() got max_evaluations, which method={method!r} does not take (nls, global)")
         max_evaluations = checked_max_evaluations(max_evaluations, IdentificationError)
     if noise_std is not None:
         noise_std = per_channel("noise_std", noise_std, frf.n_channels, IdentificationError)

@@ -14,7 +14,8 @@ from .refine import fit_bands, truncation
 
 __all__ = ["refinement_check", "chi2_of", "constant_distance", "local_misfit", "fit_noise", "missing_mode_in_bands"]
 
-def refinement_check(frf, bands, power, poles, consts, noise, estimated_noise, known_noise=False, residual=None):
+def refinement_check(frf, bands, power, poles, consts, noise, estimated_noise, known_noise=False, residual=None,
+                     budget=None):
     """Compare single-mode estimates with the least-squares refinement of the same modes.
 
     All modes are refined together by :func:`fit_modes`, started from the
@@ -27,6 +28,9 @@ def refinement_check(frf, bands, power, poles, consts, noise, estimated_noise, k
     not stand (for one mode: its refined pole left its band or has no finite error).
     ``residual``, a dict, receives the refinement's residual variance per channel
     (``"noise_var"``, NaN on the channels it did not use).
+    ``budget``: the :class:`~modal.work_budget.EvaluationBudget` of the refinement; where the refinement spends
+    it (``budget.capped``) it stands nowhere in particular: no mode is compared with it and the missing-mode
+    and truncation checks are not run (every mode as without a reference, its χ² not measured).
     """
     n_modes = len(bands)
 
@@ -49,7 +53,9 @@ def refinement_check(frf, bands, power, poles, consts, noise, estimated_noise, k
     keep, _ = regions(bands, frf.frequency_hz)
     strongest = np.argsort(np.max(np.abs(frf.channels[:, keep]) / np.where(noise > 0, noise, 1.0)[:, None],
                                   axis=1))[::-1][:POLE_CHANNELS]
-    fit = fit_bands(frf, bands, power, wn0, z0, strongest)
+    fit = fit_bands(frf, bands, power, wn0, z0, strongest, budget=budget)
+    if budget is not None and budget.capped:
+        return [no_reference(np.nan)] * n_modes, None
     if residual is not None:
         residual["noise_var"] = np.full(frf.n_channels, np.nan)
         residual["noise_var"][strongest] = fit.noise_var
