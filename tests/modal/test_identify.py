@@ -230,3 +230,27 @@ def test_the_refinement_that_checks_halfpower_and_circle_has_a_budget_too(method
         warnings.simplefilter("ignore", modal.ModalWarning)
         lifted = identify(frf, method, max_evaluations=free.settings["evaluations"])
     assert all(np.array_equal(a, b) for a, b in zip(_numbers(free), _numbers(lifted)))
+
+
+def test_auto_fits_more_peaks_than_the_global_sweep_holds_band_wise_and_says_why():
+    from modal.global_.identify import MAX_DEFAULT_ORDER
+    from modal.identify import AUTO_PEAKS_PER_REFERENCE, choose_method
+    from support.manymodes import many_modes_frf
+
+    # a third of the default ceiling's poles per reference (a pair per mode and one more for the noise)
+    assert AUTO_PEAKS_PER_REFERENCE == MAX_DEFAULT_ORDER // 3
+    from modal.identify import _too_many_peaks
+
+    assert _too_many_peaks(80, 2) is None and "81 peaks" in _too_many_peaks(81, 2)  # per reference
+    # 40 evenly spread modes (39 peaks): the global method finds every one (measured), auto keeps it
+    assert choose_method(many_modes_frf(40, 10_000)) == "global"
+    # 44 modes show 42 peaks, more than the default sweep holds: band-wise (the global fit found 4 of them)
+    many = many_modes_frf(44, 4000)
+    assert choose_method(many) == "nls"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", modal.ModalWarning)  # one evaluation: a quick fit, flagged work_capped
+        result = identify(many, "auto", max_evaluations=1)
+        ordinary = identify(_three_modes_noisy(), "auto")
+    assert result.method == "nls" and "42 peaks, more than the global method's default sweep holds" in \
+        result.settings["method_choice"]
+    assert "method_choice" not in ordinary.settings  # a few peaks: nls as always, nothing to explain
