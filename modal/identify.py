@@ -119,10 +119,11 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
     max_modes : int, optional
         Keep at most this many (strongest) peaks.
     max_evaluations : int, optional
-        Model evaluations the least-squares refinement may take, all its fits together (``"circle"`` and
-        ``"halfpower"``: the refinement that checks their estimates) (default scaled to the size of one: :func:`modal.work_budget.default_max_evaluations`, never
-        reached by ordinary files); where they run out it stops, its modes flagged ``work_capped`` with a
-        warning. ``result.settings`` gives the budget and the evaluations used.
+        Model evaluations the least-squares refinement may take, all its fits together (for ``"circle"`` and
+        ``"halfpower"``, the refinement that checks their estimates); default scaled to the size of one
+        (:func:`modal.work_budget.default_max_evaluations`), never reached by ordinary files. Where they run
+        out it stops, its modes flagged ``work_capped`` with a warning. ``result.settings`` gives the budget
+        and the evaluations used.
 
     Returns
     -------

@@ -56,8 +56,8 @@ def identify_bands(frf, method: str, bands, *, raw_noise: np.ndarray, noise_std=
     driving_point : bool, array_like of bool or channel indices, optional
         Declares which channels are driving points (:func:`modal.assemble.driving_points`).
     max_evaluations : int, optional
-        Model evaluations the least-squares fits may take together (``"nls"``'s, or the refinement that checks a
-        half-power or circle estimate) (default
+        Model evaluations the least-squares fits may take together (``"nls"``'s, or those of the refinement that
+        checks a half-power or circle estimate; default
         :func:`modal.work_budget.default_max_evaluations`); where they run out the modes are flagged
         ``work_capped``, with a warning.
     """
@@ -71,9 +71,9 @@ def identify_bands(frf, method: str, bands, *, raw_noise: np.ndarray, noise_std=
         estimated_noise = band_noise(frf, bands, line_noise)
     noise = estimated_noise if noise_std is None else np.broadcast_to(np.asarray(noise_std, float), (n_ch,)).copy()
     if method in ("halfpower", "circle"):
+        rescale = noise_std is None and not known_noise
         estimates, missing_mode, budget = _single_mode_fits(frf, bands, power, method, noise, estimated_noise,
-                                                            known_noise, rescale=noise_std is None and not known_noise,
-                                                            max_evaluations=max_evaluations)
+                                                            known_noise, rescale, max_evaluations)
         settings = {}
         fitted = "the least-squares refinement that checks it"
     else:
@@ -142,8 +142,9 @@ def _single_mode_fits(frf, bands, power, method, noise, estimated_noise, known_n
         consts[missing] = filled[missing]
     refined = {}
     lines, region = regions(bands, frf.frequency_hz)  # the refinement's lines and its offsets (one per region)
-    budget = EvaluationBudget(max_evaluations or default_max_evaluations(
-        int(np.count_nonzero(lines)), len(bands), min(n_ch, POLE_CHANNELS), int(region.max()) + 1 if region.size else 0))
+    n_regions = int(region.max()) + 1 if region.size else 0
+    budget = EvaluationBudget(max_evaluations or default_max_evaluations(int(np.count_nonzero(lines)), len(bands),
+                                                                         min(n_ch, POLE_CHANNELS), n_regions))
     check, missing_mode = refinement_check(frf, bands, power, poles, consts, noise, estimated_noise, known_noise,
                                            refined, budget)
     if rescale:

@@ -54,9 +54,10 @@ def test_a_huge_file_thins_the_sweeps_lines_to_its_budget():
 def test_too_high_orders_are_lowered_to_the_eigenvalue_budget():
     asked = sweep.sweep_orders(644)  # what the peaks of 400 modes call for
     plan = sweep.plan_sweep(asked, 200_000, 1, 1)
-    assert plan.capped and plan.orders[-1] < asked[-1] and plan.orders == sweep.sweep_orders(plan.orders[-1] + 1)[:len(plan.orders)]
+    top = plan.orders[-1]
+    assert plan.capped and top < asked[-1] and plan.orders in (sweep.sweep_orders(top), sweep.sweep_orders(top + 1))
     assert sum(float(p) ** 3 for p in plan.orders) <= sweep.SWEEP_EIGEN
-    assert sum(float(p) ** 3 for p in sweep.sweep_orders(plan.orders[-1] + 2)) > sweep.SWEEP_EIGEN  # the highest that fits
+    assert sum(float(p) ** 3 for p in sweep.sweep_orders(top + 2)) > sweep.SWEEP_EIGEN  # the highest that fits
     assert plan.n_lines >= sweep.LINES_PER_ORDER * plan.orders[-1]
     assert f"model orders up to {plan.orders[-1]} instead of {asked[-1]}" in plan.reason
     # one order asked for keeps the order below it, for its stability
@@ -100,9 +101,11 @@ def test_a_thinned_sweep_still_finds_the_modes_and_says_it_was_capped(monkeypatc
     result, messages = fit(frf)
     assert result.settings["sweep_lines"] == 500 and result.settings["orders"] == free.settings["orders"]
     assert [round(m.natural_frequency_hz) for m in result.modes] == [60, 120, 200, 260, 330, 420]
-    for capped, unthinned in zip(result.modes, free.modes):  # the same modes within their errors (both noisy fits
-        # of the same data: 3 standard errors of one fit bound their difference)
-        assert abs(capped.natural_frequency_hz - unthinned.natural_frequency_hz) < 3 * unthinned.std.natural_frequency_hz
+    # the same modes within their errors: both refinements fit every line of the same data from nearby starts
+    # (3 standard errors of one fit bound their difference)
+    for capped, unthinned in zip(result.modes, free.modes):
+        difference = abs(capped.natural_frequency_hz - unthinned.natural_frequency_hz)
+        assert difference < 3 * unthinned.std.natural_frequency_hz
     assert all("work_capped" in m.flags for m in result.modes)
     assert sum("the stabilisation sweep took 500 of its 1500 lines, within its work budget" in m for m in messages) == 1
 
