@@ -86,7 +86,7 @@ def identify_bands(frf, method: str, bands, *, raw_noise: np.ndarray, noise_std=
         from ..errors import QualityWarning, warn_caller
 
         warn_caller(f"{frf.source}: {method}: {fitted} stopped at its budget of {budget.limit} model evaluations "
-                    "before converging (the missing-mode and truncation checks were not run); its modes are flagged "
+                    "before converging (the checks that refit were cut short); its modes are flagged "
                     "work_capped; identify(..., max_evaluations=N) or --max-evaluations N with N above it lets it "
                     "go on", QualityWarning)
     for index, (band, estimate) in enumerate(zip(bands, estimates)):
@@ -248,7 +248,7 @@ def _least_squares_fits(frf, bands, power, noise, estimated_noise, known_noise, 
     if not budget.capped:
         missing_mode = missing_mode_in_bands(frf, bands, power, fit.omega_n, fit.damping_ratio, estimated_noise,
                                              residual, None if known_noise or isinstance(rows, np.ndarray)
-                                             else residual_noise, data, fit.channel_scale)
+                                             else residual_noise, data, fit.channel_scale, budget)
         # near-exact data: the offset's truncation (modes outside the bands) biases the poles
         # beyond their white-noise errors; its measured shift is added to them
         shift = truncation(frf, bands, power, fit, residual=residual, data=data)
