@@ -32,8 +32,9 @@ AUTO_GLOBAL_PEAKS = 5
 #: here, not imported, so that ``import modal`` does not load the global method) cannot hold them.
 #: A peak takes a pair of poles and the sweep needs about one pole more per peak (noise, modes outside the band):
 #: a third of the ceiling's poles. Measured on the single-reference files of tests/support/manymodes.py
-#: (modes evenly spread, ζ 0.005, 0.1 % noise): 39-40 peaks on 8 000-12 000 lines, every mode found by the
-#: global method; 42-52 peaks on 10 000-20 000 lines, 2-7 modes found where band-wise nls finds all but one
+#: (modes evenly spread, ζ 0.005, 0.1 % noise): 37-39 peaks on 8 000-12 000 lines, every mode found by the
+#: global method; 41-52 peaks on 10 000-20 000 lines, 1-7 modes found where band-wise nls finds all but one
+#: (benchmarks/REPORT.md, "auto's choice on many-mode files")
 AUTO_PEAKS_PER_REFERENCE = 40
 
 
