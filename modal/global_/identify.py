@@ -495,8 +495,10 @@ def identify_global(frf: FRF, *, modes_hz=None, order: int | None = None, max_or
     asked_order = orders[-1]
     sweep = plan_sweep(orders, omega.size, n_out, m)
     orders = sweep.orders
+    swept = omega.size  # the lines the sweep took
     if sweep.capped:
         lines = sweep_lines(np.sum(np.abs(matrix) ** 2, axis=(0, 1)), sweep.n_lines)
+        swept = lines.size
         packs = plscf_poles(omega[lines], matrix[..., lines], orders, beyond=BEYOND_BAND)
     else:
         packs = plscf_poles(omega, matrix, orders, beyond=BEYOND_BAND)
@@ -634,7 +636,7 @@ def identify_global(frf: FRF, *, modes_hz=None, order: int | None = None, max_or
                 "order": None if order is None else int(order),
                 "dropped_insignificant_hz": dropped,
                 "max_evaluations": int(budget.limit), "evaluations": int(budget.used),
-                "order_wanted": wanted_order, "sweep_lines": int(sweep.n_lines), "modes_proposed": int(proposed)}
+                "order_wanted": wanted_order, "sweep_lines": int(swept), "modes_proposed": int(proposed)}
     _warn_caps(src, budget, wanted_order, asked_order, sweep,
                (refinement_mode_limit(omega.size, n_ch), proposed, omega.size) if limited else None)
     return IdentificationResult(tuple(modes), "global", frf.kind, n_ch, noise_std=noise,

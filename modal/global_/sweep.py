@@ -60,7 +60,7 @@ class SweepPlan:
         The model orders to solve (those asked for, or fewer and lower where the eigenvalue work or the
         lines bind).
     n_lines : int
-        Lines the sweep may take (all of them when nothing binds).
+        Lines the sweep may take (all of them when nothing binds; :func:`sweep_lines` takes at most these).
     capped : bool
         A budget bound: lines thinned or orders lowered.
     reason : str
@@ -113,7 +113,7 @@ def plan_sweep(orders, n_lines: int, n_outputs: int, n_references: int) -> Sweep
         reasons.append(f"model orders up to {orders[-1]} instead of {asked}")
     allowed = _lines_allowed(orders[-1], columns)
     if allowed < n_lines:
-        reasons.append(f"{allowed} of its {n_lines} lines")
+        reasons.append(f"at most {allowed} of its {n_lines} lines")
     return SweepPlan(orders, min(allowed, n_lines), bool(reasons), ", ".join(reasons))
 
 

@@ -44,7 +44,7 @@ def test_a_huge_file_thins_the_sweeps_lines_to_its_budget():
     assert plan.capped and plan.orders == sweep.sweep_orders(MAX_DEFAULT_ORDER)  # the orders stay
     assert (2 * MAX_DEFAULT_ORDER + 1) * plan.n_lines <= sweep.SWEEP_BASIS  # the basis' memory is bounded
     assert plan.n_lines > sweep.SWEEP_BASIS / (2 * MAX_DEFAULT_ORDER + 1) - 1  # and used
-    assert f"{plan.n_lines} of its 200000 lines" in plan.reason
+    assert f"at most {plan.n_lines} of its 200000 lines" in plan.reason
     # many channels: the products with the channels bind before the basis
     wide = sweep.plan_sweep(sweep.sweep_orders(40), 100_000, 1000, 1)
     assert 81 * 100_000 <= sweep.SWEEP_BASIS  # (the basis alone would fit)
@@ -99,7 +99,9 @@ def test_a_thinned_sweep_still_finds_the_modes_and_says_it_was_capped(monkeypatc
     # a budget that holds a third of this file's lines: the sweep thins them, the refinement fits every line
     monkeypatch.setattr(sweep, "SWEEP_BASIS", (2 * free.settings["orders"][1] + 1) * 500)
     result, messages = fit(frf)
-    assert result.settings["sweep_lines"] == 500 and result.settings["orders"] == free.settings["orders"]
+    # (a block's first and strongest line, at least one per block: at least half of those allowed)
+    assert (500 - 3) / 2 <= result.settings["sweep_lines"] <= 500
+    assert result.settings["orders"] == free.settings["orders"]
     assert [round(m.natural_frequency_hz) for m in result.modes] == [60, 120, 200, 260, 330, 420]
     # the same modes within their errors: both refinements fit every line of the same data from nearby starts
     # (3 standard errors of one fit bound their difference)
@@ -107,7 +109,8 @@ def test_a_thinned_sweep_still_finds_the_modes_and_says_it_was_capped(monkeypatc
         difference = abs(capped.natural_frequency_hz - unthinned.natural_frequency_hz)
         assert difference < 3 * unthinned.std.natural_frequency_hz
     assert all("work_capped" in m.flags for m in result.modes)
-    assert sum("the stabilisation sweep took 500 of its 1500 lines, within its work budget" in m for m in messages) == 1
+    assert sum("the stabilisation sweep took at most 500 of its 1500 lines, within its work budget" in m
+               for m in messages) == 1
 
 
 def test_a_refinement_given_fewer_modes_than_proposed_flags_them(monkeypatch):
