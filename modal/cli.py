@@ -37,7 +37,8 @@ def add_fit_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--order", type=int, help="global: use this model order's poles instead of the stabilisation")
     parser.add_argument("--max-order", dest="max_order", type=int, help="global: highest order of the sweep")
     parser.add_argument("--max-evaluations", dest="max_evaluations", type=int, metavar="N",
-                        help="nls, global: model evaluations the least-squares refinement may take (default: scaled "
+                        help="model evaluations the least-squares refinement may take (circle, halfpower: the one that "
+                             "checks them; default: scaled "
                              "to the problem, never reached by ordinary files; where it binds the modes are "
                              "flagged work_capped)")
     parser.add_argument("--band", nargs=2, type=float, action="append", metavar=("FMIN", "FMAX"),

@@ -41,8 +41,9 @@ class FitOptions:
     modes_hz, order, max_order
         Options of method ``"global"`` (choosing it under ``"auto"``).
     max_evaluations : int, optional
-        Model evaluations the least-squares refinement may take (methods ``"auto"``, ``"nls"``, ``"global"``;
-        ``"all"``: its nls fit); default scaled to the problem (:mod:`modal.work_budget`).
+        Model evaluations the least-squares refinement may take (each method's: ``"circle"`` and ``"halfpower"``
+        the refinement that checks them; ``"all"``: each of its fits); default scaled to the problem
+        (:mod:`modal.work_budget`).
     driving_point : tuple of str, optional
         Driving-point channels: numbers counted from 1 or response point ids (:func:`driving_channels`).
     kind, frequency_axis, frequency_step, frequency_start, layout, delimiter, decimal, dataset
@@ -89,9 +90,6 @@ class FitOptions:
         budget = self.max_evaluations
         if budget is not None and (isinstance(budget, bool) or not isinstance(budget, int) or budget < 1):
             raise ParameterError(f"--max-evaluations {budget}: expected a whole number of model evaluations >= 1")
-        if self.max_evaluations is not None and self.method in ("circle", "halfpower"):
-            raise ParameterError(f"--max-evaluations applies to methods auto, nls, global and all (its nls fit), "
-                                 f"not {self.method}")
         given = [name for name in GLOBAL_OPTIONS if getattr(self, name) is not None]
         if given and self.method not in ("auto", "global"):
             raise ParameterError(f"--{given[0].replace('_', '-')} applies to --method global only")
@@ -233,7 +231,7 @@ def fit_path(path: str | os.PathLike | Sequence[str | os.PathLike], options: Fit
     budget = {} if options.max_evaluations is None else {"max_evaluations": options.max_evaluations}
     results = tuple(identify(frf, method, bands_hz=bands, driving_point=driving,
                              **(global_options if method == "global" else {}),
-                             **(budget if method in ("auto", "nls", "global") else {}))
+                             **budget)
                     for method in methods)
     return FitOutput(frf=frf, results=results, time_data=time_data)
 

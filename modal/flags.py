@@ -65,9 +65,11 @@ FLAG_TEXT = {
     "high_uncertainty": (f"standard error of the damping ratio exceeds {100 * REL_STD_LIMIT:g} % of its value, or the "
                          "errors are undetermined (the data do not determine this mode's pole apart from another's)"),
     "did_not_converge": "least-squares refinement did not converge; the start values are reported",
-    "work_capped": ("the least-squares refinement stopped at its budget of model evaluations (max_evaluations, "
-                    "scaled to the size of the problem) before converging: the estimates are where it stood, its "
-                    "checks were cut short and modes may be missing"),
+    "work_capped": ("identify stopped at a work budget scaled to the size of the problem: the least-squares "
+                    "refinement at its budget of model evaluations (max_evaluations) before converging (the "
+                    "estimates are where it stood, its checks were cut short), or the global method's "
+                    "stabilisation sweep on fewer lines or orders, or its refinement on fewer modes than proposed; "
+                    "modes may be missing"),
     "driving_point_unknown": ("nothing says which channel was measured at the excitation point (no point ids, none "
                               "declared): k, c, m are not given"),
     "not_driving_point": "transfer FRF (response point differs from reference): k, c, m are not defined for it",
@@ -152,8 +154,8 @@ FLAG_ACTION = {
     "high_uncertainty": "average more measurements or improve the signal-to-noise ratio near the mode",
     "did_not_converge": "give a band around the mode with --band, or try method global",
     "work_capped": "raise the budget (identify(..., max_evaluations=N), --max-evaluations N with N above the one the "
-                   "result's settings give), or fit fewer modes at once: --band for the modes of interest, a cropped "
-                   "band",
+                   "result's settings give), or fit fewer modes or lines at once: --band for the modes of interest, "
+                   "a cropped band, or method nls for a file of many modes (the warning says which budget bound)",
     "driving_point_unknown": "declare the channel measured at the excitation point: --driving-point CHANNEL "
                              "(modal fit, modal batch; channels counted from 1, or a point id), driving_point = "
                              "CHANNEL under [identify] in a scene, identify(frf, driving_point=...) in Python; or "

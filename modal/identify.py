@@ -28,14 +28,35 @@ METHODS = BANDWISE_METHODS + ("global",)
 AUTO_GLOBAL_PEAKS = 5
 
 
+#: ... unless the peaks are more than this many per reference: the global method's default sweep (orders up to
+#: :data:`modal.global_.identify.MAX_DEFAULT_ORDER` = 120, m·p poles at order p with m references; a third of it
+#: here, not imported, so that ``import modal`` does not load the global method) cannot hold them.
+#: A peak takes a pair of poles and the sweep needs about one pole more per peak (noise, modes outside the band):
+#: a third of the ceiling's poles. Measured on the single-reference files of tests/support/manymodes.py
+#: (modes evenly spread, ζ 0.005, 0.1 % noise): 37-39 peaks on 8 000-12 000 lines, every mode found by the
+#: global method; 41-52 peaks on 10 000-20 000 lines, 1-7 modes found where band-wise nls finds all but one
+#: (benchmarks/REPORT.md, "auto's choice on many-mode files")
+AUTO_PEAKS_PER_REFERENCE = 40
+
+
 def choose_method(frf: FRF, bands_hz=None, min_prominence_db: float = 6.0) -> str:
     """The method ``identify(frf, "auto")`` runs: ``"global"`` for a poly-reference test (an outputs ×
     references grid with several references) or at least :data:`AUTO_GLOBAL_PEAKS` peaks (a many-mode
     measurement, where band-wise fits each see their neighbours only as an offset), else ``"nls"``
-    (one to a few well-separated modes, where it is the Cramér–Rao-efficient choice). Bands given
-    explicitly keep the band-wise method.
+    (one to a few well-separated modes, where it is the Cramér–Rao-efficient choice). More peaks than
+    the global method's default sweep holds (:data:`AUTO_PEAKS_PER_REFERENCE` per reference) are fitted
+    band-wise (``"nls"``) as well. Bands given explicitly keep the band-wise method.
     """
     return _auto_choice(frf, bands_hz, min_prominence_db)[0]
+
+
+def _too_many_peaks(n_peaks: int, n_references: int) -> str | None:
+    """Why the global method's default sweep cannot hold ``n_peaks`` peaks (None when it can)."""
+    if n_peaks <= AUTO_PEAKS_PER_REFERENCE * n_references:
+        return None
+    return (f"nls: {n_peaks} peaks, more than the global method's default sweep holds ({AUTO_PEAKS_PER_REFERENCE} "
+            f"per reference, {n_references} reference{'s' if n_references > 1 else ''}: orders up to "
+            f"{3 * AUTO_PEAKS_PER_REFERENCE})")
 
 
 def _auto_choice(frf: FRF, bands_hz, min_prominence_db: float,
@@ -48,15 +69,16 @@ def _auto_choice(frf: FRF, bands_hz, min_prominence_db: float,
     from .global_ import channel_grid
 
     index, _, transposed = channel_grid(frf)
-    if index.shape[1] > 1:
-        return "global", None
+    references = index.shape[1]
     noise = estimate_noise_std(frf) if noise is None else noise
     try:  # the peaks identify itself would fit: the same noise-aware test (an estimate's noise per line)
         bands = find_modes(frf, min_prominence_db=min_prominence_db, noise_std=noise,
                            line_noise_std=frf.noise_std, indicator=indicator)
     except IdentificationError:
-        return "nls", None
-    return ("global" if len(bands) >= AUTO_GLOBAL_PEAKS else "nls"), bands
+        return ("global" if references > 1 else "nls"), None
+    if _too_many_peaks(len(bands), references):
+        return "nls", bands
+    return ("global" if references > 1 or len(bands) >= AUTO_GLOBAL_PEAKS else "nls"), bands
 
 
 def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, driving_point=None,
@@ -99,10 +121,11 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
     max_modes : int, optional
         Keep at most this many (strongest) peaks.
     max_evaluations : int, optional
-        ``"nls"`` and ``"global"``: model evaluations the least-squares refinement may take, all its fits
-        together (default scaled to the size of one: :func:`modal.work_budget.default_max_evaluations`, never
-        reached by ordinary files); where they run out it stops, its modes flagged ``work_capped`` with a
-        warning. ``result.settings`` gives the budget and the evaluations used.
+        Model evaluations the least-squares refinement may take, all its fits together (for ``"circle"`` and
+        ``"halfpower"``, the refinement that checks their estimates); default scaled to the size of one
+        (:func:`modal.work_budget.default_max_evaluations`), never reached by ordinary files. Where they run
+        out it stops, its modes flagged ``work_capped`` with a warning. ``result.settings`` gives the budget
+        and the evaluations used.
 
     Returns
     -------
@@ -126,8 +149,6 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
         raise TypeError(f"identify() got options {', '.join(sorted(global_options))} that only method='global' takes")
     one_of("method", method, METHODS + ("auto",), IdentificationError)
     if max_evaluations is not None:
-        if method in ("circle", "halfpower"):
-            raise TypeError(f"identify() got max_evaluations, which method={method!r} does not take (nls, global)")
         max_evaluations = checked_max_evaluations(max_evaluations, IdentificationError)
     if noise_std is not None:
         noise_std = per_channel("noise_std", noise_std, frf.n_channels, IdentificationError)
@@ -187,6 +208,13 @@ def _identify(frf: FRF, method: str, bands_hz, noise_std, driving_point, min_pro
     else:
         bands = find_modes(frf, min_prominence_db=min_prominence_db, max_modes=max_modes, noise_std=raw,
                            line_noise_std=frf.noise_std, indicator=indicator)
-    return identify_bands(frf, method, bands, raw_noise=raw, noise_std=noise_std, driving_point=driving_point,
-                          max_evaluations=global_options.get("max_evaluations"))
+    result = identify_bands(frf, method, bands, raw_noise=raw, noise_std=noise_std, driving_point=driving_point,
+                            max_evaluations=global_options.get("max_evaluations"))
+    if found is not None:  # the automatic choice: where many peaks chose nls, the result says why
+        from .global_ import channel_grid
+
+        why = _too_many_peaks(len(found), channel_grid(frf)[0].shape[1])
+        if why is not None:
+            result.settings["method_choice"] = why
+    return result
 

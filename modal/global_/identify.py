@@ -28,6 +28,7 @@ from ..units import TWO_PI
 from ..work_budget import EvaluationBudget, checked_max_evaluations, default_max_evaluations
 from .plscf import MAX_DAMPING, plscf_poles
 from .stabilisation import SelectedPole, outside_band_poles, select_poles, stabilisation
+from .sweep import most_stable, plan_sweep, refinement_mode_limit, sweep_lines, sweep_orders
 
 __all__ = ["identify_global", "channel_grid", "mpc"]
 
@@ -409,9 +410,21 @@ def _default_max_order(frf: FRF, m: int) -> tuple[int, int]:
     return int(np.clip(wanted, 10, MAX_DEFAULT_ORDER)), wanted
 
 
-def _warn_caps(src: str, budget: EvaluationBudget, wanted_order: int | None, max_order: int) -> None:
-    """One warning per work cap that bound: the joint refinement's evaluations, the sweep's model order."""
+def _warn_caps(src: str, budget: EvaluationBudget, wanted_order: int | None, max_order: int, sweep=None,
+               limited=None) -> None:
+    """One warning per work cap that bound: the joint refinement's evaluations, the sweep's model order, the
+    sweep's work (:func:`modal.global_.sweep.plan_sweep`), the modes the refinement takes (``limited``: the
+    modes it took, those proposed, the lines)."""
     from ..errors import QualityWarning, warn_caller
+
+    advice = "fit a cropped band (bands_hz, --band) or fit bands (method nls)"
+    if sweep is not None and sweep.capped:
+        warn_caller(f"{src}: global: the stabilisation sweep took {sweep.reason}, within its work budget: modes "
+                    f"may be missing, and its modes are flagged work_capped; {advice}", QualityWarning)
+    if limited is not None:
+        warn_caller(f"{src}: global: the refinement took the {limited[0]} most stable of the {limited[1]} modes the "
+                    f"sweep proposed, within its work budget on {limited[2]} lines: modes may be missing, and its "
+                    f"modes are flagged work_capped; {advice}", QualityWarning)
 
     if budget.capped:
         warn_caller(f"{src}: global: the joint refinement stopped at its budget of {budget.limit} model evaluations "
@@ -477,10 +490,18 @@ def identify_global(frf: FRF, *, modes_hz=None, order: int | None = None, max_or
         if not p_max:
             p_max, wanted = _default_max_order(work, m)
             wanted_order = wanted if wanted > p_max else None
-        # a long sweep in steps of 2: the diagram compares each order with the previous one computed
-        step = 2 if p_max - p_max // 4 > 30 else 1
-        orders = list(range(max(1, p_max // 4), p_max + 1, step))
-    packs = plscf_poles(omega, matrix, orders, beyond=BEYOND_BAND)
+        orders = sweep_orders(p_max)
+    # on a huge file (or at a high max_order) the sweep takes fewer lines, or lower orders, within its budgets
+    asked_order = orders[-1]
+    sweep = plan_sweep(orders, omega.size, n_out, m)
+    orders = sweep.orders
+    swept = omega.size  # the lines the sweep took
+    if sweep.capped:
+        lines = sweep_lines(np.sum(np.abs(matrix) ** 2, axis=(0, 1)), sweep.n_lines)
+        swept = lines.size
+        packs = plscf_poles(omega[lines], matrix[..., lines], orders, beyond=BEYOND_BAND)
+    else:
+        packs = plscf_poles(omega, matrix, orders, beyond=BEYOND_BAND)
     diagram = stabilisation(packs)
     if order is not None and modes_hz is None:
         last = packs[-1]
@@ -488,9 +509,14 @@ def identify_global(frf: FRF, *, modes_hz=None, order: int | None = None, max_or
                     zip(last.omega_n, last.damping_ratio, last.participation)]
     else:
         selected = select_poles(packs, diagram, modes_hz=modes_hz)
+    proposed = len(selected)  # the refinement takes the most stable modes its work budget allows
+    selected = most_stable(selected, refinement_mode_limit(omega.size, n_ch))
+    limited = len(selected) < proposed
     if not selected:
+        cut = (f"; the sweep took {sweep.reason} within its work budget: fit a cropped band or fit bands (method "
+               "nls)") if sweep.capped else ""
         raise IdentificationError(f"{src}: no stable pole in the stabilisation diagram (orders {orders[0]}–"
-                                  f"{orders[-1]}); give modes_hz hints or a higher max_order")
+                                  f"{orders[-1]}); give modes_hz hints or a higher max_order{cut}")
 
     line_noise = frf.noise_std
     if noise_std is not None:
@@ -559,6 +585,8 @@ def identify_global(frf: FRF, *, modes_hz=None, order: int | None = None, max_or
             flags.add("work_capped")
         elif not fit.converged:
             flags.add("did_not_converge")
+        if sweep.capped or limited:  # the sweep took fewer lines or orders, or the refinement
+            flags.add("work_capped")  # fewer modes than it proposed: some may be missing
         chi2, relative = _local_misfit(omega, H, misfit, noise, wn, zeta)
         # Clean real data (data/real beam: 1-2 % misfit at 170-33 000 times a noise the lines hardly show)
         # is explained as well as a linear model can: the relative misfit keeps it unflagged
@@ -608,7 +636,8 @@ def identify_global(frf: FRF, *, modes_hz=None, order: int | None = None, max_or
                 "order": None if order is None else int(order),
                 "dropped_insignificant_hz": dropped,
                 "max_evaluations": int(budget.limit), "evaluations": int(budget.used),
-                "order_wanted": wanted_order}
-    _warn_caps(src, budget, wanted_order, orders[-1])
+                "order_wanted": wanted_order, "sweep_lines": int(swept), "modes_proposed": int(proposed)}
+    _warn_caps(src, budget, wanted_order, asked_order, sweep,
+               (refinement_mode_limit(omega.size, n_ch), proposed, omega.size) if limited else None)
     return IdentificationResult(tuple(modes), "global", frf.kind, n_ch, noise_std=noise,
                                 residuals=residuals, stabilisation=diagram, settings=settings)

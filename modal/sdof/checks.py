@@ -310,7 +310,7 @@ def find_missing_mode(omega: np.ndarray, response: np.ndarray, power: int, regio
                       omega_n, damping_ratio, noise_std, bands_rad,
                       residual: np.ndarray | None = None,
                       residual_noise: np.ndarray | None = None,
-                      peak: np.ndarray | None = None) -> MissingMode | None:
+                      peak: np.ndarray | None = None, budget=None) -> MissingMode | None:
     """Test the residual of fitted modes for one more mode.
 
     Parameters
@@ -339,6 +339,9 @@ def find_missing_mode(omega: np.ndarray, response: np.ndarray, power: int, regio
     peak : ndarray, shape (n_channels,), optional
         max |H| of each channel on these lines, when the caller has it (a fit's
         ``channel_scale``): the strongest channels are chosen by it.
+    budget : EvaluationBudget, optional
+        The identification's :class:`~modal.work_budget.EvaluationBudget`: the trial fit with one more mode
+        takes what is left of it (and gives no verdict where it runs out).
 
     Returns
     -------
@@ -379,8 +382,11 @@ def find_missing_mode(omega: np.ndarray, response: np.ndarray, power: int, regio
     start_wn = np.append(omega_n, omega[i])
     start_zeta = np.append(zeta, max(np.median(zeta), width * spacing / (2 * omega[i])))
     with np.errstate(all="ignore"):
-        fit = fit_modes(omega, Y, power, start_wn, start_zeta, region=region, max_iter=CHECK_MAX_ITER)
-    if not fit.converged:
+        fit = fit_modes(omega, Y, power, start_wn, start_zeta, region=region, max_iter=CHECK_MAX_ITER,
+                        max_evaluations=None if budget is None else budget.for_fit())
+    if budget is not None:
+        budget.spend(fit)  # a trial the budget stopped gives no verdict (and its modes are flagged work_capped)
+    if not fit.converged or fit.capped:
         return None
     new_wn, new_zeta = float(fit.omega_n[-1]), float(fit.damping_ratio[-1])
     if not (np.isfinite(new_wn) and 0 < new_zeta < 1):

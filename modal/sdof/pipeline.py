@@ -22,7 +22,8 @@ from ..frf import KIND_POWER, line_spacing
 from ..peaks import channel_sample, neighbour_noise_rms
 from ..results import IdentificationResult
 from ..units import TWO_PI
-from .bands import POLE_CHANNELS, band_data, band_mask, band_noise, band_peaks, constants_at_poles, strongest_channels
+from .bands import (POLE_CHANNELS, band_data, band_mask, band_noise, band_peaks, constants_at_poles, regions,
+                    strongest_channels)
 from .checks import fit_residual, fit_residual_noise_std
 from .estimates import bandwise_covariance, rescaled, sdof_estimates, without_neighbours
 from .quality import chi2_of, constant_distance, fit_noise, local_misfit, missing_mode_in_bands, refinement_check
@@ -55,7 +56,8 @@ def identify_bands(frf, method: str, bands, *, raw_noise: np.ndarray, noise_std=
     driving_point : bool, array_like of bool or channel indices, optional
         Declares which channels are driving points (:func:`modal.assemble.driving_points`).
     max_evaluations : int, optional
-        ``"nls"``: model evaluations its least-squares fits may take together (default
+        Model evaluations the least-squares fits may take together (``"nls"``'s, or those of the refinement that
+        checks a half-power or circle estimate; default
         :func:`modal.work_budget.default_max_evaluations`); where they run out the modes are flagged
         ``work_capped``, with a warning.
     """
@@ -69,21 +71,24 @@ def identify_bands(frf, method: str, bands, *, raw_noise: np.ndarray, noise_std=
         estimated_noise = band_noise(frf, bands, line_noise)
     noise = estimated_noise if noise_std is None else np.broadcast_to(np.asarray(noise_std, float), (n_ch,)).copy()
     if method in ("halfpower", "circle"):
-        estimates, missing_mode = _single_mode_fits(frf, bands, power, method, noise, estimated_noise, known_noise,
-                                                    rescale=noise_std is None and not known_noise)
+        rescale = noise_std is None and not known_noise
+        estimates, missing_mode, budget = _single_mode_fits(frf, bands, power, method, noise, estimated_noise,
+                                                            known_noise, rescale, max_evaluations)
         settings = {}
+        fitted = "the least-squares refinement that checks it"
     else:
         estimates, missing_mode, note, budget = _least_squares_fits(frf, bands, power, noise, estimated_noise,
                                                                     known_noise, max_evaluations)
         settings = {} if note is None else {"window_bias": note}
-        settings.update(max_evaluations=int(budget.limit), evaluations=int(budget.used))
-        if budget.capped:
-            from ..errors import QualityWarning, warn_caller
+        fitted = "the least-squares fit"
+    settings.update(max_evaluations=int(budget.limit), evaluations=int(budget.used))
+    if budget.capped:
+        from ..errors import QualityWarning, warn_caller
 
-            warn_caller(f"{frf.source}: nls: the least-squares fit stopped at its budget of {budget.limit} model "
-                        "evaluations before converging (the missing-mode and truncation checks were not run); its "
-                        "modes are flagged work_capped; identify(..., max_evaluations=N) or --max-evaluations N with "
-                        "N above it lets it go on", QualityWarning)
+        warn_caller(f"{frf.source}: {method}: {fitted} stopped at its budget of {budget.limit} model evaluations "
+                    "before converging (the checks that refit were cut short); its modes are flagged "
+                    "work_capped; identify(..., max_evaluations=N) or --max-evaluations N with N above it lets it "
+                    "go on", QualityWarning)
     for index, (band, estimate) in enumerate(zip(bands, estimates)):
         if missing_mode is not None and (missing_mode.band == index or index in missing_mode.moved_bands):
             estimate.flags.add("missing_mode")
@@ -107,11 +112,15 @@ def _estimate(frf, band, wn, zeta, const, cov, s_wn, s_z, flags, chi2, quality, 
                         chi2=chi2, quality=quality, reference=reference)
 
 
-def _single_mode_fits(frf, bands, power, method, noise, estimated_noise, known_noise, rescale):
+def _single_mode_fits(frf, bands, power, method, noise, estimated_noise, known_noise, rescale, max_evaluations=None):
     """Half-power or circle estimates of every band's mode, checked against their least-squares refinement.
 
     ``rescale``: the errors follow the noise the refinement's residual shows (the noise was not given).
-    Returns the modes' :class:`~modal.assemble.ModeEstimate` and the missing mode found, or None.
+    ``max_evaluations``: the refinement's budget of model evaluations (default scaled to the size of one, on the
+    bands' lines and the channels it fits); where it binds, no mode is checked and every mode is flagged
+    ``work_capped``.
+    Returns the modes' :class:`~modal.assemble.ModeEstimate`, the missing mode found (or None) and the
+    refinement's :class:`~modal.work_budget.EvaluationBudget`.
     """
     n_ch = frf.n_channels
     poles = []
@@ -132,8 +141,12 @@ def _single_mode_fits(frf, bands, power, method, noise, estimated_noise, known_n
         filled = constants_at_poles(frf, bands, power, [p[0] for p in poles], [p[1] for p in poles])
         consts[missing] = filled[missing]
     refined = {}
+    lines, region = regions(bands, frf.frequency_hz)  # the refinement's lines and its offsets (one per region)
+    n_regions = int(region.max()) + 1 if region.size else 0
+    budget = EvaluationBudget(max_evaluations or default_max_evaluations(int(np.count_nonzero(lines)), len(bands),
+                                                                         min(n_ch, POLE_CHANNELS), n_regions))
     check, missing_mode = refinement_check(frf, bands, power, poles, consts, noise, estimated_noise, known_noise,
-                                           refined)
+                                           refined, budget)
     if rescale:
         poles = rescaled(frf, bands, power, poles, noise, refined.get("noise_var"))
     errors = bandwise_covariance(frf, bands, power, poles, noise, ~missing if method == "circle" else None)
@@ -149,6 +162,8 @@ def _single_mode_fits(frf, bands, power, method, noise, estimated_noise, known_n
         d_wn, d_z, d_const, chi2, bound_wn, bound_z = reference
         if model_inadequate(chi2, relative[b]):
             flags.add("model_inadequate")
+        if budget.capped:  # the refinement stopped at its budget: the estimate is not checked against it
+            flags.add("work_capped")
         # the difference from the refinement has at most the variance of the two errors
         # together (equality when they are independent; less when both see the same noise)
         scale_wn = np.hypot(np.nan_to_num(s_wn), bound_wn)
@@ -182,7 +197,7 @@ def _single_mode_fits(frf, bands, power, method, noise, estimated_noise, known_n
         if pole_biased or np.any(const_biased):
             reference = (wn - d_wn, zeta - d_z, np.where(const_biased, const - d_const, const), noise_cov)
         estimates.append(_estimate(frf, band, wn, zeta, const, cov, s_wn, s_z, flags, chi2, q, reference))
-    return estimates, missing_mode
+    return estimates, missing_mode, budget
 
 
 def _least_squares_fits(frf, bands, power, noise, estimated_noise, known_noise, max_evaluations=None):
@@ -233,7 +248,7 @@ def _least_squares_fits(frf, bands, power, noise, estimated_noise, known_noise, 
     if not budget.capped:
         missing_mode = missing_mode_in_bands(frf, bands, power, fit.omega_n, fit.damping_ratio, estimated_noise,
                                              residual, None if known_noise or isinstance(rows, np.ndarray)
-                                             else residual_noise, data, fit.channel_scale)
+                                             else residual_noise, data, fit.channel_scale, budget)
         # near-exact data: the offset's truncation (modes outside the bands) biases the poles
         # beyond their white-noise errors; its measured shift is added to them
         shift = truncation(frf, bands, power, fit, residual=residual, data=data)

@@ -14,7 +14,8 @@ from .refine import fit_bands, truncation
 
 __all__ = ["refinement_check", "chi2_of", "constant_distance", "local_misfit", "fit_noise", "missing_mode_in_bands"]
 
-def refinement_check(frf, bands, power, poles, consts, noise, estimated_noise, known_noise=False, residual=None):
+def refinement_check(frf, bands, power, poles, consts, noise, estimated_noise, known_noise=False, residual=None,
+                     budget=None):
     """Compare single-mode estimates with the least-squares refinement of the same modes.
 
     All modes are refined together by :func:`fit_modes`, started from the
@@ -27,6 +28,10 @@ def refinement_check(frf, bands, power, poles, consts, noise, estimated_noise, k
     not stand (for one mode: its refined pole left its band or has no finite error).
     ``residual``, a dict, receives the refinement's residual variance per channel
     (``"noise_var"``, NaN on the channels it did not use).
+    ``budget``: the :class:`~modal.work_budget.EvaluationBudget` of the refinement and the missing-mode check's
+    trial fit; where the refinement spends it (``budget.capped``) it stands nowhere in particular: no mode is
+    compared with it and the missing-mode and truncation checks are not run (every mode as without a
+    reference, its χ² not measured); where the trial fit spends it, the check gives no verdict.
     """
     n_modes = len(bands)
 
@@ -49,7 +54,9 @@ def refinement_check(frf, bands, power, poles, consts, noise, estimated_noise, k
     keep, _ = regions(bands, frf.frequency_hz)
     strongest = np.argsort(np.max(np.abs(frf.channels[:, keep]) / np.where(noise > 0, noise, 1.0)[:, None],
                                   axis=1))[::-1][:POLE_CHANNELS]
-    fit = fit_bands(frf, bands, power, wn0, z0, strongest)
+    fit = fit_bands(frf, bands, power, wn0, z0, strongest, budget=budget)
+    if budget is not None and budget.capped:
+        return [no_reference(np.nan)] * n_modes, None
     if residual is not None:
         residual["noise_var"] = np.full(frf.n_channels, np.nan)
         residual["noise_var"][strongest] = fit.noise_var
@@ -68,7 +75,7 @@ def refinement_check(frf, bands, power, poles, consts, noise, estimated_noise, k
     # adds flags and widens errors
     if not (np.all(np.isfinite(omega_n)) and np.all(damping_ratio > 0)):
         return [no_reference(chi2)] * n_modes, None
-    missing = missing_mode_in_bands(frf, bands, power, omega_n, damping_ratio, estimated_noise)
+    missing = missing_mode_in_bands(frf, bands, power, omega_n, damping_ratio, estimated_noise, budget=budget)
     const_ref = constants_at_poles(frf, bands, power, omega_n, damping_ratio)
     out = []
     for r, (wn, zeta, *_) in enumerate(poles):
@@ -173,12 +180,13 @@ def fit_noise(frf, bands, power, omega_n, damping_ratio, estimated_noise, channe
 
 
 def missing_mode_in_bands(frf, bands, power, omega_n, damping_ratio, estimated_noise, residual=None, residual_noise=None,
-                  data=None, peak=None):
+                  data=None, peak=None, budget=None):
     """:func:`modal.sdof.checks.find_missing_mode` on the lines of the bands (``residual`` and ``residual_noise``:
     the fit's residual and its :func:`modal.sdof.checks.residual_noise_std`, if known; ``data``: the bands'
-    :func:`band_data`; ``peak``: max |H| of each channel there)."""
+    :func:`band_data`; ``peak``: max |H| of each channel there; ``budget``: the identification's
+    :class:`~modal.work_budget.EvaluationBudget`, which its trial fit shares)."""
     omega, response, region = band_data(frf, bands) if data is None else data
     bands_rad = [(TWO_PI * b.low_hz, TWO_PI * b.high_hz) for b in bands]
     with np.errstate(all="ignore"):
         return find_missing_mode(omega, response, power, region, omega_n, damping_ratio, estimated_noise,
-                                 bands_rad, residual, residual_noise, peak)
+                                 bands_rad, residual, residual_noise, peak, budget)

@@ -201,7 +201,56 @@ def test_the_nls_fits_share_a_budget_of_evaluations_that_ordinary_data_never_rea
         assert identify(frf, "auto", max_evaluations=1).method == "nls"
 
 
-def test_a_budget_is_refused_by_the_methods_that_do_not_refine():
-    for method in ("circle", "halfpower"):
-        with pytest.raises(TypeError, match=f"max_evaluations, which method='{method}' does not take"):
-            identify(_three_modes_noisy(), method, max_evaluations=10)
+@pytest.mark.parametrize("method", ["circle", "halfpower"])
+def test_the_refinement_that_checks_halfpower_and_circle_has_a_budget_too(method):
+    frf = _three_modes_noisy()
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        free = identify(frf, method)
+        uncapped = identify(frf, method, max_evaluations=10**9)  # the work identify did before it had a budget
+    assert not any("work_capped" in m.flags for m in free.modes) and not any("budget" in str(w.message) for w in caught)
+    assert all(np.array_equal(a, b) for a, b in zip(_numbers(free), _numbers(uncapped)))
+    assert [m.flags for m in free.modes] == [m.flags for m in uncapped.modes]
+    # the default, scaled to the size of one evaluation, leaves a margin of ten at least
+    assert 0 < free.settings["evaluations"] <= free.settings["max_evaluations"] / 10
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        capped = identify(frf, method, max_evaluations=1)
+    messages = [str(w.message) for w in caught]
+    assert capped.settings["max_evaluations"] == 1 and capped.settings["evaluations"] <= 1 + 1  # the start counts
+    # the estimates are the method's own; only the check stopped: flagged, not compared with where it stood
+    assert all("work_capped" in m.flags and "method_bias" not in m.flags for m in capped.modes)
+    # (to rounding: the errors' rescaling to the noise reads another residual, and a pole passes through it)
+    np.testing.assert_allclose([m.natural_frequency_hz for m in capped.modes],
+                               [m.natural_frequency_hz for m in free.modes], rtol=1e-12)
+    assert sum(f"{method}: the least-squares refinement that checks it stopped at its budget of 1 model evaluations"
+               in m and "--max-evaluations N" in m for m in messages) == 1
+    # lifted to what the free check used, the same result as without a cap
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", modal.ModalWarning)
+        lifted = identify(frf, method, max_evaluations=free.settings["evaluations"])
+    assert all(np.array_equal(a, b) for a, b in zip(_numbers(free), _numbers(lifted)))
+
+
+def test_auto_fits_more_peaks_than_the_global_sweep_holds_band_wise_and_says_why():
+    from modal.global_.identify import MAX_DEFAULT_ORDER
+    from modal.identify import AUTO_PEAKS_PER_REFERENCE, choose_method
+    from support.manymodes import many_modes_frf
+
+    # a third of the default ceiling's poles per reference (a pair per mode and one more for the noise)
+    assert AUTO_PEAKS_PER_REFERENCE == MAX_DEFAULT_ORDER // 3
+    from modal.identify import _too_many_peaks
+
+    assert _too_many_peaks(80, 2) is None and "81 peaks" in _too_many_peaks(81, 2)  # per reference
+    # 40 evenly spread modes (39 peaks): the global method finds every one (measured), auto keeps it
+    assert choose_method(many_modes_frf(40, 10_000)) == "global"
+    # 44 modes show 42 peaks, more than the default sweep holds: band-wise (the global fit found 4 of them)
+    many = many_modes_frf(44, 4000)
+    assert choose_method(many) == "nls"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", modal.ModalWarning)  # one evaluation: a quick fit, flagged work_capped
+        result = identify(many, "auto", max_evaluations=1)
+        ordinary = identify(_three_modes_noisy(), "auto")
+    assert result.method == "nls" and "42 peaks, more than the global method's default sweep holds" in \
+        result.settings["method_choice"]
+    assert "method_choice" not in ordinary.settings  # a few peaks: nls as always, nothing to explain

@@ -123,6 +123,21 @@ def test_hidden_neighbour_is_flagged_missing_mode():
 
 
 @pytest.mark.parametrize("method", BANDWISE_METHODS)
+def test_the_missing_mode_checks_trial_fit_shares_the_budget(method):
+    # the hidden neighbour above: the check's trial fit with one more mode takes evaluations of the same
+    # budget; one evaluation short of what the free run used, the trial stops, gives no verdict and says so
+    f = np.linspace(50, 250, 3001)
+    frf = add_noise(modal_frf(f, [115, 154], [0.053, 0.057], [0.0008, 0.0036], kind="accelerance"), 0.044, seed=0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", QualityWarning)
+        free = identify(frf, method)
+        cut = identify(frf, method, max_evaluations=free.settings["evaluations"] - 1)
+    assert "missing_mode" in free[0].flags and "work_capped" not in free[0].flags
+    assert "work_capped" in cut[0].flags and "missing_mode" not in cut[0].flags
+    assert cut.settings["evaluations"] == cut.settings["max_evaluations"] == free.settings["evaluations"] - 1
+
+
+@pytest.mark.parametrize("method", BANDWISE_METHODS)
 def test_missing_mode_check_is_quiet_without_a_hidden_mode(method):
     # one mode, 1 % noise (false alarm < 1e-6 per test); and a strong mode just outside the
     # band, whose slope the band offset cannot absorb (structure that is not a mode here)
