@@ -428,8 +428,10 @@ def _read_csv(path, src: str) -> TimeRecord:
         raise FormatError(f"{src}: line {header_line}: only the time column; {_TIME_CSV}")
     for line_no, row in rows[1:]:
         if len(row) != len(header):
-            raise FormatError(f"{src}: line {line_no}: {len(row)} columns; expected {len(header)} like the header "
-                              f"(line {header_line}) in every row")
+            last = " (the last line: is the file cut short?)" if line_no == rows[-1][0] and len(row) < len(header) \
+                else ""
+            raise FormatError(f"{src}: line {line_no}: {len(row)} columns{last}; expected {len(header)} like the "
+                              f"header (line {header_line}) in every row")
     try:
         table = np.array([row for _, row in rows[1:]], dtype=float)
     except ValueError:

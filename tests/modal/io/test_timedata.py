@@ -236,6 +236,13 @@ def test_ragged_csv_names_the_line(tmp_path):
     _fails(path, "line 19: 2 columns", "expected 3 like the header")
 
 
+def test_csv_cut_short_in_its_last_line_says_so(tmp_path):
+    path = tmp_path / "cut.csv"
+    rows = [f"{k / FS!r},{k}.0,{-k}.0" for k in range(40)]
+    path.write_text("time,force [N],a [m/s^2]\n" + "\n".join(rows) + f"\n{40 / FS!r},40.0")
+    _fails(path, "line 42: 2 columns (the last line: is the file cut short?)", "expected 3 like the header")
+
+
 def test_csv_text_in_a_sample_names_line_and_column(tmp_path):
     path = tmp_path / "text.csv"
     rows = [f"{k / FS!r},{k}.0,{-k}.0" for k in range(40)]
