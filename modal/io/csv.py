@@ -315,6 +315,11 @@ def _number_error(src, n, col_name, tok, decimal) -> FormatError:
     return FormatError(f"{src}: line {n}, column {col_name!r}: {what}{hint}; expected a number")
 
 
+def _cut_short(line_no: int, n_tokens: int, data, n_cols: int) -> str:
+    """What a message adds when the short row is the file's last: the file may be cut short."""
+    return " (the last line: is the file cut short?)" if line_no == data[-1][0] and n_tokens < n_cols else ""
+
+
 def _parse_real(data, delim, decimal, n_cols, col_names, src) -> np.ndarray:
     texts = [ln for _, ln in data]
     if decimal == ",":
@@ -331,7 +336,8 @@ def _parse_real(data, delim, decimal, n_cols, col_names, src) -> np.ndarray:
             toks = _split(t, delim)
             if len(toks) != n_cols:
                 raise FormatError(
-                    f"{src}: line {n}: {len(toks)} columns; expected {n_cols} (as on line {data[0][0]})"
+                    f"{src}: line {n}: {len(toks)} columns{_cut_short(n, len(toks), data, n_cols)}; expected "
+                    f"{n_cols} (as on line {data[0][0]})"
                 ) from None
             for k, tok in enumerate(toks):
                 try:
@@ -349,7 +355,8 @@ def _parse_complex(data, delim, decimal, n_cols, col_names, src) -> np.ndarray:
     for i, (n, ln) in enumerate(data):
         toks = _split(ln, delim)
         if len(toks) != n_cols:
-            raise FormatError(f"{src}: line {n}: {len(toks)} columns; expected {n_cols} (as on line {data[0][0]})")
+            raise FormatError(f"{src}: line {n}: {len(toks)} columns{_cut_short(n, len(toks), data, n_cols)}; "
+                              f"expected {n_cols} (as on line {data[0][0]})")
         for k, tok in enumerate(toks):
             t = tok.replace(" ", "")
             if decimal == ",":

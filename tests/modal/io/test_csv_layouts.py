@@ -4,6 +4,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from modal.errors import FormatError
 from modal.io import read_frf
 from modal.units import TWO_PI
 
@@ -101,6 +102,13 @@ def test_kind_aliases_and_units_hint(tmp_path):
     # g/N is converted to the kind's SI unit (1 g = 9.80665 m/s^2, exactly by definition)
     assert frf.kind == "accelerance" and frf.units == "m/s^2/N"
     np.testing.assert_allclose(frf.response, 9.80665 * H[0], rtol=1e-15)
+
+
+def test_a_file_cut_short_in_its_last_line_says_so(tmp_path):
+    text = _table([F, H[0].real, H[0].imag], header=["f", "re", "im"])
+    cut = text.rstrip("\n").rpartition(",")[0] + "\n"  # the last row loses its last column
+    with pytest.raises(FormatError, match=r"2 columns \(the last line: is the file cut short\?\); expected 3"):
+        read_frf(_write(tmp_path, "cut.csv", cut), kind="mobility")
 
 
 def test_trailing_delimiter_and_utf16(tmp_path):
