@@ -25,6 +25,7 @@ from ..noise_model import (INPUT_NOISE_LIMIT, NoiseModel, input_noise_split, lag
                            window_line_correlation)
 from ..validate import finite_samples, one_of, per_line, positive_number
 from . import spectra
+from .error_correlation import LEAKAGE_LAGS, MIN_RECORDS, measured_line_correlation
 from .hits import find_hits, pulse_train
 from .overload import find_overloads
 from .quiet import quiet_noise
@@ -170,6 +171,9 @@ def _noise_model(sums, output_correlation, input_window, output_window, sample_r
     shape (``variance_model``). A hammer test's force noise, over the force window's few dozen samples, is
     nearly the same on every line of a band: at the peaks it is most of the error.
 
+    Continuous records (``sums.error_products`` summed): the correlation measured over the records
+    (:func:`~modal.estimate.error_correlation.measured_line_correlation`) replaces the window's model.
+
     One record (a single hit) has no residual over records: ``quiet`` (:func:`~modal.estimate.quiet.quiet_noise`,
     the noise read from the samples where the channels hold noise alone) gives a and b instead.
     """
@@ -210,6 +214,12 @@ def _noise_model(sums, output_correlation, input_window, output_window, sample_r
         correlation[m - 1, :-m] = np.where(np.isfinite(value), value, 0.0)
     magnitude = np.abs(correlation)
     correlation = np.where(magnitude > 1, correlation / np.maximum(magnitude, 1e-300), correlation)
+    if sums.error_products is not None and frf is not None and frf.shape[:2] == (1, 1):
+        # near a resonance a continuous record's errors are mostly leakage, which the window's model does not
+        # describe: the correlation measured over the records serves instead
+        measured = measured_line_correlation(sums.error_products, frf[0, 0], sums.n_records)
+        if measured is not None:
+            correlation = measured
     lags = lag_window(input_window, output_window, sums.excitation_square / sums.n_records)
     if decay_s is not None:
         lags = lags * np.exp(np.arange(lags.size) * interval / decay_s)
@@ -403,8 +413,11 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
                  "lower the gain or the excitation level", QualityWarning)
 
     output_correlation = window_line_correlation(out_w)
-    sums = spectra.accumulate(x, y, starts, length, in_w, out_w,
-                              lags=lags_carried(output_correlation, length // 2 + 1))
+    window_lags = lags_carried(output_correlation, length // 2 + 1)
+    # continuous records, enough of them: the errors' correlation is also measured over the records
+    measured = not impact and starts.size >= MIN_RECORDS
+    sums = spectra.accumulate(x, y, starts, length, in_w, out_w, lags=window_lags,
+                              error_lags=max(window_lags, LEAKAGE_LAGS) if measured else 0)
     factor = spectra.overlap_variance_factor(out_w, step) if not impact else 1.0
     estimate = {"H1": spectra.h1, "H2": spectra.h2, "Hv": spectra.hv}[estimator]
     frf3, coherence3, multiple, variance3 = estimate(sums, source)
