@@ -69,7 +69,8 @@ def quiet_noise(force, response, start: int, length: int, pretrigger: int, pulse
     Returns
     -------
     QuietNoise or None
-        a per output from the variance of the responses' pre-trigger (less its mean: a constant offset
+        None also where a channel's lines would carry no noise at all (b = 0 and some a = 0: noise-free
+        data, whose errors the fit's residual tells). a per output from the variance of the responses' pre-trigger (less its mean: a constant offset
         enters the 0 Hz line only); b from the force after the pulse, by its median absolute deviation
         (robust to a hammer's ringing after the pulse, a few samples far from the noise).
     """
@@ -83,6 +84,6 @@ def quiet_noise(force, response, start: int, length: int, pretrigger: int, pulse
     force_std = MAD_TO_STD * float(np.median(np.abs(tail - np.median(tail))))
     a = response_variance * float(np.dot(output_window, output_window))
     b = force_std**2 * float(np.dot(input_window, input_window))
-    if not (np.all(np.isfinite(a)) and np.isfinite(b)):
-        return None
+    if not (np.all(np.isfinite(a)) and np.isfinite(b)) or (b == 0 and not np.all(a > 0)):
+        return None  # no noise on some channel's lines (noise-free data): the fit's residual tells it
     return QuietNoise(a, b)

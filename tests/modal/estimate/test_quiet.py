@@ -57,3 +57,12 @@ def test_one_hit_carries_a_calibrated_noise_level_on_every_line():
     # of it. With the force's noise left out of noise_std the peaks' median is about 13
     for lines in (peaks, between):
         assert abs(np.median(ratios[:, lines]) - RAYLEIGH_MEDIAN) < 0.07, np.median(ratios[:, lines])
+
+
+def test_noise_free_hit_leaves_its_noise_to_the_fit():
+    # exact data: the quiet samples are exactly zero, no noise level per line to weight by (every weight
+    # would be infinite); the estimate carries none, as with one average of a continuous record
+    rec = impact_record(PLANT, [0.5], 4.5, seed=0)
+    est = modal.estimate_frf(rec.record.signals[0], rec.record.signals[1], FS, impact=True, window="rect",
+                             kind="accelerance")
+    assert est.averages == 1 and est.noise_std is None
