@@ -29,10 +29,14 @@ import numpy as np
 
 from .errors import FRFValidationError
 
-__all__ = ["NoiseModel", "window_line_correlation", "lag_window", "input_noise_split", "MAX_LAGS", "CORRELATION_FLOOR"]
+__all__ = ["NoiseModel", "window_line_correlation", "lag_window", "input_noise_split", "MAX_LAGS", "CORRELATION_FLOOR",
+           "MEASURED_CORRELATION_RECORDS"]
 
 #: neighbouring lines whose noise correlation is carried, at most
 MAX_LAGS = 64
+#: a continuous estimate from at least this many records carries its errors' correlation as measured over them
+#: (:mod:`modal.estimate.error_correlation`; fewer scatter too much to whiten by: ±0.25 per line with 16)
+MEASURED_CORRELATION_RECORDS = 16
 #: a window's line correlation |c(m)| below this at every lag from m on ends the lags carried
 CORRELATION_FLOOR = 0.01
 #: at most this many correlation values per FRF (lags × lines): long FRFs carry fewer lags

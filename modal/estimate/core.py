@@ -25,8 +25,10 @@ from ..noise_model import (INPUT_NOISE_LIMIT, NoiseModel, input_noise_split, lag
                            window_line_correlation)
 from ..validate import finite_samples, one_of, per_line, positive_number
 from . import spectra
+from .error_correlation import LEAKAGE_LAGS, MIN_RECORDS, measured_line_correlation
 from .hits import find_hits, pulse_train
 from .overload import find_overloads
+from .quiet import quiet_noise
 from .takes import find_hits_in_takes, segment_starts, take_bounds
 from .takes import take_names as _take_names
 from .windows import WINDOWS, exponential_window, force_window, segment_window
@@ -53,7 +55,9 @@ class EstimatedFRF(FRF):
         coherence for one input).
     noise_std : ndarray, shape like ``response``, or None
         (:class:`~modal.frf.FRF`'s field) Standard deviation of the complex random error of
-        each line, E|Ĥ − H|² = noise_std², in the FRF's unit. None with one average (undefined).
+        each line, E|Ĥ − H|² = noise_std², in the FRF's unit. One hit (an impact estimate from one record):
+        the noise its channels hold before the trigger and after the pulse gives it
+        (:mod:`modal.estimate.quiet`); None with one average otherwise (undefined).
     averages : int
         Records (segments or accepted hits) averaged.
     rejected : list of dict
@@ -150,7 +154,7 @@ def _as_signals(value, name: str, source: str):
 
 
 def _noise_model(sums, output_correlation, input_window, output_window, sample_rate_hz, overlap_factor,
-                 decay_s=None, frf=None) -> NoiseModel:
+                 decay_s=None, frf=None, quiet=None) -> NoiseModel:
     """The estimate's :class:`~modal.noise_model.NoiseModel` from its sums and windows.
 
     One input: the errors of lines k and k + m correlate by c_out(m) Σ conj(X_k) X_{k+m} / √(S_xx,k S_xx,k+m)
@@ -166,6 +170,12 @@ def _noise_model(sums, output_correlation, input_window, output_window, sample_r
     excitation's term above, and the model's variance per line, (a + b|H_k|²)/S_xx,k, is the noise level's
     shape (``variance_model``). A hammer test's force noise, over the force window's few dozen samples, is
     nearly the same on every line of a band: at the peaks it is most of the error.
+
+    Continuous records (``sums.error_products`` summed): the correlation measured over the records
+    (:func:`~modal.estimate.error_correlation.measured_line_correlation`) replaces the window's model.
+
+    One record (a single hit) has no residual over records: ``quiet`` (:func:`~modal.estimate.quiet.quiet_noise`,
+    the noise read from the samples where the channels hold noise alone) gives a and b instead.
     """
     n_in = sums.sxx.shape[0]
     dof = max(sums.n_records - n_in, 0) / overlap_factor
@@ -176,15 +186,19 @@ def _noise_model(sums, output_correlation, input_window, output_window, sample_r
     n_lags, n_lines = sums.sxx_lag.shape
     correlation = np.zeros((n_lags, n_lines), complex)
     response_part, input_part, variance = np.ones(n_lines), np.zeros(n_lines, complex), None
-    if frf is not None and frf.shape[:2] == (1, 1) and sums.n_records > 1:
+    one_record = quiet is not None and sums.n_records == 1
+    if frf is not None and frf.shape[:2] == (1, 1) and (sums.n_records > 1 or one_record):
         h = frf[0, 0]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            residual = (sums.syy[0] - np.abs(sums.syx[0, 0]) ** 2 / power) / (sums.n_records - 1)
-        a, b = input_noise_split(residual, np.abs(h) ** 2)
-        # where the excitation's noise is not small against the excitation (above a hammer's band, at the
-        # zeros of its spectrum) H1 is biased towards zero and the model does not hold: fitted without them
-        holds = b * sums.n_records < INPUT_NOISE_LIMIT * power
-        a, b = input_noise_split(residual, np.abs(h) ** 2, holds)
+        if one_record:
+            a, b = float(quiet.response_power[0]), quiet.force_power
+        else:
+            with np.errstate(divide="ignore", invalid="ignore"):
+                residual = (sums.syy[0] - np.abs(sums.syx[0, 0]) ** 2 / power) / (sums.n_records - 1)
+            a, b = input_noise_split(residual, np.abs(h) ** 2)
+            # where the excitation's noise is not small against the excitation (above a hammer's band, at the
+            # zeros of its spectrum) H1 is biased towards zero and the model does not hold: fitted without them
+            holds = b * sums.n_records < INPUT_NOISE_LIMIT * power
+            a, b = input_noise_split(residual, np.abs(h) ** 2, holds)
         holds = b * sums.n_records < INPUT_NOISE_LIMIT * power
         total = a + b * np.abs(h) ** 2
         if b > 0 and np.any(holds) and np.all(total[holds] > 0):
@@ -200,6 +214,12 @@ def _noise_model(sums, output_correlation, input_window, output_window, sample_r
         correlation[m - 1, :-m] = np.where(np.isfinite(value), value, 0.0)
     magnitude = np.abs(correlation)
     correlation = np.where(magnitude > 1, correlation / np.maximum(magnitude, 1e-300), correlation)
+    if sums.error_products is not None and frf is not None and frf.shape[:2] == (1, 1):
+        # near a resonance a continuous record's errors are mostly leakage, which the window's model does not
+        # describe: the correlation measured over the records serves instead
+        measured = measured_line_correlation(sums.error_products, frf[0, 0], sums.n_records)
+        if measured is not None:
+            correlation = measured
     lags = lag_window(input_window, output_window, sums.excitation_square / sums.n_records)
     if decay_s is not None:
         lags = lags * np.exp(np.arange(lags.size) * interval / decay_s)
@@ -393,8 +413,11 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
                  "lower the gain or the excitation level", QualityWarning)
 
     output_correlation = window_line_correlation(out_w)
-    sums = spectra.accumulate(x, y, starts, length, in_w, out_w,
-                              lags=lags_carried(output_correlation, length // 2 + 1))
+    window_lags = lags_carried(output_correlation, length // 2 + 1)
+    # continuous records, enough of them: the errors' correlation is also measured over the records
+    measured = not impact and starts.size >= MIN_RECORDS
+    sums = spectra.accumulate(x, y, starts, length, in_w, out_w, lags=window_lags,
+                              error_lags=max(window_lags, LEAKAGE_LAGS) if measured else 0)
     factor = spectra.overlap_variance_factor(out_w, step) if not impact else 1.0
     estimate = {"H1": spectra.h1, "H2": spectra.h2, "Hv": spectra.hv}[estimator]
     frf3, coherence3, multiple, variance3 = estimate(sums, source)
@@ -405,8 +428,18 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
     noise = None
     if variance3 is not None:
         noise = np.sqrt(variance3.reshape(n_out * n_in, n_lines) * factor)
+    quiet = None
+    if impact and sums.n_records == 1 and estimator == "H1":
+        # one hit: no residual over records; the noise is read where the channels hold noise alone
+        quiet = quiet_noise(x[0], y, int(starts[0]), length, pre_samples, hits.pulse_samples, in_w, out_w)
+        if quiet is not None:
+            with np.errstate(divide="ignore", invalid="ignore"):
+                variance = ((quiet.response_power[:, None, None] + quiet.force_power * np.abs(frf3) ** 2)
+                            / sums.sxx[0, 0].real)
+            if np.all(np.isfinite(variance)):
+                noise = np.sqrt(variance.reshape(n_out * n_in, n_lines))
     model = _noise_model(sums, output_correlation, in_w, out_w, fs, factor, decay_s=exponential_decay_s,
-                         frf=frf3 if estimator == "H1" else None)
+                         frf=frf3 if estimator == "H1" else None, quiet=quiet)
 
     if response_quantity is not None:
         delta = KIND_POWER[kind] - RESPONSE_QUANTITIES[response_quantity]

@@ -40,6 +40,11 @@ class SpectralSums:
         One input: ``Σ conj(X_k) X_{k+m}`` for m = 1 … n_lags (zero past the last line).
     excitation_square : ndarray, shape (length,), optional
         One input: Σ x[n]² over the records at each sample n of a record (unwindowed).
+    error_products : ndarray, shape (4, n_lags + 1, n_lines), optional
+        One input and one output: with p = Y conj(X) and q = |X|² per record and line, the sums over the
+        records of p_k conj(p_{k+m}), p_k q_{k+m}, q_k conj(p_{k+m}) and q_k q_{k+m} for m = 0 … n_lags
+        (zero past the last line): each line's error products over the records
+        (:func:`modal.estimate.error_correlation.measured_line_correlation`).
     """
 
     sxx: np.ndarray
@@ -48,6 +53,7 @@ class SpectralSums:
     n_records: int
     sxx_lag: np.ndarray | None = None
     excitation_square: np.ndarray | None = None
+    error_products: np.ndarray | None = None
 
 
 def _records(signal, starts: np.ndarray, length: int) -> np.ndarray:
@@ -59,7 +65,7 @@ def _records(signal, starts: np.ndarray, length: int) -> np.ndarray:
 
 
 def accumulate(excitation, response, starts, length: int, input_window: np.ndarray,
-               output_window: np.ndarray, lags: int = 0) -> SpectralSums:
+               output_window: np.ndarray, lags: int = 0, error_lags: int = 0) -> SpectralSums:
     """Sum the spectra of the records that start at ``starts``.
 
     Parameters
@@ -75,6 +81,8 @@ def accumulate(excitation, response, starts, length: int, input_window: np.ndarr
     lags : int
         One input: also sum the products of each line with the ``lags`` lines above it
         (``sxx_lag``) and the excitation's square at each sample (``excitation_square``).
+    error_lags : int
+        One input and one output: also sum the ``error_products`` over this many lags (0: not).
     """
     starts = np.asarray(starts, dtype=np.int64)
     n_in, n_out = excitation.shape[0], response.shape[0]
@@ -85,6 +93,8 @@ def accumulate(excitation, response, starts, length: int, input_window: np.ndarr
     one_input = n_in == 1
     sxx_lag = np.zeros((lags, n_lines), complex) if one_input else None
     square = np.zeros(length) if one_input else None
+    error_lags = min(error_lags, n_lines - 1) if one_input and n_out == 1 else 0
+    products = np.zeros((4, error_lags + 1, n_lines), complex) if error_lags > 0 else None
     per_record = (n_in + n_out) * n_lines * 16 + (n_in + n_out) * length * 8
     block = max(1, int(_BLOCK_BYTES // max(per_record, 1)))
     for first in range(0, starts.size, block):
@@ -100,7 +110,23 @@ def accumulate(excitation, response, starts, length: int, input_window: np.ndarr
             square += np.einsum("sn,sn->n", raw[0], raw[0])
             for m in range(1, min(lags, n_lines - 1) + 1):
                 sxx_lag[m - 1, :-m] += np.einsum("sf,sf->f", xc[0, :, :-m], x[0, :, m:])
-    return SpectralSums(sxx, syx, syy, int(starts.size), sxx_lag, square)
+        if products is not None:
+            _add_error_products(products, y[0] * xc[0], (x[0] * xc[0]).real)
+    return SpectralSums(sxx, syx, syy, int(starts.size), sxx_lag, square, products)
+
+
+def _add_error_products(products: np.ndarray, cross: np.ndarray, power: np.ndarray) -> None:
+    """Add the records' p_k conj(p_{k+m}), p_k q_{k+m}, q_k conj(p_{k+m}), q_k q_{k+m} (p = ``cross``,
+    q = ``power``, each (records, lines)) to ``products`` (4, lags + 1, lines)."""
+    n_lines = cross.shape[1]
+    for m in range(products.shape[1]):
+        end = n_lines - m
+        left_p, left_q = cross[:, :end], power[:, :end]
+        right_p, right_q = cross[:, m:].conj(), power[:, m:]
+        products[0, m, :end] += np.einsum("sf,sf->f", left_p, right_p)
+        products[1, m, :end] += np.einsum("sf,sf->f", left_p, right_q)
+        products[2, m, :end] += np.einsum("sf,sf->f", left_q, right_p)
+        products[3, m, :end] += np.einsum("sf,sf->f", left_q, right_q)
 
 
 def overlap_variance_factor(window: np.ndarray, step: int) -> float:

@@ -19,6 +19,7 @@ import numpy as np
 from ..assemble import ModeEstimate, assemble_modes, driving_points
 from ..flags import BIAS_LIMIT, model_inadequate
 from ..frf import KIND_POWER, line_spacing
+from ..noise_model import MEASURED_CORRELATION_RECORDS
 from ..peaks import channel_sample, neighbour_noise_rms
 from ..results import IdentificationResult
 from ..units import TWO_PI
@@ -251,7 +252,14 @@ def _least_squares_fits(frf, bands, power, noise, estimated_noise, known_noise, 
                                              else residual_noise, data, fit.channel_scale, budget)
         # near-exact data: the offset's truncation (modes outside the bands) biases the poles
         # beyond their white-noise errors; its measured shift is added to them
-        shift = truncation(frf, bands, power, fit, residual=residual, data=data)
+        # an estimate from many records (a continuous one carries its errors' correlation as measured over
+        # them): the structure is read on the fit's own residual, whitened with that correlation (the raw
+        # residual of a windowed estimate correlates between lines and looks smooth however well the model
+        # fits: the shift, noise, was added to every random record's errors, 1.5-2 times too wide). With
+        # fewer records the raw residual decides
+        measured = frf.noise_model is not None and frf.noise_model.averages >= MEASURED_CORRELATION_RECORDS \
+            and fit.residual is not None
+        shift = truncation(frf, bands, power, fit, residual=fit.residual if measured else residual, data=data)
     order = np.argsort(fit.omega_n)  # two close poles may cross during the fit
     relative = local_misfit(frf, bands, power, fit.omega_n[order], fit.damping_ratio[order], data, band_peak)
     estimates = []

@@ -11,9 +11,11 @@ Tolerances, for the 80 z-values of one quantity of one mode:
 * |mean| ≤ 0.35: standard error of the mean 1/√80 = 0.11; 0.35 is 3.1 of those.
 
 Random excitation with the default Hann segments meets the mean (the window's bias, +0.8 to +1.0
-standard errors of ζ before, is fitted out) and the upper bound of the spread, not its lower bound: its
-errors are up to twice the scatter (spread 0.56–0.94; leakage of the windowed records in the shape of the
-modes, which the residual sees and the poles do not); that test asserts what holds. The hammer with an
+standard errors of ζ before, is fitted out) and, for the damping, the spread: its errors' line correlation
+is measured over the records (near the peaks it is leakage's, not the window's) and the truncation check
+reads the whitened residual (on the raw one it fired on every record and added its shift, noise, to the
+errors: spread 0.69–0.88 before). The frequency's errors are still up to 1.8 times the scatter (spread
+0.44–0.78 over seed sets): that test asserts only the upper bound there. The hammer with an
 exponential window meets the target for both modes: its errors' correlation over the window's tens of
 lines is whitened as it is (not tapered), and the force noise, which at the peaks is most of the error and
 correlates through the force window, is in the noise model.
@@ -52,4 +54,6 @@ def test_random_excitation_is_unbiased_and_not_overconfident(quantity, mode):
     z = scores["z"][(quantity, mode)]
     assert scores["found"][mode] == RECORDS
     assert np.std(z) <= 1.3, np.std(z)
+    if quantity == "zeta":
+        assert np.std(z) >= 0.75, np.std(z)
     assert abs(np.mean(z)) <= 0.35, np.mean(z)

@@ -21,9 +21,10 @@ from modal.synthetic_time import impact_record
 HITS = 40
 
 
-def _scatter(force_noise: float) -> dict:
+def _scatter(force_noise: float, flags: bool = False):
     structure = system()
     z = {(q, r): [] for q in ("fn", "zeta") for r in range(2)}
+    flagged = 0
     for seed in range(HITS):
         rec = impact_record(structure, [0.5], 4.5, amplitude_variation=0.2, width_variation=0.1,
                             pulse_width_s=0.002, response_noise=0.002, force_noise=force_noise, seed=seed).record
@@ -38,7 +39,9 @@ def _scatter(force_noise: float) -> dict:
             assert abs(mode.natural_frequency_hz - fn) < 0.5  # every hit finds both modes
             z[("fn", r)].append((mode.natural_frequency_hz - fn) / mode.std.natural_frequency_hz)
             z[("zeta", r)].append((mode.damping_ratio - zeta) / mode.std.damping_ratio)
-    return {k: np.asarray(v) for k, v in z.items()}
+            flagged += "model_inadequate" in mode.flags
+    z = {k: np.asarray(v) for k, v in z.items()}
+    return (z, flagged) if flags else z
 
 
 def test_single_hits_scatter_as_their_errors_say_with_noise_on_the_response():
@@ -48,11 +51,15 @@ def test_single_hits_scatter_as_their_errors_say_with_noise_on_the_response():
         assert abs(np.mean(z)) <= 0.47, (key, np.mean(z))
 
 
-@pytest.mark.xfail(strict=True, reason="target not met: with 0.2 % force noise single hits scatter 1.3-2.0 times "
-                                       "their errors (noise on the force makes the errors grow as |H| at the peaks; "
-                                       "one average gives no noise level per line to weight by)")
 def test_single_hits_scatter_as_their_errors_say_with_noise_on_the_force():
     # the same with 0.2 % noise on the force as well: over the whole 4 s record it is ~10 % of a line's
-    # force spectrum, an error of H in proportion to |H| that the fit's one noise level does not describe
-    for key, z in _scatter(0.002).items():
-        assert 0.67 <= np.std(z) <= 1.33, (key, np.std(z))
+    # force spectrum, an error of H in proportion to |H|; the noise level each hit carries (read from its
+    # quiet samples, modal.estimate.quiet) has that shape, and the fit weights its lines by it
+    z, flagged = _scatter(0.002, flags=True)
+    for key, values in z.items():
+        assert 0.67 <= np.std(values) <= 1.33, (key, np.std(values))
+        assert abs(np.mean(values)) <= 0.47, (key, np.mean(values))
+    # the modes are fitted as well as the noise allows: model_inadequate is for the exceptions, not for every
+    # mode of every hit (as it was on repeated real hits); with a calibrated chi-square it fires on a few in
+    # a hundred at most (4 of 80 is 5 %)
+    assert flagged <= 4, flagged
