@@ -485,3 +485,17 @@ def test_a_weak_mode_misfit_by_a_strong_neighbour_splits_the_neighbour():
     assert _split_candidate(omega, omega_n, np.array([1.0, 90.0, 50.0, 80.0]), 1) == 1
     # a stronger misfit outside the lines (a mode above the band) is no candidate
     assert _split_candidate(omega, np.array([20.0, 50.0, 120.0]), np.array([1.0, 5.0, 80.0]), 1) == 1
+
+
+def test_pseudo_inverse_factor_leaves_out_the_directions_zero_to_rounding():
+    from modal.global_.plscf import RANK_TOL, _pseudo_inverse_factor
+
+    basis, _ = np.linalg.qr(np.random.default_rng(0).normal(size=(4, 4)))
+    eigenvalues = np.array([2.0, 1e-3, 1e-9, 1e-15])  # the last below RANK_TOL of the largest
+    G = _pseudo_inverse_factor(basis @ np.diag(eigenvalues) @ basis.T)
+    assert G.shape == (3, 4)
+    kept = np.where(eigenvalues > RANK_TOL * eigenvalues.max(), 1 / eigenvalues, 0.0)
+    # GᵀG is that pseudo-inverse to the eigen-decomposition's rounding: ~ε·λ_max = 4e-16 absolute moves the 1e-9
+    # eigenvalue by 4e-7 of itself and its inverse (1e9) by ~400, hence 1e3 absolute (1e-6 of the largest entry)
+    np.testing.assert_allclose(G.T @ G, basis @ np.diag(kept) @ basis.T, rtol=1e-6, atol=1e3)
+    assert _pseudo_inverse_factor(np.zeros((3, 3))) is None
