@@ -154,11 +154,18 @@ def test_errors_are_calibrated_over_noise_seeds():
     assert np.all(np.abs(coverage - 0.954) < 0.045), coverage
 
 
-def test_real_beam_modes_and_synthesis():
+def _beam(relative_perturbation=0.0, seed=0):
+    """The real beam as one response and three hammer points, each value optionally times (1 + ε·N(0, 1))."""
     paths = sorted(REAL.glob("pyuff_meas_point_*.txt"))
     channels = [modal.read_frf(p, frequency_step=1.0, kind="accelerance") for p in paths]
-    frf = modal.FRF(channels[0].frequency_hz, np.array([c.response for c in channels]), kind="accelerance",
-                    response_points=["1"] * 3, reference_points=["1", "2", "3"])
+    H = np.array([c.response for c in channels])
+    H = H * (1 + relative_perturbation * np.random.default_rng(seed).standard_normal(H.shape))
+    return modal.FRF(channels[0].frequency_hz, H, kind="accelerance", response_points=["1"] * 3,
+                     reference_points=["1", "2", "3"])
+
+
+def test_real_beam_modes_and_synthesis():
+    frf = _beam()
     result = _fit(frf)
     assert result.settings["transposed_by_reciprocity"]  # one response, three hammer points
     found = np.array([m.natural_frequency_hz for m in result])
@@ -177,12 +184,44 @@ def test_real_beam_modes_and_synthesis():
     error = np.abs(result.synthesize(f[band]).channels - frf.channels[:, band]) / np.abs(frf.channels[:, band])
     assert np.median(error) < 0.06 and np.percentile(error, 90) < 0.35  # the 6 % and 35 % asked
     # and no worse than the joint refinement gave when it came (3.8 % and 8.8 %): the 4 % and 9 % asked since.
-    # A pLSCF pole on the band's top edge (993.6 Hz, where the stabilisation picks 992.9 Hz as it stands: the
-    # choice turns on the rounding of pLSCF's sums) wanders above the lines with its damping collapsing onto
-    # its floor; that once kept the final fit going to its iteration limit (every mode did_not_converge), and
-    # the pole, kept at 1059 Hz with ζ = 0, takes the 90th percentile to 9.5 %
+    # A pLSCF pole on the band's top edge that wanders above the lines with its damping collapsing onto its floor
+    # once kept the final fit going to its iteration limit (every mode did_not_converge); kept at 1059 Hz with
+    # ζ = 0, it took the 90th percentile to 9.5 %
     assert np.median(error) <= 0.04 and np.percentile(error, 90) <= 0.09
     assert not any("did_not_converge" in m.flags for m in result)
+
+
+def test_real_beam_modes_do_not_turn_on_rounding():
+    # a relative perturbation of 1e-12 is a few units in the last place of the data: the modes must not move
+    # beyond what such a change can move a well-posed fit (1e-12 relative, 1e-8 with the refinement's own
+    # tolerances: its last step stops at 1e-9 of a pole). With the stabilisation sweep reaching 1.25 times the
+    # top line, the edge pole the selection kept was set by rounding: this perturbation moved the 901 Hz mode by
+    # 4e-7, and with pLSCF's sums summed in another order it added a mode at 960.1 Hz
+    base = _fit(_beam())
+    for seed in (2, 3):
+        perturbed = _fit(_beam(1e-12, seed))
+        assert len(perturbed) == len(base)
+        np.testing.assert_allclose([m.natural_frequency_hz for m in perturbed],
+                                   [m.natural_frequency_hz for m in base], rtol=1e-8)
+        np.testing.assert_allclose([m.damping_ratio for m in perturbed], [m.damping_ratio for m in base],
+                                   rtol=1e-5)  # ζ 1e-4: 1e-9 of ωn is 1e-5 of ζ
+
+
+def test_plscf_poles_of_the_sweep_do_not_turn_on_rounding():
+    # the sweep's basis reaches BEYOND_BAND times the top line; on the real beam's 999 lines every order of
+    # the default sweep (14-56) keeps its physical poles under a 1e-12 relative perturbation, to 1e-8 (measured
+    # at most 1e-9; with 1.25 they moved by up to 10 % and high orders changed their count by a factor 3)
+    from modal.global_.identify import BEYOND_BAND
+
+    orders = list(range(14, 57, 2))
+    packs = []
+    for frf in (_beam(), _beam(1e-12, 1)):
+        weight = 1 / np.sqrt(np.mean(np.abs(frf.channels[:, 1:]) ** 2, axis=1))
+        matrix = (frf.channels[:, 1:] * weight[:, None])[:, None, :]
+        packs.append(plscf_poles(frf.omega_rad_s[1:], matrix, orders, beyond=BEYOND_BAND))
+    for a, b in zip(*packs):
+        assert a.omega_n.size == b.omega_n.size, a.order
+        np.testing.assert_allclose(b.omega_n, a.omega_n, rtol=1e-8, err_msg=str(a.order))
 
 
 def test_cli_global_on_the_real_beam_with_a_stabilisation_plot(tmp_path):
@@ -415,3 +454,48 @@ def test_loose_stages_sample_the_lines_far_from_every_mode():
     assert np.all(np.abs(after_sampled.damping_ratio - after_every.damping_ratio) < 0.1 * s_zeta)
     # a line spacing as wide as the modes: nothing far from them to sample, every line
     assert _loose_lines(omega[::100], wn0, zeta0) is None
+
+
+def test_modes_above_the_band_come_from_the_low_order_sweep():
+    # the benchmark's wide-band case at noise seed 1: modes at 2150 and 2500 Hz above 0.5-2000 Hz lines. The
+    # stabilisation sweep's basis reaches only 1.05 times the top line; without the low-order sweep reaching 1.25
+    # the 2500 Hz mode is left to the residual terms, which absorb it badly, and the 2150 Hz mode came out at
+    # 2153.24 ± 0.68 Hz (4.8 of its errors off). Both above-band modes are found within 4 of their errors (a
+    # 4σ excursion has probability 6e-5) and flagged outside_band
+    from benchmarks.bench_global import WIDE_BAND, WIDE_FN, make_wide_case
+
+    _, noisy = make_wide_case(seed=1)
+    result = _fit(noisy)
+    above = [m for m in result if m.natural_frequency_hz > WIDE_BAND[1]]
+    assert len(above) == 2
+    for m, f_true in zip(above, WIDE_FN[WIDE_FN > WIDE_BAND[1]]):
+        assert "outside_band" in m.flags
+        assert abs(m.natural_frequency_hz - f_true) < 4 * m.std.natural_frequency_hz, (f_true, m.natural_frequency_hz)
+
+
+def test_a_weak_mode_misfit_by_a_strong_neighbour_splits_the_neighbour():
+    from modal.global_.identify import _split_candidate
+
+    omega = np.linspace(10.0, 100.0, 91)
+    omega_n = np.array([20.0, 50.0, 57.0, 90.0])
+    # mode 1 (weak, flagged) sits in the skirt of mode 2, whose misfit is larger: mode 2 is tried as two; mode 3
+    # leaves more misfit still but is farther
+    assert _split_candidate(omega, omega_n, np.array([1.0, 5.0, 50.0, 80.0]), 1) == 2
+    # the flagged mode leaves the most misfit itself: it is the one tried as two
+    assert _split_candidate(omega, omega_n, np.array([1.0, 90.0, 50.0, 80.0]), 1) == 1
+    # a stronger misfit outside the lines (a mode above the band) is no candidate
+    assert _split_candidate(omega, np.array([20.0, 50.0, 120.0]), np.array([1.0, 5.0, 80.0]), 1) == 1
+
+
+def test_pseudo_inverse_factor_leaves_out_the_directions_zero_to_rounding():
+    from modal.global_.plscf import RANK_TOL, _pseudo_inverse_factor
+
+    basis, _ = np.linalg.qr(np.random.default_rng(0).normal(size=(4, 4)))
+    eigenvalues = np.array([2.0, 1e-3, 1e-9, 1e-15])  # the last below RANK_TOL of the largest
+    G = _pseudo_inverse_factor(basis @ np.diag(eigenvalues) @ basis.T)
+    assert G.shape == (3, 4)
+    kept = np.where(eigenvalues > RANK_TOL * eigenvalues.max(), 1 / eigenvalues, 0.0)
+    # GᵀG is that pseudo-inverse to the eigen-decomposition's rounding: ~ε·λ_max = 4e-16 absolute moves the 1e-9
+    # eigenvalue by 4e-7 of itself and its inverse (1e9) by ~400, hence 1e3 absolute (1e-6 of the largest entry)
+    np.testing.assert_allclose(G.T @ G, basis @ np.diag(kept) @ basis.T, rtol=1e-6, atol=1e3)
+    assert _pseudo_inverse_factor(np.zeros((3, 3))) is None
