@@ -13,7 +13,7 @@ of the estimator (:mod:`modal.operational.plscf_perturb`), and to the shapes by 
 the half-spectra and poles moved by it (central differences). Each mode is reported from the upper half of
 its chain's orders (the order of smallest frequency error there): over 50 records of the anchor case,
 the under-fitted low orders hold poles biased by about one of their (small) standard errors, so that
-ranking every order by its error chose them (frequency z means up to +1.0, SDs up to 1.5). The lags span
+ranking every order by its error chose them (frequency z means up to +0.84, SDs up to 1.53). The lags span
 :data:`PERIODS` periods of the lowest frequency of interest: over 4 periods the window's truncation, at 1 %
 of a mode that has not yet decayed, biased the weak mode's damping by +0.4 of its error.
 """
