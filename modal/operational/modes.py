@@ -96,7 +96,8 @@ def estimates_from_clusters(flat, clusters: list[Cluster], perturb, n_orders_swe
         poles of small error (ranked by their errors, they would be chosen).
     """
     # the errors are computed at a few orders spread over the sweep (one perturbation per order serves every
-    # cluster), and at each cluster's top order when it has no pole at those
+    # cluster), and at each cluster's top order when it has no pole at those; or at every order of the
+    # clusters' upper halves
     upper = [upper_half(flat, c) for c in clusters] if representative == "upper_half" else None
     if upper is not None:
         probe = {int(o) for members in upper for o in flat.order[members]}
