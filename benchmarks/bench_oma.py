@@ -21,7 +21,7 @@ damping errors over the modes found.
 ``--calibration N``: z = error / reported standard error of modalbal's frequency and damping per mode
 over N records (seeds 5000+, as the stress test), the table of their means and SDs; ``--channels C`` runs
 it on the anchor case with C sensors along the frame (32 or 64: the many-channel layout, 8 references
-chosen and fewer output block rows).
+chosen and fewer output block rows); ``--method plscf`` checks the cross-check estimator's errors instead.
 ``--tones N``: the tone test over N records of the anchor case (seeds 7000+; 5, 10 and 20 % noise in turn,
 1000 s and 200 s, with and without the tones): structural modes called tones (false calls), tones missed, and
 the lowest kurtosis any structural mode's band reached against the limit.
@@ -151,16 +151,16 @@ def compare(n_records: int) -> str:
     return "\n".join(lines)
 
 
-def calibration(n_records: int, n_sensors: int = 8) -> str:
+def calibration(n_records: int, n_sensors: int = 8, method: str = "ssi") -> str:
     zf, zz, wrong = [], [], 0
     layout = None
     for seed in range(n_records):
         rec = anchor_record(5000 + seed, noise=0.1, tones=True, n_sensors=n_sensors)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            result = modal.oma(rec.signals, rec.sample_rate_hz, band_hz=BAND)
-        layout = (len(result.settings["reference_channels"]), result.settings["block_rows"],
-                  result.settings["block_cols"])
+            result = modal.oma(rec.signals, rec.sample_rate_hz, band_hz=BAND, method=method)
+        layout = (len(result.settings["reference_channels"]), result.settings.get("block_rows"),
+                  result.settings.get("block_cols"), result.settings.get("lags"))
         wrong += len(result) != FN.size or len(result.harmonics_hz) != TONES.size
         row_f, row_z = [], []
         for k, fn in enumerate(FN):
@@ -170,8 +170,10 @@ def calibration(n_records: int, n_sensors: int = 8) -> str:
             row_z.append(np.nan if m is None else (m.damping_ratio - ZETA[k]) / m.std.damping_ratio)
         zf.append(row_f), zz.append(row_z)
     zf, zz = np.array(zf), np.array(zz)
+    shape = (f"{layout[1]} + 1 output block rows, {layout[2]} reference block columns; SSI" if method == "ssi"
+             else f"half-spectra over {layout[3]} lags; pLSCF")
     lines = [f"z = error / reported standard error over {n_records} records (anchor case, {n_sensors} sensors, "
-             f"{layout[0]} references, {layout[1]} + 1 output block rows, {layout[2]} reference block columns; SSI); "
+             f"{layout[0]} references, {shape}); "
              f"records with a mode missing, twice or a tone missing: {wrong}", "",
              "| mode [Hz] | ζ | z(f) mean | z(f) SD | z(ζ) mean | z(ζ) SD |", "|---|---|---|---|---|---|"]
     for k in range(FN.size):
@@ -245,6 +247,8 @@ def main(argv=None) -> None:
     parser.add_argument("--records", type=int, default=10)
     parser.add_argument("--calibration", type=int, default=0)
     parser.add_argument("--channels", type=int, default=8)
+    parser.add_argument("--method", choices=("ssi", "plscf"), default="ssi",
+                        help="the estimator whose errors --calibration checks")
     parser.add_argument("--tones", type=int, default=0)
     parser.add_argument("--speed", action="store_true")
     args = parser.parse_args(argv)
@@ -252,7 +256,7 @@ def main(argv=None) -> None:
         print(compare(args.records))
     if args.calibration:
         print()
-        print(calibration(args.calibration, args.channels))
+        print(calibration(args.calibration, args.channels, args.method))
     if args.tones:
         print()
         print(tone_calls(args.tones))

@@ -75,14 +75,21 @@ def _record(data, sample_rate_hz):
             raise ParameterError(f"{data.source}: channel(s) {forces} measured force; expected responses only "
                                  "(with a force channel, estimate FRFs: python -m modal fit)")
         quantity = quantities.pop() if len(quantities) == 1 else None
-        return np.asarray(data.signals, float), data.sample_rate_hz, quantity, tuple(data.names), data.source
+        return _real_samples(data.signals), data.sample_rate_hz, quantity, tuple(data.names), data.source
     arr = np.asarray(data)
     if arr.dtype.kind not in "biuf":
         raise ParameterError(f"<array>: 'data' has dtype {arr.dtype}; expected real numbers (n_channels, n_samples)")
     if sample_rate_hz is None:
         raise ParameterError("<array>: 'sample_rate_hz' is missing; expected the sampling rate in Hz for an array")
     names = tuple(str(k) for k in range(arr.shape[0])) if arr.ndim == 2 else ()
-    return np.asarray(arr, float), float(sample_rate_hz), None, names, "<array>"
+    return _real_samples(arr), float(sample_rate_hz), None, names, "<array>"
+
+
+def _real_samples(signals) -> np.ndarray:
+    """The samples as stored when they are single or double precision (a record of 64 channels × 10⁶ samples in
+    single precision is 256 MB, and a double copy 512 MB more), else in double precision."""
+    arr = np.asarray(signals)
+    return arr if arr.dtype in (np.float32, np.float64) else arr.astype(float)
 
 
 def check_band(band_hz, nyquist_hz: float, src: str) -> tuple[float, float]:
@@ -115,7 +122,7 @@ def check_channels(signals: np.ndarray, src: str, names=(), dtype=float) -> tupl
     centred = np.empty(signals.shape, dtype)
     rms = np.empty(signals.shape[0])
     for ch, row in enumerate(signals):  # channel by channel: no temporary as large as the record
-        mean = row.mean()
+        mean = row.mean(dtype=np.float64)  # each channel's arithmetic in double, whatever it is stored in
         if not np.isfinite(mean):  # a NaN or infinite sample (or finite ones whose sum overflows)
             bad = ~np.isfinite(signals)
             if bad.any():

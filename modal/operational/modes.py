@@ -4,7 +4,8 @@ Each chain's poles are followed through the record's blocks to first order
 (:class:`modal.operational.ssi.Perturbation`); the chain reports the pole of the order where
 its frequency is best determined (the smallest standard error): over-fitted orders inflate the
 first-order errors of the poles beside their spurious neighbours, and the errors there are larger
-too. Two chains whose representatives agree within their errors in frequency, with one shape, are
+too (an estimator whose under-fitted low orders hold biased poles of small error looks only in the upper
+half of the chain's orders, ``representative="upper_half"``). Two chains whose representatives agree within their errors in frequency, with one shape, are
 one mode: the weaker is dropped.
 """
 from __future__ import annotations
@@ -16,7 +17,7 @@ from .correlations import MAX_BLOCKS
 from .pole import PoleEstimate
 from .selection import Cluster, shape_mac
 
-__all__ = ["pole_errors", "estimates_from_clusters", "error_blocks", "resolved"]
+__all__ = ["pole_errors", "estimates_from_clusters", "error_blocks", "upper_half", "resolved"]
 
 #: the blocks of the record used for the error bars last at least this many decay times 1/(ζω) of the
 #: slowest-decaying mode (their correlation estimates are then nearly independent)...
@@ -70,7 +71,8 @@ def _physical_shape(unit_shape: np.ndarray, d_unit: np.ndarray | None, scale: np
 
 
 def estimates_from_clusters(flat, clusters: list[Cluster], perturb, n_orders_swept: int,
-                            scale: np.ndarray) -> tuple[list[PoleEstimate], list[int], list[Cluster]]:
+                            scale: np.ndarray, representative: str = "consensus"
+                            ) -> tuple[list[PoleEstimate], list[int], list[Cluster]]:
     """One estimate per cluster, from its member with the smallest frequency error among a few probed orders
     that agrees with the cluster's medians (:data:`CONSENSUS_SIGMAS`), with the representative
     member's index (into ``flat``) and its cluster. Duplicates within their errors are dropped.
@@ -87,11 +89,21 @@ def estimates_from_clusters(flat, clusters: list[Cluster], perturb, n_orders_swe
     n_orders_swept : int
     scale : ndarray
         Each channel's RMS (the shapes were found on unit-RMS channels).
+    representative : {"consensus", "upper_half"}
+        Where the reporting member is looked for. ``"consensus"``: the probed orders, among the members
+        that agree with the cluster's medians. ``"upper_half"``: every order of the upper half of the
+        cluster's own orders (:func:`upper_half`), for an estimator whose under-fitted low orders hold biased
+        poles of small error (ranked by their errors, they would be chosen).
     """
     # the errors are computed at a few orders spread over the sweep (one perturbation per order serves every
-    # cluster), and at each cluster's top order when it has no pole at those
-    swept = np.unique(flat.order)
-    probe = set(swept[np.unique(np.linspace(0, swept.size - 1, PROBE_ORDERS).round().astype(int))].tolist())
+    # cluster), and at each cluster's top order when it has no pole at those; or at every order of the
+    # clusters' upper halves
+    upper = [upper_half(flat, c) for c in clusters] if representative == "upper_half" else None
+    if upper is not None:
+        probe = {int(o) for members in upper for o in flat.order[members]}
+    else:
+        swept = np.unique(flat.order)
+        probe = set(swept[np.unique(np.linspace(0, swept.size - 1, PROBE_ORDERS).round().astype(int))].tolist())
     for cluster in clusters:
         own = set(flat.order[cluster.members].tolist())
         if not own & probe:
@@ -112,7 +124,7 @@ def estimates_from_clusters(flat, clusters: list[Cluster], perturb, n_orders_swe
             d_shape = None if dev["shape"] is None else dev["shape"][:, :, j]
             errors[int(member)] = (sf[j], sz[j], d_shape, unit, dev["pole"][:, j])
     candidates = []
-    for cluster in clusters:
+    for k, cluster in enumerate(clusters):
         members = cluster.members
         f_mid = float(np.median(flat.frequency_hz[members]))
         z_mid = float(np.median(flat.damping_ratio[members]))
@@ -123,7 +135,10 @@ def estimates_from_clusters(flat, clusters: list[Cluster], perturb, n_orders_swe
             return (abs(flat.frequency_hz[m] - f_mid) <= CONSENSUS_SIGMAS * sf
                     and abs(flat.damping_ratio[m] - z_mid) <= CONSENSUS_SIGMAS * sz)
 
-        eligible = [m for m in probed if np.isfinite(errors[m][0]) and agrees(m)]
+        if upper is not None:
+            eligible = [int(m) for m in upper[k] if np.isfinite(errors[int(m)][0])]
+        else:
+            eligible = [m for m in probed if np.isfinite(errors[m][0]) and agrees(m)]
         if eligible:
             member = min(eligible, key=lambda m: errors[m][0])
         else:
@@ -148,6 +163,13 @@ def estimates_from_clusters(flat, clusters: list[Cluster], perturb, n_orders_swe
             kept.append((estimate, member, cluster))
     kept.sort(key=lambda c: abs(c[0].pole))
     return [k[0] for k in kept], [k[1] for k in kept], [k[2] for k in kept]
+
+
+def upper_half(flat, cluster: Cluster) -> np.ndarray:
+    """The cluster's members (indices into ``flat``) at or above the middle of its orders."""
+    members = cluster.members
+    orders = np.unique(flat.order[members])
+    return members[flat.order[members] >= orders[orders.size // 2]]
 
 
 def resolved(estimate: PoleEstimate, duration_s: float) -> bool:

@@ -156,12 +156,26 @@ class Perturbation:
         # the deviations are formed in double precision and carried through these products in single: their
         # rounding (1e-7 of the deviations) lies far below the deviations' own scatter, which is what they measure
         U, V = model.U.astype(np.float32), model.V.astype(np.float32)
-        dH = (hankel(block_R, model.block_rows, model.block_cols) - model.hankel[None]).astype(np.float32)
+        # ΔH is the Hankel matrix of the correlations' deviations (it is linear in them), built in single
+        # precision from deviations formed in double
+        d_R = (block_R - np.tensordot(w, block_R, axes=1)[None]).astype(np.float32)
+        dH = hankel(d_R, model.block_rows, model.block_cols)
         G = dH @ V[:, :top]  # (blocks, p, top): ΔH V₁ for every order up to top
         B_right = np.swapaxes(U.T @ G, 1, 2)  # (blocks, top, k): (Uᵀ ΔH V₁)ᵀ
         self.B_right = B_right.astype(float)
-        self.E = (G - U @ np.swapaxes(B_right, 1, 2)).astype(float)  # the part of ΔH V₁ outside the range of H
+        E = G - U @ np.swapaxes(B_right, 1, 2)  # the part of ΔH V₁ outside the range of H
         self.B_left = ((np.swapaxes(U[:, :top], 0, 1) @ dH) @ V).astype(float)  # (blocks, top, k): U₁ᵀ ΔH V
+        # E enters every order only through its first l rows and these projections, whose leading n × n
+        # blocks are those of order n: formed once for all orders
+        l, rows = model.n_outputs, model.n_outputs * model.block_rows
+        Q = model.Q[:, :top].astype(np.float32)
+        E_up, E_down = E[:, :rows], E[:, l:]
+        self.E_C = E[:, :l].astype(float)  # (blocks, l, top)
+        self.QtE_down = (Q.T @ E_down).astype(float)  # (blocks, top, top): Qᵀ E_down
+        self.QtE_up = (Q.T @ E_up).astype(float)
+        E_up_t = np.swapaxes(E_up, 1, 2)
+        self.EtU_down = (E_up_t @ U[l:, :top]).astype(float)  # E_upᵀ U_down
+        self.EtU_up = (E_up_t @ U[:rows, :top]).astype(float)  # E_upᵀ U_up
 
     def at(self, order: int, indices) -> dict[str, np.ndarray]:
         """Deviations of the poles ``indices`` of :func:`poles_at` (``order``).
@@ -191,17 +205,18 @@ class Perturbation:
         # part inside only rotates the basis, which leaves the eigenvalues and the observed shapes as they
         # are). ΔU₁ enters only projected: Qᵀ ΔO_down, Qᵀ ΔO_up, ΔO_upᵀ (O_down − O_up A) and its first l
         # rows (ΔC), so U₂ is projected once per order rather than ΔU₁ formed per block
-        outside = self.E[:, :, :n] / s1[None, None, :]
+        # (outside = E₁/σ₁, its products taken from the projections formed once for all orders)
         A, mu, psi = _system(model, order)
         Rn, Qn = model.R[:n, :n], model.Q[:, :n]
         rows = l * model.block_rows
         U1, U2 = U[:, :n], U[:, n:]
         resid = U1[l:] - U1[:rows] @ A
-        q_down = Qn.T @ U2[l:] @ inside + Qn.T @ outside[:, l:]  # (blocks, n, n): Qᵀ ΔO_down
-        q_up = Qn.T @ U2[:rows] @ inside + Qn.T @ outside[:, :rows]  # Qᵀ ΔO_up
+        per_column = s1[None, None, :]
+        q_down = Qn.T @ U2[l:] @ inside + self.QtE_down[:, :n, :n] / per_column  # (blocks, n, n): Qᵀ ΔO_down
+        q_up = Qn.T @ U2[:rows] @ inside + self.QtE_up[:, :n, :n] / per_column  # Qᵀ ΔO_up
         up_resid = np.swapaxes(inside, 1, 2) @ (U2[:rows].T @ resid) \
-            + np.swapaxes(outside[:, :rows], 1, 2) @ resid  # ΔO_upᵀ (O_down − O_up A)
-        d_C = U2[:l] @ inside + outside[:, :l]  # (blocks, l, n)
+            + (self.EtU_down[:, :n, :n] - self.EtU_up[:, :n, :n] @ A) / s1[None, :, None]  # ΔO_upᵀ (O_down − O_up A)
+        d_C = U2[:l] @ inside + self.E_C[:, :, :n] / per_column  # (blocks, l, n)
         # ΔA = R⁻¹ [Qᵀ (ΔO_down − ΔO_up A) + R⁻ᵀ ΔO_upᵀ (O_down − O_up A)], R upper triangular: two
         # triangular solves for all blocks at once
         from scipy.linalg import solve_triangular
