@@ -3,29 +3,13 @@ the result says so (flag work_capped, a warning naming the cap and how to lift i
 files never reach them and give the results they gave without them."""
 from __future__ import annotations
 
-import warnings
 
 import numpy as np
 import pytest
 
 import modal
 from modal.global_.identify import MAX_DEFAULT_ORDER
-from support.manymodes import many_modes_frf
-
-
-def six_modes():
-    """Six modes in 10-500 Hz on 1500 lines, 1 % noise: an ordinary global fit (a few model evaluations)."""
-    f = np.linspace(10.0, 500.0, 1500)
-    frf = modal.modal_frf(f, [60, 120, 200, 260, 330, 420], [0.02, 0.01, 0.015, 0.01, 0.02, 0.01],
-                          [1, 0.5, 2, 1, 0.7, 1.2], kind="mobility", response_points=["1"], reference_points=["1"])
-    return modal.add_noise(frf, 0.01, seed=1)
-
-
-def fit(frf, **kwargs):
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        result = modal.identify(frf, "global", **kwargs)
-    return result, [str(w.message) for w in caught]
+from support.manymodes import fit_global, many_modes_frf, six_modes
 
 
 def same(a, b) -> bool:
@@ -40,8 +24,8 @@ def same(a, b) -> bool:
 
 def test_an_ordinary_fit_stays_far_inside_its_budget_and_is_unchanged_by_it():
     frf = six_modes()
-    result, messages = fit(frf)
-    uncapped, _ = fit(frf, max_evaluations=10**9)  # the work identify did before it had a budget
+    result, messages = fit_global(frf)
+    uncapped, _ = fit_global(frf, max_evaluations=10**9)  # the work identify did before it had a budget
     assert same(result, uncapped)
     assert not any("work_capped" in m.flags for m in result.modes) and not messages
     # the default, scaled to the size of one evaluation, leaves a margin of ten at least
@@ -51,8 +35,8 @@ def test_an_ordinary_fit_stays_far_inside_its_budget_and_is_unchanged_by_it():
 
 def test_a_refinement_stopped_by_its_budget_is_flagged_and_says_how_to_lift_it():
     frf = six_modes()
-    free, _ = fit(frf)
-    result, messages = fit(frf, max_evaluations=3)
+    free, _ = fit_global(frf)
+    result, messages = fit_global(frf, max_evaluations=3)
     assert result.settings["max_evaluations"] == 3
     # each fit's start counts one; the final fit (for the errors) starts even when the budget is spent: one over
     assert result.settings["evaluations"] <= 3 + 1
@@ -62,18 +46,18 @@ def test_a_refinement_stopped_by_its_budget_is_flagged_and_says_how_to_lift_it()
     assert len(budget_lines) == 1 and "max_evaluations=N" in budget_lines[0] and "--max-evaluations N" in budget_lines[0]
     assert any("is flagged (work_capped:" in m for m in messages)  # and each mode's own warning
     # lifted to what the free fit used, the same fit as without a cap
-    lifted, _ = fit(frf, max_evaluations=free.settings["evaluations"])
+    lifted, _ = fit_global(frf, max_evaluations=free.settings["evaluations"])
     assert same(lifted, free)
 
 
 def test_a_sweep_cut_at_the_default_order_ceiling_says_so():
     # 18 peaks call for order 6 x 18 + 20 = 128 with one reference; the default sweep stops at 120
     frf = many_modes_frf(18, 1000)
-    result, messages = fit(frf)
+    result, messages = fit_global(frf)
     assert result.settings["orders"][1] == MAX_DEFAULT_ORDER and result.settings["order_wanted"] == 128
     assert any(f"stopped at model order {MAX_DEFAULT_ORDER}" in m and "max_order=128" in m for m in messages)
     # an explicit max_order is the user's: no word (a low one, to keep the test short)
-    _, quiet = fit(frf, max_order=40)
+    _, quiet = fit_global(frf, max_order=40)
     assert not any("stopped at model order" in m for m in quiet)
 
 

@@ -2,7 +2,6 @@
 to its budget, too high orders lowered, and the refinement's modes bounded; where one binds the result says so."""
 from __future__ import annotations
 
-import warnings
 
 import numpy as np
 import pytest
@@ -12,21 +11,7 @@ from modal.global_ import sweep
 from modal.global_.identify import MAX_DEFAULT_ORDER
 from modal.global_.stabilisation import SelectedPole
 from modal.work_budget import MIN_EVALUATIONS, REFINEMENT_WORK, evaluation_size
-
-
-def six_modes():
-    """Six modes in 10-500 Hz on 1500 lines, 1 % noise: an ordinary global fit."""
-    f = np.linspace(10.0, 500.0, 1500)
-    frf = modal.modal_frf(f, [60, 120, 200, 260, 330, 420], [0.02, 0.01, 0.015, 0.01, 0.02, 0.01],
-                          [1, 0.5, 2, 1, 0.7, 1.2], kind="mobility", response_points=["1"], reference_points=["1"])
-    return modal.add_noise(frf, 0.01, seed=1)
-
-
-def fit(frf, **kwargs):
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        result = modal.identify(frf, "global", **kwargs)
-    return result, [str(w.message) for w in caught]
+from support.manymodes import fit_global, six_modes
 
 
 @pytest.mark.parametrize("top, lines, outputs, references", [
@@ -87,7 +72,7 @@ def test_the_refinement_takes_at_most_the_modes_its_budget_allows_the_most_stabl
 
 
 def test_an_ordinary_global_fit_reports_its_sweep_unthinned():
-    result, messages = fit(six_modes())
+    result, messages = fit_global(six_modes())
     # (the sweep proposes more poles than modes: the significance test drops those that only fit noise)
     assert result.settings["sweep_lines"] == 1500 and result.settings["modes_proposed"] >= len(result.modes)
     assert not any("work_capped" in m.flags for m in result.modes) and not messages
@@ -95,10 +80,10 @@ def test_an_ordinary_global_fit_reports_its_sweep_unthinned():
 
 def test_a_thinned_sweep_still_finds_the_modes_and_says_it_was_capped(monkeypatch):
     frf = six_modes()
-    free, _ = fit(frf)
+    free, _ = fit_global(frf)
     # a budget that holds a third of this file's lines: the sweep thins them, the refinement fits every line
     monkeypatch.setattr(sweep, "SWEEP_BASIS", (2 * free.settings["orders"][1] + 1) * 500)
-    result, messages = fit(frf)
+    result, messages = fit_global(frf)
     # (a block's first and strongest line, at least one per block: at least half of those allowed)
     assert (500 - 3) / 2 <= result.settings["sweep_lines"] <= 500
     assert result.settings["orders"] == free.settings["orders"]
@@ -115,10 +100,10 @@ def test_a_thinned_sweep_still_finds_the_modes_and_says_it_was_capped(monkeypatc
 
 def test_a_refinement_given_fewer_modes_than_proposed_flags_them(monkeypatch):
     frf = six_modes()
-    proposed = fit(frf)[0].settings["modes_proposed"]
+    proposed = fit_global(frf)[0].settings["modes_proposed"]
     # a refinement budget whose fewest evaluations hold three modes on these lines
     monkeypatch.setattr(sweep, "REFINEMENT_WORK", evaluation_size(1500, 3, 1) * MIN_EVALUATIONS)
-    result, messages = fit(frf)
+    result, messages = fit_global(frf)
     assert result.settings["modes_proposed"] == proposed > 3 and all("work_capped" in m.flags for m in result.modes)
     assert 1 <= len(result.modes) <= 3 + 3 * 4  # and the missing-mode rounds' additions (3 rounds of at most 4)
     assert sum(f"the refinement took the 3 most stable of the {proposed} modes the sweep proposed" in m
