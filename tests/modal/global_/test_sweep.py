@@ -6,7 +6,6 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import modal
 from modal.global_ import sweep
 from modal.global_.identify import MAX_DEFAULT_ORDER
 from modal.global_.stabilisation import SelectedPole
