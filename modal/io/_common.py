@@ -15,6 +15,7 @@ import numpy as np
 
 from ..errors import FormatError
 from ..frf import FRF, FRF_KINDS
+from ..frf_units import frf_in_si
 from ..units import TWO_PI
 
 __all__ = [
@@ -170,8 +171,6 @@ def build_frf(frequency_hz: np.ndarray, response: np.ndarray, kind: str, src: st
         resp = resp[0]
     n_ch = 1 if resp.ndim == 1 else resp.shape[0]
     rsp_hint, ref_hint = hint_points(hints, n_ch, src)
-    from ..frf_units import frf_in_si
-
     units = hints.get("units") or units
     return frf_in_si(FRF(  # a unit the toolkit knows (g/N, mm/s/N, in/lbf) becomes the kind's SI unit
         frequency_hz, resp, kind=kind,

@@ -150,7 +150,7 @@ def _read_text(text: str, src: str, hints: dict[str, Any]) -> FRF:
     content = [(n, ln) for n, ln in content if ln]
     if not content:
         raise FormatError(f"{src}: line 1: no content (only blank lines); expected rows of numbers")
-    delim = _delimiter(hints, content, decimal, src)
+    delim = choose_delimiter(hints, content, decimal, src)
     for n, ln in content:
         if ln.startswith("#"):
             if not data and ":" in ln:
@@ -237,7 +237,9 @@ def _points(meta: dict[str, tuple[int, str]], key: str, src: str):
     return tuple(str(v) for v in ids)
 
 
-def _delimiter(hints: dict[str, Any], content: list[tuple[int, str]], decimal: str, src: str) -> str | None:
+def choose_delimiter(hints: dict[str, Any], content: list[tuple[int, str]], decimal: str, src: str) -> str | None:
+    """The delimiter a hint names, else the first of tab, ';', ',' found on each of the first five lines
+    (',' not with a decimal comma); None: whitespace."""
     hint = hints.get("delimiter")
     if hint is not None:
         if hint not in _DELIMITERS:

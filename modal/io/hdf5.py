@@ -27,6 +27,7 @@ import numpy as np
 
 from ..errors import FormatError, ModalError
 from ..frf import FRF
+from ..frf_units import frf_in_si
 from ._atomic import atomic_path
 from ._common import build_frf, check_file, normalise_kind, resolve_kind, source_name
 
@@ -280,8 +281,6 @@ def write_frf_hdf5(frf: FRF, path: str | os.PathLike, name: str = "0") -> None:
     """
     h5py = _h5py()
     src = source_name(path)
-
-    from ..frf_units import frf_in_si
 
     def verify(tmp) -> None:
         with h5py.File(tmp, "r") as fh:

@@ -38,6 +38,7 @@ import numpy as np
 
 from ..errors import FormatError, QualityWarning, warn
 from ._common import check_file, source_name
+from .csv import choose_delimiter
 from .mat import _MAX_ELEMENTS_PER_BYTE
 
 __all__ = ["TimeRecord", "read_time", "QUANTITY_FROM_DATA_TYPE"]
@@ -382,19 +383,6 @@ def _csv_full_scale(comments: list[tuple[int, str]], n_channels: int, src: str) 
     return None
 
 
-def _delimiter(lines: list[str]) -> str | None:
-    """The delimiter of a time CSV: the first of ``,`` ``;`` tab found the same number of times on every one
-    of ``lines`` (the header and the first rows), else None (whitespace)."""
-    for candidate in (",", ";", "\t"):
-        counts = {line.count(candidate) for line in lines}
-        if len(counts) == 1 and counts != {0}:
-            return candidate
-    for candidate in (";", "\t", ","):  # quoted fields may hold the delimiter: the one most lines have
-        if all(candidate in line for line in lines):
-            return candidate
-    return None
-
-
 def _read_csv(path, src: str) -> TimeRecord:
     with open(path, newline="", encoding="utf-8-sig") as fh:
         text = fh.read()
@@ -404,7 +392,7 @@ def _read_csv(path, src: str) -> TimeRecord:
     if any("modalbal-frf-csv" in ln for _, ln in comments[:1]):
         raise FormatError(f"{src}: line 1: an FRF file (modalbal-frf-csv), not a time record; {_TIME_CSV} "
                           "(fit FRF files with 'modal fit')")
-    delimiter = _delimiter([ln for _, ln in body[:50]])
+    delimiter = choose_delimiter({}, body, ".", src)  # as the FRF CSV reader chooses it
     if delimiter is None:  # whitespace
         rows = [(k, ln.split()) for k, ln in body]
     else:

@@ -26,7 +26,7 @@ def _record(**kwargs):
     return impact_record(PLANT, [0.5, 2.5], 4.0, force_noise=0.01, response_noise=0.01, seed=1, **kwargs).record
 
 
-def _fails(path, *fragments) -> str:
+def assert_refused(path, *fragments) -> str:
     """read_time refuses ``path``: one line naming the file, each fragment, and what was expected; no warning."""
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # a NumPy RuntimeWarning on the way is a failure too
@@ -100,7 +100,7 @@ def test_uff_cut_short_names_the_dataset_and_says_it_ends_early(tmp_path):
     data = REAL_58B.read_bytes()
     path = tmp_path / "cut.uff"
     path.write_bytes(data[:int(0.8 * len(data))])  # within the 4th of 4 datasets
-    _fails(path, "dataset 4 has no closing '    -1' line", "ends early")
+    assert_refused(path, "dataset 4 has no closing '    -1' line", "ends early")
 
 
 def test_uff_dataset_with_fewer_samples_than_it_says(tmp_path):
@@ -110,7 +110,7 @@ def test_uff_dataset_with_fewer_samples_than_it_says(tmp_path):
     last_open = max(k for k, ln in enumerate(text) if ln == "    -1" and k < len(text) - 1)
     # drop 20 data lines (80 samples) of the last dataset, keeping its closing line
     path.write_text("\n".join(text[:last_open + 20] + text[last_open + 40:]) + "\n")
-    _fails(path, "dataset 3", "num_pts", "2048 samples", "ends early")
+    assert_refused(path, "dataset 3", "num_pts", "2048 samples", "ends early")
 
 
 @pytest.mark.parametrize("binary", [True, False])
@@ -129,7 +129,7 @@ def test_uff_explicit_uneven_abscissa_is_refused(tmp_path):
     x[100:] += 0.3 / FS
     path = tmp_path / "uneven.uff"
     _uff(path, _three_channels(), spacing=0, x=x)
-    _fails(path, "dataset 1", "abscissa_spacing 0", "from sample 100 to 101", "one rate")
+    assert_refused(path, "dataset 1", "abscissa_spacing 0", "from sample 100 to 101", "one rate")
 
 
 def test_uff_zero_time_step_is_refused(tmp_path):
@@ -145,7 +145,7 @@ def test_uff_zero_time_step_is_refused(tmp_path):
         data[line + 43:line + 56] = b"  0.00000e+00"
         start = data.index(b"    -1", start + 10) + 6
     path.write_bytes(bytes(data))
-    _fails(path, "dataset 1", "abscissa_inc", "time step 0.0 s", "positive step")
+    assert_refused(path, "dataset 1", "abscissa_inc", "time step 0.0 s", "positive step")
 
 
 @pytest.mark.parametrize("token", ["inf", "-inf", "1.79769313486e+308"])
@@ -157,7 +157,7 @@ def test_ascii_uff_holding_infinity_is_refused_without_numpy_warnings(tmp_path, 
     data_line = lines[second + 12]  # the first data line of dataset 2: four E20.12 fields
     lines[second + 12] = data_line[:20] + f"{token:>20}" + data_line[40:]
     path.write_text("\n".join(lines) + "\n")
-    _fails(path, "dataset 2", "sample 2", "expected finite samples")
+    assert_refused(path, "dataset 2", "sample 2", "expected finite samples")
 
 
 def test_frf_uff_is_not_a_time_file(tmp_path):
@@ -166,7 +166,7 @@ def test_frf_uff_is_not_a_time_file(tmp_path):
 
     path = tmp_path / "frf.uff"
     write_frf(modal_frf(np.arange(1.0, 101.0), [40.0], [0.02], [1.0], kind="accelerance"), path)
-    _fails(path, "function type 4", "modal fit", "expected a time file")
+    assert_refused(path, "function type 4", "modal fit", "expected a time file")
 
 
 # ------------------------------------------------------------------ MAT, HDF5
@@ -177,7 +177,7 @@ def test_mat_channels_of_different_lengths(tmp_path):
     cell = np.empty(2, dtype=object)
     cell[0], cell[1] = np.ones(1000), np.ones(900)
     savemat(path, {"signals": cell, "sample_rate_hz": FS})
-    _fails(path, "field 'signals', channel 2: 900 samples", "channel 1 has 1000", "one length for every channel")
+    assert_refused(path, "field 'signals', channel 2: 900 samples", "channel 1 has 1000", "one length for every channel")
 
 
 def test_mat_cell_of_equal_channels_is_read(tmp_path):
@@ -204,7 +204,7 @@ def test_damaged_mat_size_is_refused_at_once(tmp_path):
     data[dims + 4:dims + 8] = (268435457).to_bytes(4, "little")
     path.write_bytes(bytes(data))
     start = time.perf_counter()
-    _fails(path, "variable 'names' claims shape (1, 268435457)", f"{len(data)}-byte file")
+    assert_refused(path, "variable 'names' claims shape (1, 268435457)", f"{len(data)}-byte file")
     # not a timing test: it ends long before a multi-gigabyte allocation could (seconds, on a loaded machine)
     assert time.perf_counter() - start < 10
 
@@ -214,7 +214,7 @@ def test_mat_unknown_quantity_name_is_refused(tmp_path):
 
     path = tmp_path / "q.mat"
     savemat(path, {"signals": np.ones((2, 16)), "fs": FS, "quantities": np.array(["force", "accel"], dtype=object)})
-    _fails(path, "field 'quantities', channel 2: 'accel'", "acceleration")
+    assert_refused(path, "field 'quantities', channel 2: 'accel'", "acceleration")
 
 
 def test_hdf5_dataset_larger_than_the_file_is_refused(tmp_path):
@@ -224,7 +224,7 @@ def test_hdf5_dataset_larger_than_the_file_is_refused(tmp_path):
     with h5py.File(path, "w") as fh:
         fh.create_dataset("signals", shape=(2, 10**9), dtype="f8", chunks=(1, 1024))  # claims 16 GB, stores nothing
         fh.create_dataset("sample_rate_hz", data=FS)
-    _fails(path, "dataset /signals claims shape (2, 1000000000)", "an undamaged file")
+    assert_refused(path, "dataset /signals claims shape (2, 1000000000)", "an undamaged file")
 
 
 # ------------------------------------------------------------------ CSV
@@ -233,14 +233,14 @@ def test_ragged_csv_names_the_line(tmp_path):
     rows = [f"{k / FS!r},{k}.0,{-k}.0" for k in range(40)]
     rows[17] = f"{17 / FS!r},17.0"
     path.write_text("time,force [N],a [m/s^2]\n" + "\n".join(rows) + "\n")
-    _fails(path, "line 19: 2 columns", "expected 3 like the header")
+    assert_refused(path, "line 19: 2 columns", "expected 3 like the header")
 
 
 def test_csv_cut_short_in_its_last_line_says_so(tmp_path):
     path = tmp_path / "cut.csv"
     rows = [f"{k / FS!r},{k}.0,{-k}.0" for k in range(40)]
     path.write_text("time,force [N],a [m/s^2]\n" + "\n".join(rows) + f"\n{40 / FS!r},40.0")
-    _fails(path, "line 42: 2 columns (the last line: is the file cut short?)", "expected 3 like the header")
+    assert_refused(path, "line 42: 2 columns (the last line: is the file cut short?)", "expected 3 like the header")
 
 
 def test_csv_text_in_a_sample_names_line_and_column(tmp_path):
@@ -248,7 +248,7 @@ def test_csv_text_in_a_sample_names_line_and_column(tmp_path):
     rows = [f"{k / FS!r},{k}.0,{-k}.0" for k in range(40)]
     rows[5] = f"{5 / FS!r},5.0,oops"
     path.write_text("time,force [N],a [m/s^2]\n" + "\n".join(rows) + "\n")
-    _fails(path, "line 7, column 'a [m/s^2]': 'oops' is not a number")
+    assert_refused(path, "line 7, column 'a [m/s^2]': 'oops' is not a number")
 
 
 def test_frf_csv_is_not_a_time_file(tmp_path):
@@ -257,10 +257,10 @@ def test_frf_csv_is_not_a_time_file(tmp_path):
 
     path = tmp_path / "frf.csv"
     write_frf(modal_frf(np.linspace(1, 100, 50), [40.0], [0.02], [1.0], kind="accelerance"), path)
-    _fails(path, "an FRF file", "expected a time file", "modal fit")
+    assert_refused(path, "an FRF file", "expected a time file", "modal fit")
     bare = tmp_path / "bare.csv"
     bare.write_text("frequency_hz,re,im\n1,0.5,0.1\n2,0.4,0.2\n3,0.3,0.3\n")
-    _fails(bare, "column 1 is 'frequency_hz'", "an FRF", "expected a time file")
+    assert_refused(bare, "column 1 is 'frequency_hz'", "an FRF", "expected a time file")
 
 
 
@@ -363,5 +363,5 @@ def test_a_unit_that_contradicts_the_data_type_is_refused(tmp_path):
     channels[0] = (channels[0][0], 13, "m/s^2")
     path = tmp_path / "contradiction.uff"
     _uff(path, channels)
-    _fails(path, "dataset 1", "record 9, field ordinate_axis_units_lab", "'m/s^2' is of acceleration",
+    assert_refused(path, "dataset 1", "record 9, field ordinate_axis_units_lab", "'m/s^2' is of acceleration",
            "measured force")
