@@ -8,6 +8,8 @@ compute the correction; predict what it leaves and check it against ISO 21940-11
   against rotation);
 * :mod:`~balancer.influence.coefficients`: :func:`influence_matrix`, :func:`correction`
   (least squares or min-max, weights, a bound per plane);
+* :mod:`~balancer.influence.checkrun`: :func:`check_run` (the check run after the correction
+  against the prediction, a mounting mistake named, the trim);
 * :mod:`~balancer.influence.split`: :func:`split_correction` onto holes or blades;
 * :mod:`~balancer.influence.iso`: :func:`permissible_unbalance_kg_m`, :func:`iso_check`;
 * :mod:`~balancer.influence.jeffcott`: :func:`jeffcott_influence` (model alpha from
@@ -17,6 +19,7 @@ SI inside: readings in m, m/s or m/s^2, unbalances in kg m (complex: angle in th
 """
 from __future__ import annotations
 
+from .checkrun import CheckRun, check_run
 from .coefficients import CONDITION_WARNING, CorrectionResult, correction, influence_matrix, predict_residual
 from .iso import BALANCE_GRADES_MM_S, IsoCheck, allocate_to_planes, iso_check, permissible_unbalance_kg_m
 from .jeffcott import jeffcott_influence, trial_mass_kg
@@ -27,6 +30,8 @@ __all__ = [
     "influence_matrix",
     "correction",
     "predict_residual",
+    "check_run",
+    "CheckRun",
     "CorrectionResult",
     "CONDITION_WARNING",
     "split_correction",

@@ -31,12 +31,16 @@ def add_parser(sub) -> argparse.ArgumentParser:
                    help="round the masses on the holes to multiples of MASS (in the readings file's mass units), "
                         "the smallest step of the weights at hand")
     p.add_argument("--max-correction", type=float, metavar="KG_M", help="largest correction per plane (kg m)")
+    p.add_argument("--reading-noise", type=float, metavar="FRACTION",
+                   help="relative repeatability of a reading (default 0.05: 5 %%), against which a check run "
+                        "([after]) is judged")
     p.add_argument("--json", action="store_true", help="print one JSON document on stdout")
     return p
 
 
 def report_document(report) -> dict:
     """The report as a JSON-ready dict (user units for readings and masses; SI where named)."""
+    from .job import check_run_summary
     from .readings import reading_unit, user_digits
 
     scale = 1e3 if report.mass_units == "g" else 1.0
@@ -56,6 +60,11 @@ def report_document(report) -> dict:
         "rms_initial": float((amp0**2).mean() ** 0.5), "rms_residual": float((amp1**2).mean() ** 0.5),
         "condition_number": report.condition_number, "flags": list(report.flags),
     }
+    if report.check is not None:
+        amp2, ph2 = report.in_user_units(report.check.measured)
+        for i, row in enumerate(doc["readings"]):
+            row["measured_amplitude"], row["measured_phase_deg"] = float(amp2[i]), float(ph2[i])
+        doc["check_run"] = check_run_summary(report)
     if report.positions_deg.size:
         doc["split"] = [[{"hole_deg": float(p), "mass": float(user_digits(m * scale))}
                          for p, m in zip(report.positions_deg, row) if m > 0] for row in report.split_mass_kg]
@@ -72,6 +81,8 @@ def report_document(report) -> dict:
 
 
 def _text(doc: dict) -> str:
+    from .job import check_run_lines
+
     unit, mu = doc["reading_units"], doc["mass_units"]
     lines = [f"method: {doc['method']}", "", "correction (add):"]
     for c in doc["correction"]:
@@ -79,13 +90,17 @@ def _text(doc: dict) -> str:
     for j, row in enumerate(doc.get("split", [])):
         lines.append(f"  plane {j + 1} on holes: " + ", ".join(f"{h['mass']:.4g} {mu} at {h['hole_deg']:g} deg" for h in row)
                      + (f" (to {doc['weight_resolution']:g} {mu})" if "weight_resolution" in doc else ""))
-    lines += ["", f"{'reading':<28} {'initial':>18} {'predicted after':>20}"]
+    measured = "check_run" in doc
+    lines += ["", f"{'reading':<28} {'initial':>18} {'predicted after':>20}" + (f" {'measured after':>20}" if measured else "")]
     for r in doc["readings"]:
         lines.append(f"{r['sensor']:<28} {r['initial_amplitude']:>9.4g} {unit} {r['initial_phase_deg']:>5.0f}° "
-                     f"{r['predicted_amplitude']:>10.3g} {unit} {r['predicted_phase_deg']:>5.0f}°")
+                     f"{r['predicted_amplitude']:>10.3g} {unit} {r['predicted_phase_deg']:>5.0f}°"
+                     + (f" {r['measured_amplitude']:>10.4g} {unit} {r['measured_phase_deg']:>5.0f}°" if measured else ""))
     lines += ["", f"worst {doc['worst_initial']:.4g} -> {doc['worst_residual']:.3g} {unit}; "
               f"RMS {doc['rms_initial']:.4g} -> {doc['rms_residual']:.3g} {unit}; condition number {doc['condition_number']:.3g}"
               + (f"; flags: {', '.join(doc['flags'])}" if doc["flags"] else "")]
+    if measured:
+        lines += [""] + check_run_lines(doc["check_run"], unit, mu)
     if "iso" in doc:
         iso = doc["iso"]
         lines.append(f"ISO 21940-11 G {iso['grade_mm_s']:g}: {iso['verdict']} (residual "
@@ -109,6 +124,7 @@ def run(args) -> int:
         grade = args.grade if args.grade is not None else iso.get("grade_mm_s")
         mass = args.rotor_mass if args.rotor_mass is not None else iso.get("rotor_mass_kg")
         speed = args.speed_rpm if args.speed_rpm is not None else iso.get("speed_rpm")
+        noise = args.reading_noise if args.reading_noise is not None else options.get("reading_noise")
         resolution = args.weight_resolution if args.weight_resolution is not None else options.get("weight_resolution")
         if resolution is not None and not (isinstance(resolution, (int, float)) and 0 < resolution < float("inf")):
             where = "--weight-resolution" if args.weight_resolution is not None else f"{args.readings}: weight_resolution"
@@ -121,7 +137,8 @@ def run(args) -> int:
                          positions_deg=None if args.holes is not None else options.get("positions_deg"),
                          grade_mm_s=grade, rotor_mass_kg=mass, speed_rpm=speed,
                          distances_m=tuple(iso["distances_m"]) if "distances_m" in iso else None,
-                         weight_resolution_kg=None if resolution is None else resolution * MASS_UNITS[job.mass_units])
+                         weight_resolution_kg=None if resolution is None else resolution * MASS_UNITS[job.mass_units],
+                         reading_noise=noise)
     except ModalError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 1

@@ -17,14 +17,16 @@ File format (``READINGS.toml``; the same keys form a scene's ``[balance]`` secti
     amplitude = [150.0, 95.0]
     phase_deg = [70.0, 215.0]
 
-    [after]                      # optional: a check run after the correction
+    [after]                      # optional: a check run after the correction (judged against the
+                                 # prediction: balancer.influence.checkrun)
 
 Instead of inline amplitudes, ``readings = "runs.csv"`` names a CSV file with the
 columns ``run,amplitude,phase_deg`` (``run`` = ``initial``, ``trial1`` ... ``trialN`` or
 ``after``; rows in reading order); ``[[trial]]`` then gives only ``mass`` and ``angle_deg``.
 Options: ``method``, ``weights``, ``max_unbalance_kg_m``, ``holes`` or ``positions_deg``,
 ``weight_resolution`` (in ``mass_units``: the masses on the holes rounded to multiples of it, the
-smallest step of the weights at hand) and ``[iso]`` (``grade_mm_s``, ``rotor_mass_kg``, ``speed_rpm``, ``distances_m``).
+smallest step of the weights at hand), ``reading_noise`` (the readings' relative repeatability a check
+run is judged with, default 0.05) and ``[iso]`` (``grade_mm_s``, ``rotor_mass_kg``, ``speed_rpm``, ``distances_m``).
 """
 from __future__ import annotations
 
@@ -37,15 +39,18 @@ import numpy as np
 
 from modal.errors import FormatError, ParameterError
 
+from .checkrun import DEFAULT_READING_NOISE, CheckRun, check_reading_noise, check_run
 from .coefficients import correction, influence_matrix
 from .iso import IsoCheck, iso_check
 from .readings import MASS_UNITS, amplitude_phase, reading_unit, unbalance_kg_m, vibration
 from .split import equally_spaced_deg, split_correction
 
-__all__ = ["BalanceJob", "BalanceReport", "parse_job", "load_job", "balance", "JOB_KEYS"]
+__all__ = ["BalanceJob", "BalanceReport", "parse_job", "load_job", "balance", "check_run_summary", "check_run_lines",
+           "JOB_KEYS"]
 
 JOB_KEYS = ("units", "mass_units", "radius_m", "sensors", "initial", "trial", "after", "readings",
-            "method", "weights", "max_unbalance_kg_m", "holes", "positions_deg", "weight_resolution", "iso")
+            "method", "weights", "max_unbalance_kg_m", "holes", "positions_deg", "weight_resolution", "iso",
+            "reading_noise")
 _ISO_KEYS = ("grade_mm_s", "rotor_mass_kg", "speed_rpm", "distances_m")
 _UNITS_PER_KG_M = {"m": "m/(kg m)", "m/s": "m/s/(kg m)", "m/s^2": "m/s^2/(kg m)"}
 
@@ -255,6 +260,8 @@ class BalanceReport:
     iso : IsoCheck or None
     weight_resolution_kg : float or None
         The step the masses on the holes were rounded to (None: not rounded).
+    check : CheckRun or None
+        The check run set against the prediction, with the trim correction (None: no check run).
     """
 
     method: str
@@ -284,6 +291,7 @@ class BalanceReport:
     residual_unbalance_kg_m: np.ndarray
     iso: IsoCheck | None
     weight_resolution_kg: float | None = None
+    check: CheckRun | None = None
 
     def archive_units(self) -> dict[str, str]:
         """Units of the numeric fields whose unit depends on the readings (for the archive)."""
@@ -301,7 +309,8 @@ class BalanceReport:
 def balance(job: BalanceJob, method: str = "least_squares", *, weights=None, max_unbalance_kg_m=None,
             holes: int | None = None, positions_deg=None, grade_mm_s: float | None = None,
             rotor_mass_kg: float | None = None, speed_rpm: float | None = None,
-            distances_m: tuple[float, float] | None = None, weight_resolution_kg: float | None = None) -> BalanceReport:
+            distances_m: tuple[float, float] | None = None, weight_resolution_kg: float | None = None,
+            reading_noise: float | None = None) -> BalanceReport:
     """Influence matrix, correction, split onto holes and ISO verdict of a job.
 
     Parameters
@@ -319,11 +328,16 @@ def balance(job: BalanceJob, method: str = "least_squares", *, weights=None, max
     weight_resolution_kg : float, optional
         Round the masses on the holes to multiples of this (kg): the smallest step of the weights at hand
         (a hole whose mass rounds to zero gets none). Default: not rounded.
+    reading_noise : float, optional
+        Relative repeatability of a reading (default 0.05), against which a check run (``job.after``) is judged
+        (:func:`~balancer.influence.checkrun.check_run`).
 
     Returns
     -------
     BalanceReport
     """
+    if reading_noise is not None:
+        check_reading_noise(reading_noise)
     alpha = influence_matrix(job.initial, job.trial_runs, job.trial_unbalance_kg_m)
     result = correction(alpha, job.initial, method=method, weights=weights, max_unbalance_kg_m=max_unbalance_kg_m)
     if holes is not None and positions_deg is not None:
@@ -339,6 +353,11 @@ def balance(job: BalanceJob, method: str = "least_squares", *, weights=None, max
         # multiples of the step, written as the step's own digits would be (0.1 g steps give 0.3 g, not 0.30000000000000004)
         split = np.array([float(f"{v:.12g}") for v in (np.round(split / step) * step).ravel()]).reshape(split.shape)
     left = job.after if job.after.size else result.residual
+    check = None
+    if job.after.size:
+        check = check_run(alpha, job.initial, job.trial_runs, job.trial_unbalance_kg_m, result.unbalance_kg_m,
+                          job.after, method=method, weights=weights, si_units=reading_unit(job.units).si_unit,
+                          reading_noise=DEFAULT_READING_NOISE if reading_noise is None else reading_noise)
     sensitivity = np.max(np.abs(alpha), axis=0)
     residual_unbalance = np.max(np.abs(left)) / sensitivity
     iso = None
@@ -357,7 +376,45 @@ def balance(job: BalanceJob, method: str = "least_squares", *, weights=None, max
         correction_angle_deg=np.mod(np.rad2deg(np.angle(u)), 360.0), radius_m=job.radius_m, residual=result.residual,
         after=job.after, worst_initial=result.worst_initial, rms_initial=result.rms_initial,
         worst_residual=result.worst_residual, rms_residual=result.rms_residual,
-        condition_number=result.condition_number, minmax_gap=result.minmax_gap, flags=result.flags,
+        condition_number=result.condition_number, minmax_gap=result.minmax_gap,
+        flags=result.flags + (check.flags if check is not None else ()),
         positions_deg=positions, split_mass_kg=split, residual_unbalance_kg_m=residual_unbalance, iso=iso,
-        weight_resolution_kg=None if weight_resolution_kg is None else float(weight_resolution_kg),
+        weight_resolution_kg=None if weight_resolution_kg is None else float(weight_resolution_kg), check=check,
     )
+
+
+def check_run_summary(report: BalanceReport) -> dict:
+    """A report's check run as a JSON-ready dict (user units for readings and masses; SI where named).
+
+    ``trim_worthwhile`` says whether the trim lowers the worst reading by more than the readings' noise
+    (``reading_noise`` times the worst measured reading).
+    """
+    check = report.check
+    scale = MASS_UNITS[report.mass_units]
+    measured, _ = report.in_user_units(check.measured)
+    doc = {"agrees": check.agrees, "discrepancy": check.discrepancy, "discrepancy_limit": check.discrepancy_limit,
+           "reading_noise": check.reading_noise, "cause": check.cause, "cause_plane": check.cause_plane,
+           "other_causes": list(check.other_causes),
+           "message": check.message, "worst_measured": float(measured.max()), "alpha_updated": check.alpha_updated,
+           "trim": [{"plane": j + 1, "mass": float(abs(u) / report.radius_m[j] / scale),
+                     "angle_deg": float(np.mod(np.rad2deg(np.angle(u)), 360.0)), "unbalance_kg_m": float(abs(u))}
+                    for j, u in enumerate(check.trim_kg_m)]}
+    if check.trim_residual.size:
+        left = float(report.in_user_units(check.trim_residual)[0].max())
+        doc["trim_worst_residual"] = left
+        doc["trim_worthwhile"] = bool(doc["worst_measured"] - left > check.reading_noise * doc["worst_measured"])
+    return doc
+
+
+def check_run_lines(check: dict, unit: str, mass_units: str) -> list[str]:
+    """A check run's summary (:func:`check_run_summary`) as text: the verdict, then the trim (if any)."""
+    lines = [f"check run: worst {check['worst_measured']:.4g} {unit} measured; {check['message']}"]
+    if check["trim"]:
+        masses = "; ".join(f"plane {t['plane']}: {t['mass']:.4g} {mass_units} at {t['angle_deg']:.1f} deg"
+                           for t in check["trim"])
+        if check["trim_worthwhile"]:
+            lines.append(f"trim (add): {masses} -> worst {check['trim_worst_residual']:.3g} {unit} predicted"
+                         + (" (alpha updated by the check run)" if check["alpha_updated"] else ""))
+        else:
+            lines.append(f"no trim needed: a trim ({masses}) would lower the worst reading by less than the readings' noise")
+    return lines

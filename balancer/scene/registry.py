@@ -294,7 +294,7 @@ REGISTRY: dict[str, Stage] = {stage.name: stage for stage in (
             "trial": [{"mass": POS, "angle_deg": NUM, "amplitude": list_of(NONNEG), "phase_deg": list_of(NUM)}],
             "after": {"amplitude": list_of(NONNEG), "phase_deg": list_of(NUM)},
             "method": choice("least_squares", "minmax"), "weights": list_of(POS), "max_unbalance_kg_m": POS,
-            "holes": INT, "positions_deg": list_of(NUM), "weight_resolution": POS,
+            "holes": INT, "positions_deg": list_of(NUM), "weight_resolution": POS, "reading_noise": POS,
             "iso": {"grade_mm_s": POS, "rotor_mass_kg": POS, "speed_rpm": POS, "distances_m": list_of(NONNEG, length=2)},
             "simulate": {"speeds_rad_s": list_of(POS), "trial_mass": POS, "trial_angle_deg": NUM, "noise": NONNEG,
                          "seed": INT, "rotor_mass_kg": POS, "stiffness_n_per_m": POS, "damping_n_s_per_m": NONNEG},

@@ -511,7 +511,8 @@ def stage_balance(scene: Scene, rotor: RotorStage | None = None, adb_response=No
                "grade_mm_s": iso.get("grade_mm_s"), "rotor_mass_kg": iso.get("rotor_mass_kg"),
                "speed_rpm": iso.get("speed_rpm"), "distances_m": tuple(iso["distances_m"]) if "distances_m" in iso else None,
                "weight_resolution_kg": (cfg["weight_resolution"] * MASS_UNITS[cfg.get("mass_units", "g")]
-                                        if "weight_resolution" in cfg else None)}
+                                        if "weight_resolution" in cfg else None),
+               "reading_noise": cfg.get("reading_noise")}
     method = cfg.get("method", "least_squares")
     sim = cfg.get("simulate")
     if sim is None:  # the readings as read when the scene was checked
