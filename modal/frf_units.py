@@ -84,9 +84,14 @@ def frf_in_si(frf: FRF) -> FRF:
 
 def withhold_physical(result, frf: FRF):
     """The result with k, c, m (and their errors) NaN and flag ``units_unknown`` on every mode with a driving
-    point, when the FRF's unit is neither SI nor convertible; the result itself otherwise."""
+    point, when the FRF's unit is neither SI nor convertible; the result itself otherwise.
+
+    The modal constants keep the file's unit then (times s² for accelerance, s for mobility, not 1/kg):
+    ``settings["modal_constant_units"]`` says so, for tables."""
     if si_units(frf) or parse_frf_unit(frf.units) is not None:
         return result
+    given = frf.units and "not given" not in frf.units
+    settings = {**result.settings, "modal_constant_units": f"{frf.units}-based" if given else "unknown"}
     modes = []
     for mode in result.modes:
         if not np.any(mode.driving_point):
@@ -99,4 +104,4 @@ def withhold_physical(result, frf: FRF):
     if any("units_unknown" in mode.flags for mode in modes):
         warn_caller(f"{frf.source}: the FRF's unit {frf.units!r} is not one the toolkit converts to SI: k, c, m are "
                     "not given (flag units_unknown)", QualityWarning)
-    return replace(result, modes=tuple(modes))
+    return replace(result, modes=tuple(modes), settings=settings)

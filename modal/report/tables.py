@@ -19,7 +19,8 @@ def _pm(value: float, std: float, fmt: str) -> str:
 def format_table(result: IdentificationResult, point_ids: list[str] | None = None) -> str:
     """A readable table of modes per channel (channels numbered from 1, as the command line names them).
 
-    Columns: frequency (Hz), damping (%), modal constant (1/kg), k (N/m),
+    Columns: frequency (Hz), damping (%), modal constant (1/kg, or the file's unit when it is not one the
+    toolkit converts: ``settings["modal_constant_units"]``), k (N/m),
     c (N s/m), m (kg), each with its standard error, and the flags. When no channel is known to be a
     driving point (flag ``driving_point_unknown``) a last line says why k, c, m are missing and how to
     declare the driving point.
@@ -28,7 +29,8 @@ def format_table(result: IdentificationResult, point_ids: list[str] | None = Non
 
     rows = result.rows()
     lines = [f"method: {result.method}   kind: {result.kind}   modes: {len(result)}   channels: {result.n_channels}"]
-    header = f"{'mode':>4}  {'f_n [Hz]':>22}  {'zeta [%]':>20}  {'A [1/kg]':>26}  {'k [N/m]':>20}  {'c [N s/m]':>20}  {'m [kg]':>20}  flags"
+    constant = f"A [{result.settings.get('modal_constant_units', '1/kg')}]"
+    header = f"{'mode':>4}  {'f_n [Hz]':>22}  {'zeta [%]':>20}  {constant:>26}  {'k [N/m]':>20}  {'c [N s/m]':>20}  {'m [kg]':>20}  flags"
     for ch in range(result.n_channels):
         label = f"channel {ch + 1}" + (f" ({point_ids[ch]})" if point_ids else "")
         lines += ["", label, header]

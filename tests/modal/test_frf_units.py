@@ -108,3 +108,18 @@ def test_uff_unit_labels_are_converted(tmp_path, numerator, denominator, factor)
     frf = read_frf(path)
     assert frf.units == "m/s^2/N"
     np.testing.assert_allclose(frf.response, si, rtol=1e-12)
+
+
+def test_the_table_does_not_call_constants_in_an_unknown_unit_1_per_kg():
+    # the modal constants of an FRF in V/V are in V/V (times s^2 for accelerance), not 1/kg: the table's header says so
+    si = modal_frf(FREQUENCY, [40.0], [0.02], [[1.0]], kind="accelerance", response_points=["1+Z"],
+                   reference_points=["1+Z"])
+    volts = modal.FRF(si.frequency_hz, si.response * 0.01, kind="accelerance", units="V/V",
+                      response_points=["1+Z"], reference_points=["1+Z"])
+    from modal.report.tables import format_table
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        table = format_table(modal.identify(volts, "nls"))
+        assert "A [1/kg]" in format_table(modal.identify(si, "nls"))
+    assert "A [V/V-based]" in table and "1/kg" not in table
