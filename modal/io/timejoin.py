@@ -46,8 +46,13 @@ def join_takes(records: Sequence[TimeRecord]) -> TimeRecord:
             mine, theirs = getattr(record, field), getattr(first, field)
             for k, (a, b) in enumerate(zip(mine, theirs)):
                 if a != b:
+                    roving = field == "names" and record.quantities == first.quantities and record.units == first.units
+                    hint = ("; files measured at different points (a roving hammer or sensor) are not takes: estimate "
+                            "each file's FRFs on its own (python -m modal frf FILE --out FILE.h5) and fit the FRF "
+                            "files together (python -m modal fit A.h5 B.h5, or a scene's [frf] file = [...])"
+                            if roving else "")
                     raise FormatError(f"{src}: channel {k + 1} ({field}) is {a!r} where {first.source} has {b!r}; "
-                                      "expected the same channels in every take of one test")
+                                      f"expected the same channels in every take of one test{hint}")
         if record.full_scale != first.full_scale:
             raise FormatError(f"{src}: full scale {record.full_scale!r} where {first.source} has "
                               f"{first.full_scale!r}; expected one recorder setting in every take")

@@ -45,3 +45,15 @@ def test_a_take_with_fewer_channels_is_refused():
                      units=second.units[:2])
     with pytest.raises(FormatError, match="b.csv: 2 channel\\(s\\) where a.csv has 3"):
         join_takes([_take(1, "a.csv"), second])
+
+
+def test_files_measured_at_different_points_are_pointed_to_the_frf_route():
+    # a roving hammer saves one file per excitation point: the force channel's point id changes, nothing else;
+    # averaging them as takes would mix two FRFs, so they are refused with the way to combine them as channels
+    second = replace(_take(2, "b.csv"), names=("hammer2", "a1", "a2"))
+    with pytest.raises(FormatError, match=r"roving hammer or sensor\) are not takes.*modal fit A.h5 B.h5"):
+        join_takes([_take(1, "a.csv"), second])
+    other_unit = replace(_take(2, "b.csv"), names=("hammer2", "a1", "a2"), units=("N", "m/s^2", "m/s"))
+    with pytest.raises(FormatError) as info:
+        join_takes([_take(1, "a.csv"), other_unit])
+    assert "roving" not in str(info.value)  # other units: not the same test moved, another record
