@@ -159,15 +159,49 @@ def _combine(frfs: list[FRF], paths: list, hints: dict[str, Any]) -> FRF:
                 f"from {source_name(paths[0])} ({first.n_freq} lines, {first.frequency_hz[0]}–"
                 f"{first.frequency_hz[-1]} Hz); expected one shared axis to combine the files"
             )
+        if (f.exponential_decay_s or 0.0) != (first.exponential_decay_s or 0.0):
+            def window(frf):
+                return (f"an exponential window of {frf.exponential_decay_s:g} s" if frf.exponential_decay_s
+                        else "no exponential window")
+            raise FormatError(f"{src}: estimated with {window(f)} where {source_name(paths[0])} has {window(first)}; "
+                              "expected one window for FRFs fitted together (its damping is taken out of every pole)")
     resp = np.concatenate([f.channels for f in frfs], axis=0)
 
     def joined(attr):
         ids = [getattr(f, attr) for f in frfs]
         return None if any(i is None for i in ids) else tuple(x for i in ids for x in i)
 
-    return build_frf(first.frequency_hz, resp, first.kind, " + ".join(source_name(p) for p in paths),
-                     response_points=joined("response_points"), reference_points=joined("reference_points"),
-                     units=first.units, hints=hints)
+    frf = build_frf(first.frequency_hz, resp, first.kind, " + ".join(source_name(p) for p in paths),
+                    response_points=joined("response_points"), reference_points=joined("reference_points"),
+                    units=first.units, hints=hints)
+    return _with_estimates(frf, frfs)
+
+
+def _with_estimates(frf: FRF, frfs: list[FRF]) -> FRF:
+    """The combined FRF with what the files' estimates knew of their errors: the exponential window (one for all,
+    checked by the caller), each line's noise (where every file has it) and the noise model (where every file has
+    one of the same lag window: the first file's line correlation for all, the fewest averages, no variance model,
+    which is fitted per channel)."""
+    from dataclasses import replace
+
+    from ..noise_model import NoiseModel
+
+    noise = [f.noise_std for f in frfs]
+    noise_std = None
+    if all(n is not None for n in noise):
+        noise_std = np.concatenate([np.atleast_2d(n) for n in noise], axis=0)  # each already in the SI unit
+    models = [f.noise_model for f in frfs]
+    model = None
+    if all(m is not None for m in models):
+        lag = [None if m.lag_window is None else m.lag_window.shape for m in models]
+        if len(set(lag)) == 1 and len({m.sample_interval_s for m in models}) == 1:
+            first = models[0]
+            correlation = first.line_correlation if all(m.line_correlation is not None for m in models) else None
+            model = NoiseModel(averages=min(m.averages for m in models),
+                               degrees_of_freedom=min(m.degrees_of_freedom for m in models),
+                               line_correlation=correlation, lag_window=first.lag_window,
+                               sample_interval_s=first.sample_interval_s)
+    return replace(frf, noise_std=noise_std, exponential_decay_s=frfs[0].exponential_decay_s, noise_model=model)
 
 
 def write_frf(frf: FRF, path: str | os.PathLike, format: str | None = None) -> None:
