@@ -40,7 +40,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import FormatError
+from ..errors import FormatError, QualityWarning, warn
 from ..frf import FRF
 from ._atomic import atomic_path
 from ._common import (
@@ -52,6 +52,8 @@ __all__ = ["read_frf_csv", "write_frf_csv", "LAYOUTS", "CANONICAL_FORMAT"]
 
 CANONICAL_FORMAT = "modalbal-frf-csv"
 CANONICAL_MAJOR = 1
+#: a phase column in degrees over at least this many lines that stays within ±π is taken for radians (warning)
+_PHASE_CHECK_LINES = 20
 LAYOUTS = ("re_im", "mag_deg", "mag_rad", "db_deg", "db_rad", "complex")
 _LAYOUT_ALIASES = {
     "re_im": "re_im", "real_imag": "re_im", "reim": "re_im",
@@ -278,7 +280,12 @@ def _layout(hints, names, is_complex, canonical, n_cols, src, first_line) -> str
         key = str(hint).strip().lower()
         if key not in _LAYOUT_ALIASES:
             raise FormatError(f"{src}: hint layout={hint!r}; expected one of {', '.join(LAYOUTS)}")
-        return _LAYOUT_ALIASES[key]
+        layout = _LAYOUT_ALIASES[key]
+        said = _layout_from_names(names[1].lower(), names[2].lower()) if names is not None and len(names) >= 3 else None
+        if said is not None and _contradicts(layout, said, names[2].lower()):
+            raise FormatError(f"{src}: layout={hint!r} but the header names the columns {names[1]!r}, {names[2]!r} "
+                              f"({said}); expected a layout that agrees with the header, or none")
+        return layout
     if is_complex:
         return "complex"
     if canonical:
@@ -292,6 +299,19 @@ def _layout(hints, names, is_complex, canonical, n_cols, src, first_line) -> str
         f"{src}: line {first_line}: {n_cols} real columns and {where}, so real/imaginary and "
         f"magnitude/phase cannot be told apart; expected layout= one of {', '.join(LAYOUTS)}"
     )
+
+
+def _contradicts(layout: str, said: str, second: str) -> bool:
+    """Whether a layout given contradicts what the header states outright: real/imaginary against
+    magnitude/phase, or a phase unit the header names (a magnitude column not marked dB proves nothing)."""
+    if (layout == "re_im") != (said == "re_im") or layout == "complex":
+        return True
+    if layout == "re_im":
+        return False
+    if said.startswith("db") and not layout.startswith("db"):
+        return True  # the header marks the magnitude in dB
+    stated = "rad" if re.search(r"rad", second) and "deg" not in second else "deg" if "deg" in second else None
+    return stated is not None and not layout.endswith(stated)
 
 
 def _layout_from_names(first: str, second: str) -> str | None:
@@ -402,7 +422,18 @@ def _to_frf_arrays(table, layout, n_cols, names, meta, hints, src):
         if layout == "re_im":
             resp = a + 1j * b
         else:
+            if not layout.startswith("db") and np.any(a < 0):
+                row, column = np.unravel_index(np.argmax(a < 0), a.shape)
+                name = (repr(names[1 + 2 * row]) if names is not None and len(names) > 1 + 2 * row
+                        else str(2 + 2 * row))
+                raise FormatError(f"{src}: column {name}: negative magnitude {a[row, column]:g} in data row "
+                                  f"{column + 1} (layout {layout}); expected magnitudes >= 0 (in dB? layout db_deg "
+                                  "or db_rad)")
             mag = 10.0 ** (a / 20.0) if layout.startswith("db") else a
+            if layout.endswith("deg") and b.shape[1] >= _PHASE_CHECK_LINES and 0.5 < np.max(np.abs(b)) <= np.pi + 1e-6:
+                warn(f"{src}: the phase column{'s' if b.shape[0] > 1 else ''} in degrees span only "
+                     f"{np.min(b):.3g} to {np.max(b):.3g} over {b.shape[1]} lines (a mode turns the phase by 180 "
+                     "degrees): radians? (layout mag_rad or db_rad)", QualityWarning)
             phase = np.deg2rad(b) if layout.endswith("deg") else b
             resp = mag * np.exp(1j * phase)
         freq_col = table[:, 0]

@@ -119,3 +119,46 @@ def test_trailing_delimiter_and_utf16(tmp_path):
     path = tmp_path / "u16.csv"
     path.write_bytes(text.encode("utf-16"))
     assert np.array_equal(read_frf(path, kind="mobility").response, H[0])
+
+
+def test_a_layout_that_contradicts_the_header_is_refused(tmp_path):
+    # the header states the phase in degrees and the magnitude in dB: a layout saying otherwise is a mistake
+    # (read as given it would turn every phase by 57x or take dB for magnitudes: a plausible, wrong fit)
+    mag, deg = np.abs(H[0]), np.rad2deg(np.angle(H[0]))
+    path = _write(tmp_path, "m.csv", _table([F, mag, deg], header=["f [Hz]", "Magnitude", "Phase (deg)"]))
+    for layout in ("mag_rad", "re_im", "db_deg"):
+        if layout == "db_deg":  # a magnitude column not marked dB may hold dB: not a contradiction
+            assert np.allclose(np.abs(read_frf(path, layout=layout, kind="receptance").response), 10 ** (mag / 20))
+            continue
+        with pytest.raises(FormatError, match=rf"layout='{layout}' but the header names the columns 'Magnitude', "
+                                              r"'Phase \(deg\)' \(mag_deg\)"):
+            read_frf(path, layout=layout, kind="receptance")
+    db = _write(tmp_path, "d.csv", _table([F, 20 * np.log10(mag), deg], header=["f", "Magnitude (dB)", "Phase (deg)"]))
+    with pytest.raises(FormatError, match=r"header names the columns 'Magnitude \(dB\)'"):
+        read_frf(db, layout="mag_deg", kind="receptance")
+
+
+def test_negative_magnitudes_are_refused_as_probably_db(tmp_path):
+    path = _write(tmp_path, "d.csv", _table([F, 20 * np.log10(np.abs(H[0]) / 10), np.rad2deg(np.angle(H[0]))]))
+    with pytest.raises(FormatError, match=r"d.csv: column 2: negative magnitude .* in data row 1 \(layout mag_deg\); "
+                                          r"expected magnitudes >= 0 \(in dB\?"):
+        read_frf(path, layout="mag_deg", kind="receptance")
+
+
+def test_a_degree_phase_within_pi_warns_of_radians(tmp_path):
+    # an FRF's phase turns by 180 degrees at every mode: a column "in degrees" that stays within ±3.14 over 20 lines
+    # or more holds radians
+    from modal.errors import QualityWarning
+    from modal.synthetic import modal_frf
+
+    f = np.linspace(1.0, 200.0, 40)
+    h = modal_frf(f, [80.0], [0.02], [1.0], kind="accelerance").response
+    path = _write(tmp_path, "r.csv", _table([f, np.abs(h), np.angle(h)]))
+    with pytest.warns(QualityWarning, match=r"r.csv: the phase column in degrees span only .* radians\?"):
+        read_frf(path, layout="mag_deg", kind="accelerance")
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", QualityWarning)  # the same phase in degrees: no warning
+        read_frf(_write(tmp_path, "d.csv", _table([f, np.abs(h), np.rad2deg(np.angle(h))])), layout="mag_deg",
+                 kind="accelerance")
