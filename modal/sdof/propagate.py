@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..model import mode_basis
+from ..model import mode_basis, mode_basis_derivatives
 
 __all__ = ["magnitude_to_complex", "combine_poles", "constant_covariance"]
 
@@ -155,20 +155,20 @@ def constant_covariance(omega, region, power, omega_n, damping_ratio, response, 
         norms[norms == 0] = 1.0
         return np.linalg.pinv(basis / norms) / norms[:, None]
 
-    pinv = pinv_of(wn0, z0)[:n_modes]  # (n_modes, n)
-    # ∂A_{r,c}/∂θ_{s,j} (n_modes, n_ch, n_modes, 2) by central differences of the solve
-    slope = np.zeros((n_modes, n_ch, n_modes, 2), complex)
-    for s in range(n_modes):
-        for j, base in enumerate((wn0, z0)):
-            step = 1e-6 * base[s]
-            up, down = base.copy(), base.copy()
-            up[s] += step
-            down[s] -= step
-            args_up = (up, z0) if j == 0 else (wn0, up)
-            args_down = (down, z0) if j == 0 else (wn0, down)
-            plus = pinv_of(*args_up)[:n_modes] @ response.T
-            minus = pinv_of(*args_down)[:n_modes] @ response.T
-            slope[:, :, s, j] = (plus - minus) / (2 * step)
+    full = pinv_of(wn0, z0)  # (n_modes + regions, n)
+    pinv = full[:n_modes]  # (n_modes, n)
+    # ∂A_{r,c}/∂θ_{s,j} (n_modes, n_ch, n_modes, 2) of the least-squares solve x = Φ⁺h: with column s of Φ moved
+    # by d_s, dx = −Φ⁺ d_s x_s + (ΦᴴΦ)⁻¹ e_s d_sᴴ r (r = h − Φx, the solve's residual; (ΦᴴΦ)⁻¹ = Φ⁺Φ⁺ᴴ)
+    basis = np.hstack([mode_basis(omega, wn0, z0, power).T, offsets])  # (n, p)
+    solution = full @ response.T  # (p, n_ch)
+    residual = response.T - basis @ solution  # (n, n_ch)
+    gram_inverse = full @ full.conj().T  # (p, p)
+    slope = np.empty((n_modes, n_ch, n_modes, 2), complex)
+    for j, derivative in enumerate(mode_basis_derivatives(omega, wn0, z0, power)):  # each (n_modes, n)
+        moved = (full @ derivative.T)[:n_modes]  # (n_modes, n_modes): Φ⁺ d_s in column s
+        against = derivative.conj() @ residual  # (n_modes, n_ch): d_sᴴ r_c
+        slope[:, :, :, j] = (-moved[:, None, :] * solution[:n_modes].T[None, :, :]
+                             + gram_inverse[:n_modes, :n_modes][:, None, :] * against.T[None, :, :])
     # real form: K (n_modes, n_ch, 2 [Re, Im], 2 n_modes)
     K = np.stack([slope.real, slope.imag], axis=2).reshape(n_modes, n_ch, 2, 2 * n_modes)
     theta_cov = np.zeros((2 * n_modes, 2 * n_modes))
