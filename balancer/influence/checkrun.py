@@ -42,14 +42,13 @@ import numpy as np
 
 from modal.errors import ParameterError, QualityWarning, warn
 
+from .bootstrap import BOOTSTRAP_DRAWS, redraw, redrawn_jobs
 from .coefficients import correction
 
 __all__ = ["CheckRun", "check_run", "check_reading_noise", "DEFAULT_READING_NOISE", "BOOTSTRAP_DRAWS", "CAUSES"]
 
 #: relative standard deviation of a reading assumed by default (amplitude 5 %, phase about 3 deg)
 DEFAULT_READING_NOISE = 0.05
-#: bootstrap draws of the check run's discrepancy (the 99th percentile rests on ~2 draws above it per 200)
-BOOTSTRAP_DRAWS = 400
 _QUANTILE = 0.99
 #: a cause is named when it explains the check run at least this many times better than the prediction
 _BETTER = 3.0
@@ -148,17 +147,6 @@ def check_reading_noise(reading_noise) -> float:
     return float(reading_noise)
 
 
-def _lstsq(alpha: np.ndarray, initial: np.ndarray, weights: np.ndarray) -> np.ndarray:
-    return np.linalg.lstsq(alpha * weights[:, None], -initial * weights, rcond=None)[0]
-
-
-def _redraw(values: np.ndarray, noise: float, rng: np.random.Generator, per_draw: bool = False) -> np.ndarray:
-    """``values`` with a relative circular Gaussian error of standard deviation ``noise`` on each, once per
-    bootstrap draw (``per_draw``: ``values`` already holds one set per draw along its first axis)."""
-    shape = values.shape if per_draw else (BOOTSTRAP_DRAWS,) + values.shape
-    return values * (1 + noise * (rng.standard_normal(shape) + 1j * rng.standard_normal(shape)) / np.sqrt(2))
-
-
 def discrepancy_limit(initial, trial_runs, trial_unbalance_kg_m, reading_noise: float, weights=None,
                       seed: int = 0) -> float:
     """The 99th percentile of the check run's discrepancy with the correction mounted as computed (module notes).
@@ -167,17 +155,10 @@ def discrepancy_limit(initial, trial_runs, trial_unbalance_kg_m, reading_noise: 
     the reading errors move either).
     """
     v0 = np.asarray(initial, dtype=complex)
-    runs = np.asarray(trial_runs, dtype=complex)
-    trials = np.asarray(trial_unbalance_kg_m, dtype=complex)
-    w = np.ones(v0.size) if weights is None else np.asarray(weights, dtype=float)
-    alpha = (runs - v0).T / trials
-    rng = np.random.default_rng(seed)
-    v0_b = _redraw(v0, reading_noise, rng)
-    runs_b = _redraw(runs, reading_noise, rng)
-    alpha_b = np.swapaxes(runs_b - v0_b[:, None, :], 1, 2) / trials
-    u_b = np.stack([_lstsq(a, v, w) for a, v in zip(alpha_b, v0_b)])
+    alpha = (np.asarray(trial_runs, dtype=complex) - v0).T / np.asarray(trial_unbalance_kg_m, dtype=complex)
+    v0_b, alpha_b, u_b, rng = redrawn_jobs(v0, trial_runs, trial_unbalance_kg_m, reading_noise, weights, seed)
     predicted_b = v0_b + np.einsum("bij,bj->bi", alpha_b, u_b)
-    after_b = _redraw(v0 + np.einsum("ij,bj->bi", alpha, u_b), reading_noise, rng, per_draw=True)
+    after_b = redraw(v0 + np.einsum("ij,bj->bi", alpha, u_b), reading_noise, rng, per_draw=True)
     change = np.linalg.norm(predicted_b - v0_b, axis=1)
     ratio = np.linalg.norm(after_b - predicted_b, axis=1) / np.where(change > 0, change, np.inf)
     return float(np.quantile(ratio, _QUANTILE))

@@ -40,7 +40,7 @@ def add_parser(sub) -> argparse.ArgumentParser:
 
 def report_document(report) -> dict:
     """The report as a JSON-ready dict (user units for readings and masses; SI where named)."""
-    from .job import check_run_summary
+    from .job import check_run_summary, spread_summary
     from .readings import reading_unit, user_digits
 
     scale = 1e3 if report.mass_units == "g" else 1.0
@@ -60,6 +60,8 @@ def report_document(report) -> dict:
         "rms_initial": float((amp0**2).mean() ** 0.5), "rms_residual": float((amp1**2).mean() ** 0.5),
         "condition_number": report.condition_number, "flags": list(report.flags),
     }
+    if report.spread is not None:
+        doc["spread"] = spread_summary(report)
     if report.check is not None:
         amp2, ph2 = report.in_user_units(report.check.measured)
         for i, row in enumerate(doc["readings"]):
@@ -81,7 +83,7 @@ def report_document(report) -> dict:
 
 
 def _text(doc: dict) -> str:
-    from .job import check_run_lines
+    from .job import check_run_lines, spread_lines
 
     unit, mu = doc["reading_units"], doc["mass_units"]
     lines = [f"method: {doc['method']}", "", "correction (add):"]
@@ -99,6 +101,8 @@ def _text(doc: dict) -> str:
     lines += ["", f"worst {doc['worst_initial']:.4g} -> {doc['worst_residual']:.3g} {unit}; "
               f"RMS {doc['rms_initial']:.4g} -> {doc['rms_residual']:.3g} {unit}; condition number {doc['condition_number']:.3g}"
               + (f"; flags: {', '.join(doc['flags'])}" if doc["flags"] else "")]
+    if "spread" in doc:
+        lines += spread_lines(doc["spread"], unit, mu)
     if measured:
         lines += [""] + check_run_lines(doc["check_run"], unit, mu)
     if "iso" in doc:

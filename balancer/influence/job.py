@@ -39,6 +39,7 @@ import numpy as np
 
 from modal.errors import FormatError, ParameterError
 
+from .bootstrap import CorrectionSpread, correction_spread
 from .checkrun import DEFAULT_READING_NOISE, CheckRun, check_reading_noise, check_run
 from .coefficients import correction, influence_matrix
 from .iso import IsoCheck, iso_check
@@ -46,6 +47,7 @@ from .readings import MASS_UNITS, amplitude_phase, reading_unit, unbalance_kg_m,
 from .split import equally_spaced_deg, split_correction
 
 __all__ = ["BalanceJob", "BalanceReport", "parse_job", "load_job", "balance", "check_run_summary", "check_run_lines",
+           "spread_summary", "spread_lines",
            "JOB_KEYS"]
 
 JOB_KEYS = ("units", "mass_units", "radius_m", "sensors", "initial", "trial", "after", "readings",
@@ -262,6 +264,8 @@ class BalanceReport:
         The step the masses on the holes were rounded to (None: not rounded).
     check : CheckRun or None
         The check run set against the prediction, with the trim correction (None: no check run).
+    spread : CorrectionSpread or None
+        How the correction and the vibration it leaves scatter with the readings' repeatability.
     """
 
     method: str
@@ -292,6 +296,7 @@ class BalanceReport:
     iso: IsoCheck | None
     weight_resolution_kg: float | None = None
     check: CheckRun | None = None
+    spread: CorrectionSpread | None = None
 
     def archive_units(self) -> dict[str, str]:
         """Units of the numeric fields whose unit depends on the readings (for the archive)."""
@@ -329,15 +334,15 @@ def balance(job: BalanceJob, method: str = "least_squares", *, weights=None, max
         Round the masses on the holes to multiples of this (kg): the smallest step of the weights at hand
         (a hole whose mass rounds to zero gets none). Default: not rounded.
     reading_noise : float, optional
-        Relative repeatability of a reading (default 0.05), against which a check run (``job.after``) is judged
-        (:func:`~balancer.influence.checkrun.check_run`).
+        Relative repeatability of a reading (default 0.05): the correction's spread
+        (:func:`~balancer.influence.bootstrap.correction_spread`) and the judgement of a check run
+        (``job.after``, :func:`~balancer.influence.checkrun.check_run`) rest on it.
 
     Returns
     -------
     BalanceReport
     """
-    if reading_noise is not None:
-        check_reading_noise(reading_noise)
+    noise = DEFAULT_READING_NOISE if reading_noise is None else check_reading_noise(reading_noise)
     alpha = influence_matrix(job.initial, job.trial_runs, job.trial_unbalance_kg_m)
     result = correction(alpha, job.initial, method=method, weights=weights, max_unbalance_kg_m=max_unbalance_kg_m)
     if holes is not None and positions_deg is not None:
@@ -357,7 +362,9 @@ def balance(job: BalanceJob, method: str = "least_squares", *, weights=None, max
     if job.after.size:
         check = check_run(alpha, job.initial, job.trial_runs, job.trial_unbalance_kg_m, result.unbalance_kg_m,
                           job.after, method=method, weights=weights, si_units=reading_unit(job.units).si_unit,
-                          reading_noise=DEFAULT_READING_NOISE if reading_noise is None else reading_noise)
+                          reading_noise=noise)
+    spread = correction_spread(job.initial, job.trial_runs, job.trial_unbalance_kg_m, job.radius_m, noise,
+                               weights=weights, si_units=reading_unit(job.units).si_unit)
     sensitivity = np.max(np.abs(alpha), axis=0)
     residual_unbalance = np.max(np.abs(left)) / sensitivity
     iso = None
@@ -380,6 +387,7 @@ def balance(job: BalanceJob, method: str = "least_squares", *, weights=None, max
         flags=result.flags + (check.flags if check is not None else ()),
         positions_deg=positions, split_mass_kg=split, residual_unbalance_kg_m=residual_unbalance, iso=iso,
         weight_resolution_kg=None if weight_resolution_kg is None else float(weight_resolution_kg), check=check,
+        spread=spread,
     )
 
 
@@ -418,3 +426,21 @@ def check_run_lines(check: dict, unit: str, mass_units: str) -> list[str]:
         else:
             lines.append(f"no trim needed: a trim ({masses}) would lower the worst reading by less than the readings' noise")
     return lines
+
+
+def spread_summary(report: BalanceReport) -> dict:
+    """The correction's spread as a JSON-ready dict (the masses in ``mass_units``, the vibration in the readings'
+    unit)."""
+    spread = report.spread
+    scale = MASS_UNITS[report.mass_units]
+    worst = float(report.in_user_units(np.array([spread.worst_residual_p90]))[0][0])
+    return {"reading_noise": spread.reading_noise, "mass_std": [float(m / scale) for m in spread.mass_std_kg],
+            "angle_std_deg": [float(a) for a in spread.angle_std_deg], "worst_residual_p90": worst}
+
+
+def spread_lines(spread: dict, unit: str, mass_units: str) -> list[str]:
+    """The correction's spread (:func:`spread_summary`) as text."""
+    planes = "; ".join(f"plane {j + 1} ± {m:.2g} {mass_units}, ± {a:.2g} deg"
+                       for j, (m, a) in enumerate(zip(spread["mass_std"], spread["angle_std_deg"])))
+    return [f"at {100 * spread['reading_noise']:g} % reading noise: {planes}; the worst reading left is below "
+            f"{spread['worst_residual_p90']:.3g} {unit} in 90 % of repeats"]

@@ -168,9 +168,11 @@ def balance_digest(result) -> dict:
         d["iso"] = {"grade_mm_s": r.iso.grade_mm_s, "verdict": r.iso.verdict,
                     "permissible_per_plane_kg_m": [float(v) for v in r.iso.permissible_per_plane_kg_m],
                     "residual_unbalance_kg_m": [float(v) for v in r.iso.residual_unbalance_kg_m]}
-    if r.check is not None:
-        from balancer.influence.job import check_run_summary
+    from balancer.influence.job import check_run_summary, spread_summary
 
+    if r.spread is not None:
+        d["spread"] = spread_summary(r)
+    if r.check is not None:
         d["check_run"] = check_run_summary(r)
     st = result.study
     if st is not None:
@@ -200,9 +202,11 @@ def balance_rows(result, d: dict) -> list[str]:
         lines.append(f"  ISO 21940-11 G {iso['grade_mm_s']:g}: {iso['verdict']} (residual "
                      + ", ".join(f"{r * 1e6:.4g}" for r in iso["residual_unbalance_kg_m"]) + " g mm, permissible "
                      + ", ".join(f"{p * 1e6:.4g}" for p in iso["permissible_per_plane_kg_m"]) + " g mm)")
-    if "check_run" in d:
-        from balancer.influence.job import check_run_lines
+    from balancer.influence.job import check_run_lines, spread_lines
 
+    if "spread" in d:
+        lines += [f"  {line}" for line in spread_lines(d["spread"], d["reading_units"], unit)]
+    if "check_run" in d:
         lines += [f"  {line}" for line in check_run_lines(d["check_run"], d["reading_units"], unit)]
     if "study" in d:
         st = d["study"]
