@@ -21,6 +21,7 @@ from .inputs import MIN_LAGS_IN_RECORD, Prepared, prepare
 from .modes import error_blocks, estimates_from_clusters, resolved
 from .tones import nearly_undamped, separate_tones
 from .result import oma_result
+from .screen import warn_unresponsive
 from .selection import OMAStabilisation, mpc, stabilise
 
 __all__ = ["oma", "OMA_METHODS"]
@@ -163,7 +164,9 @@ def oma(data, sample_rate_hz: float | None = None, *, band_hz=None, method: str 
     if method in ("fdd", "efdd"):
         from .fdd import fdd
 
-        return fdd(prepared, refs, enhanced=method == "efdd", rotor_speed_hz=rotor_speed_hz)
+        result = fdd(prepared, refs, enhanced=method == "efdd", rotor_speed_hz=rotor_speed_hz)
+        warn_unresponsive(result, prepared.source)
+        return result
     if method == "ssi":
         estimates, chosen, clusters, flat, stable, corr, settings = _ssi(prepared, refs, max_order, block_rows)
     else:
@@ -182,8 +185,10 @@ def oma(data, sample_rate_hz: float | None = None, *, band_hz=None, method: str 
                 "duration_s": prepared.duration_s, "rotor_speed_hz": rotor_speed_hz,
                 "channel_names": list(prepared.names), "n_channels": prepared.n_channels, "source": prepared.source,
                 "dropped_unresolved_hz": dropped}
-    return oma_result(estimates, method=method, quantity=prepared.quantity, band_hz=prepared.band_hz,
-                      stabilisation=diagram, settings=settings, harmonics_hz=tones, source=prepared.source)
+    result = oma_result(estimates, method=method, quantity=prepared.quantity, band_hz=prepared.band_hz,
+                        stabilisation=diagram, settings=settings, harmonics_hz=tones, source=prepared.source)
+    warn_unresponsive(result, prepared.source)
+    return result
 
 
 def _sort_out(estimates, chosen, clusters, flat, stable, prepared: Prepared, rotor_speed_hz, method: str,
