@@ -84,3 +84,8 @@ def test_the_files_warnings_are_printed_on_every_run(dask_cluster, tmp_path):
         assert len(dropout) == 1, done.stderr  # one, of dropout.h5: none of clean.h5
         assert dropout[0].startswith(f"warning: {folder / 'dropout.h5'}: every channel holds the value 0 for 1500 "
                                      "samples")
+    # the same folder without --oma: each record refused, pointing to the batch's own option
+    fit = _batch(folder, "--out", tmp_path / "fit.h5", "--scheduler", dask_cluster[0])
+    failed = [line for line in fit.stderr.splitlines() if line.startswith("failed: ")]
+    assert fit.returncode == 1 and len(failed) == 2
+    assert all("responses only" in line and "modal batch --oma" in line for line in failed), fit.stderr
