@@ -41,7 +41,8 @@ NODE_SIGMAS = 3.0
 
 def _channel_label(names, ch: int) -> str:
     name = names[ch] if names and ch < len(names) else None
-    return f"channel {ch + 1}" + (f" ({name})" if name is not None and name != str(ch) else "")
+    plain = name is None or name in (str(ch), str(ch + 1))  # an array's index or a file's number says nothing more
+    return f"channel {ch + 1}" + ("" if plain else f" ({name})")
 
 
 def check_units(record) -> str | None:
