@@ -151,9 +151,16 @@ def oma(data, sample_rate_hz: float | None = None, *, band_hz=None, method: str 
     ------
     ParameterError
         Bad input: fewer than 2 channels, a constant channel, non-finite samples, a band outside
-        (0, Nyquist), a record too short for the band or order.
+        (0, Nyquist), a record too short for the band or order; a record (file) with a force channel or
+        with channels of different quantities or units.
     IdentificationError
         No stable pole in the band.
+
+    Warns
+    -----
+    QualityWarning
+        A flagged mode; a dropout (a run of identical samples) or a clipped channel; a channel that
+        moves in none of the modes found (:mod:`modal.operational.screen`).
     """
     if method not in OMA_METHODS:
         raise ParameterError(f"'method' is {method!r}; expected one of {', '.join(OMA_METHODS)}")
