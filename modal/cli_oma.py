@@ -154,7 +154,7 @@ def _plot(result, path, args) -> None:
     from .operational.inputs import prepare
     from .operational.plots import plot_stabilisation
 
-    prepared = prepare(read_time(path), band_hz=tuple(result.settings["band_hz"]))
+    prepared = prepare(read_time(path), band_hz=tuple(result.settings["band_hz"]), screen=False)
     lines, s1, *_ = singular_values(prepared, result.settings["reference_channels"])
     fig = plot_stabilisation(result, spectrum=(lines, s1)) if result.stabilisation is not None else None
     if fig is None:

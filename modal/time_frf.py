@@ -120,10 +120,13 @@ def plan_time_frf(record, args, report: Callable[[str], None] | None = None,
                                 for k, (n, q) in enumerate(zip(record.names, record.quantities)))
             what = "no channel" if not inputs else f"{len(inputs)} channels"
             responses_only = not inputs and all(q not in (None, "force") for q in record.quantities)
-            hint = (f"; the record holds responses only: for operational (output-only) modal analysis use "
-                    f"python -m modal oma {src}" if responses_only else "")
+            if responses_only:  # the advice before the listing, which may be long (a batch keeps 500 characters)
+                raise FormatError(f"{src}: no channel marked as force: the record holds responses only; for "
+                                  f"operational (output-only) modal analysis use python -m modal oma {src} (a folder "
+                                  f"of such records: modal batch --oma), or name the force channel with "
+                                  f"{option('excitation')} (an FRF needs an excitation); channels {listing}")
             raise FormatError(f"{src}: {what} marked as force ({listing}); expected one: name the force channel "
-                              f"with {option('excitation')} (an FRF needs an excitation){hint}")
+                              f"with {option('excitation')} (an FRF needs an excitation)")
     if args.response:
         outputs = [record.channel_index(r) for r in args.response]
     else:

@@ -147,6 +147,23 @@ def _oma_channel(identified, scene: Scene) -> int:
                      f"1..{identified.n_channels} or a name ({', '.join(names)})")
 
 
+def _check_oma_channel_moves(mode, ref: Reference, key: str, identified, scene: Scene) -> None:
+    """Refuse k, c, m at an ``[oma] channel`` whose shape entry lies within a few of its standard errors of
+    zero: there ψ² rests on noise and m = 1/ψ² is any number (a node of the mode, or a dead channel)."""
+    from modal.operational.screen import NODE_SIGMAS
+
+    channel = _channel(identified, scene)
+    if mode.std.mode_shape is None:
+        return
+    entry, error = abs(mode.mode_shape[channel]), float(mode.std.mode_shape[channel])
+    if entry <= NODE_SIGMAS * error:
+        mass, mass_std = np.atleast_1d(mode.mass_kg)[channel], np.atleast_1d(mode.std.mass_kg)[channel]
+        raise SceneError(f"{scene.source}: key '{key}' = {ref.text!r}: mode {ref.mode}'s shape at channel "
+                         f"{channel + 1} ({entry:.3g} ± {error:.3g}) is within {NODE_SIGMAS:g} standard errors of "
+                         f"zero: its k, c, m there rest on noise (m = {mass:.3g} ± {mass_std:.3g} kg); expected "
+                         "oma.channel where the mode moves (a node of the mode, or a dead sensor?)")
+
+
 def resolve(value, key: str, scene: Scene, identified=None, drive=None) -> float:
     """A number, or the value a reference points at (SI units)."""
     if isinstance(value, str):
@@ -165,6 +182,8 @@ def resolve(value, key: str, scene: Scene, identified=None, drive=None) -> float
                 f"mode, give {narrow}, or set {test}.accept_flagged = true to use it anyway")
         raw = np.atleast_1d(getattr(mode, IDENTIFIED_FIELDS[value.field]))
         number = float(raw[_channel(identified, scene)] if raw.size > 1 else raw[0])
+        if test == "oma" and math.isfinite(number):
+            _check_oma_channel_moves(mode, value, key, identified, scene)
         if not math.isfinite(number) and test == "oma" and scene.section("oma.mass_change") is None:
             raise SceneError(f"{scene.source}: key '{key}' = {value.text!r}: an operational test alone gives no "
                              "k, c, m; expected oma.mass_change and oma.added_mass_kg (a second record with known "

@@ -103,6 +103,9 @@ def run_batch(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
         print(f"interrupted: the files fitted so far are kept in {args.out}.parts; run the same command again "
               "to finish", file=sys.stderr)
         return 130
+    for outcome in result.outcomes:  # what modal fit would have printed of each file, kept in the archive too
+        for text in outcome.warnings:
+            print(f"warning: {failure_line(outcome.file, text)}", file=sys.stderr)
     for item in result.failed:
         print(f"failed: {failure_line(item['file'], item['error'])}", file=sys.stderr)
     if args.json:

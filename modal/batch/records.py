@@ -84,7 +84,7 @@ class Entry:
 
     Attributes
     ----------
-    source, sha256, error, retry, table
+    source, sha256, error, retry, table, warnings
         As in :class:`FileFit`.
     location : tuple of (str, str) or None
         HDF5 file and group holding the :class:`FileFit`.
@@ -99,6 +99,7 @@ class Entry:
     table: str
     location: tuple[str, str] | None = None
     fit: FileFit | None = None
+    warnings: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -146,6 +147,8 @@ class Outcome:
     fit : FileFit or None
         The whole result (modes with all fields) when the batch writes no archive (``out=None``);
         with an archive, read it from there: ``read_archive(out)["files"]``.
+    warnings : tuple of str
+        The warnings the file's fit raised (one line each), as ``modal fit`` prints them.
     """
 
     file: str
@@ -153,3 +156,4 @@ class Outcome:
     error: str
     rows: tuple[dict, ...] = field(default=(), repr=False)
     fit: FileFit | None = field(default=None, repr=False)
+    warnings: tuple[str, ...] = field(default=(), repr=False)

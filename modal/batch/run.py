@@ -164,7 +164,8 @@ def _check_timeout(value) -> float | None:
 
 
 def _outcome(entry: Entry, status: str) -> Outcome:
-    return Outcome(entry.source, status, entry.error, parse_table(entry.source, entry.table), entry.fit)
+    return Outcome(entry.source, status, entry.error, parse_table(entry.source, entry.table), entry.fit,
+                   entry.warnings)
 
 
 def _run(files: list[str], options: FitOptions, client, out, table, workers, progress,

@@ -106,10 +106,18 @@ def _text(node) -> str | None:
     return value.decode() if isinstance(value, bytes) else str(value)
 
 
+def _texts(node) -> tuple[str, ...]:
+    """A stored tuple of strings (a group of datasets "0", "1", ...); empty when absent."""
+    if not isinstance(node, h5py.Group):
+        return ()
+    return tuple(t for i in range(len(node)) if (t := _text(node.get(str(i)))) is not None)
+
+
 def _entry(node, location: tuple[str, str]) -> Entry | None:
     try:
         return Entry(source=_text(node["source"]), sha256=_text(node["sha256"]), error=_text(node["error"]),
-                     retry=bool(node["retry"][()]), table=_text(node["table"]), location=location)
+                     retry=bool(node["retry"][()]), table=_text(node["table"]), location=location,
+                     warnings=_texts(node.get("warnings")))
     except KeyError:
         return None
 
@@ -170,7 +178,7 @@ class PartStore:
         part = self.folder / f"{fits[0].settings_hash[:16]}-{key}.h5"
         write_archive(part, {"files": list(fits)})
         return [Entry(source=fit.source, sha256=fit.sha256, error=fit.error, retry=fit.retry, table=fit.table,
-                      location=(str(part), f"/files/{i}")) for i, fit in enumerate(fits)]
+                      location=(str(part), f"/files/{i}"), warnings=fit.warnings) for i, fit in enumerate(fits)]
 
     def clear(self) -> None:
         """Remove the parts folder (once the archive holds everything)."""
@@ -260,6 +268,7 @@ def write_batch_archive(path: str | os.PathLike, info: BatchInfo, entries: Seque
 
 def entry_of(fit: FileFit) -> Entry:
     """An entry holding the fit itself (not stored in a part)."""
-    return Entry(source=fit.source, sha256=fit.sha256, error=fit.error, retry=fit.retry, table=fit.table, fit=fit)
+    return Entry(source=fit.source, sha256=fit.sha256, error=fit.error, retry=fit.retry, table=fit.table, fit=fit,
+                 warnings=fit.warnings)
 
 

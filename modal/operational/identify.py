@@ -21,6 +21,7 @@ from .inputs import MIN_LAGS_IN_RECORD, Prepared, prepare
 from .modes import error_blocks, estimates_from_clusters, resolved
 from .tones import nearly_undamped, separate_tones
 from .result import oma_result
+from .screen import warn_unresponsive
 from .selection import OMAStabilisation, mpc, stabilise
 
 __all__ = ["oma", "OMA_METHODS"]
@@ -150,9 +151,16 @@ def oma(data, sample_rate_hz: float | None = None, *, band_hz=None, method: str 
     ------
     ParameterError
         Bad input: fewer than 2 channels, a constant channel, non-finite samples, a band outside
-        (0, Nyquist), a record too short for the band or order.
+        (0, Nyquist), a record too short for the band or order; a record (file) with a force channel or
+        with channels of different quantities or units.
     IdentificationError
         No stable pole in the band.
+
+    Warns
+    -----
+    QualityWarning
+        A flagged mode; a dropout (a run of identical samples) or a clipped channel; a channel that
+        moves in none of the modes found (:mod:`modal.operational.screen`).
     """
     if method not in OMA_METHODS:
         raise ParameterError(f"'method' is {method!r}; expected one of {', '.join(OMA_METHODS)}")
@@ -163,7 +171,9 @@ def oma(data, sample_rate_hz: float | None = None, *, band_hz=None, method: str 
     if method in ("fdd", "efdd"):
         from .fdd import fdd
 
-        return fdd(prepared, refs, enhanced=method == "efdd", rotor_speed_hz=rotor_speed_hz)
+        result = fdd(prepared, refs, enhanced=method == "efdd", rotor_speed_hz=rotor_speed_hz)
+        warn_unresponsive(result, prepared.source)
+        return result
     if method == "ssi":
         estimates, chosen, clusters, flat, stable, corr, settings = _ssi(prepared, refs, max_order, block_rows)
     else:
@@ -182,8 +192,10 @@ def oma(data, sample_rate_hz: float | None = None, *, band_hz=None, method: str 
                 "duration_s": prepared.duration_s, "rotor_speed_hz": rotor_speed_hz,
                 "channel_names": list(prepared.names), "n_channels": prepared.n_channels, "source": prepared.source,
                 "dropped_unresolved_hz": dropped}
-    return oma_result(estimates, method=method, quantity=prepared.quantity, band_hz=prepared.band_hz,
-                      stabilisation=diagram, settings=settings, harmonics_hz=tones, source=prepared.source)
+    result = oma_result(estimates, method=method, quantity=prepared.quantity, band_hz=prepared.band_hz,
+                        stabilisation=diagram, settings=settings, harmonics_hz=tones, source=prepared.source)
+    warn_unresponsive(result, prepared.source)
+    return result
 
 
 def _sort_out(estimates, chosen, clusters, flat, stable, prepared: Prepared, rotor_speed_hz, method: str,

@@ -12,6 +12,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from .correlations import decimate, decimation_factor
+from .screen import check_units, screen_samples
 
 __all__ = ["Prepared", "prepare", "check_band", "check_channels"]
 
@@ -74,7 +75,7 @@ def _record(data, sample_rate_hz):
             forces = ", ".join(str(k + 1) for k in data.force_channels())
             raise ParameterError(f"{data.source}: channel(s) {forces} measured force; expected responses only "
                                  "(with a force channel, estimate FRFs: python -m modal fit)")
-        quantity = quantities.pop() if len(quantities) == 1 else None
+        quantity = check_units(data)
         return _real_samples(data.signals), data.sample_rate_hz, quantity, tuple(data.names), data.source
     arr = np.asarray(data)
     if arr.dtype.kind not in "biuf":
@@ -146,7 +147,7 @@ def _name(names, ch) -> str:
     return f" ({names[ch]})" if names and ch < len(names) and names[ch] != str(ch) else ""
 
 
-def prepare(data, sample_rate_hz=None, band_hz=None, quantity: str | None = None) -> Prepared:
+def prepare(data, sample_rate_hz=None, band_hz=None, quantity: str | None = None, screen: bool = True) -> Prepared:
     """Check a record and bring it to zero mean, unit RMS per channel and a rate suited to the band.
 
     Parameters
@@ -159,6 +160,9 @@ def prepare(data, sample_rate_hz=None, band_hz=None, quantity: str | None = None
         (linear-phase FIR) so that the band's upper edge lies at or below half of the new Nyquist frequency.
     quantity : str, optional
         What the channels measured, for an array (a record says it itself).
+    screen : bool
+        Warn of dropouts and clipping (:func:`modal.operational.screen.screen_samples`); False for a record
+        prepared again (a plot of a record identified already).
     """
     signals, rate, file_quantity, names, src = _record(data, sample_rate_hz)
     if not (np.isfinite(rate) and rate > 0):
@@ -168,6 +172,8 @@ def prepare(data, sample_rate_hz=None, band_hz=None, quantity: str | None = None
     # single precision from here on (the correlations' FFTs are single precision anyway: their rounding, 1e-7,
     # lies far below the estimates' scatter); a record to be decimated is filtered in double first
     centred, scale = check_channels(signals, src, names, dtype=np.float32 if factor == 1 else float)
+    if screen:
+        screen_samples(signals, rate, names, src)
     if factor > 1:
         work = decimate(centred, factor)
         if work.shape[1] < 2:

@@ -71,6 +71,46 @@ def _pair(mode, after: IdentificationResult):
     return best
 
 
+def _same_channels(before: IdentificationResult, after: IdentificationResult) -> None:
+    """Refuse records of different channels (or of the same channels in another order), by their names."""
+    if before.n_channels != after.n_channels:
+        raise ParameterError(f"'before' ({_source(before)}) has {before.n_channels} channels and 'after' "
+                             f"({_source(after)}) {after.n_channels}; expected records of the same channels")
+    names = [list(r.settings.get("channel_names") or []) for r in (before, after)]
+    if all(names) and names[0] != names[1]:
+        how = "in another order" if sorted(names[0]) == sorted(names[1]) else "other channels"
+        raise ParameterError(f"'after' ({_source(after)}) holds {how} than 'before' ({_source(before)}): channels "
+                             f"{', '.join(names[1])} against {', '.join(names[0])}; expected the same channels in the "
+                             "same order (the shapes are compared entry by entry)")
+
+
+def _not_swapped(before: IdentificationResult, after: IdentificationResult) -> None:
+    """Refuse a pair in which every mode found in both rose (beyond its errors) with the added mass: the
+    records given in swapped order."""
+    rose, pairs = [], 0
+    for mode in before:
+        best, best_mac = None, PAIR_MAC
+        for other in after:
+            shift = other.natural_frequency_hz / mode.natural_frequency_hz - 1
+            mac = shape_mac(mode.mode_shape, other.mode_shape)
+            if abs(shift) <= MAX_SHIFT and mac >= best_mac:
+                best, best_mac = other, mac
+        if best is None:
+            continue
+        pairs += 1
+        limit = MIN_SHIFT_SIGMAS * np.hypot(mode.std.natural_frequency_hz, best.std.natural_frequency_hz)
+        if best.natural_frequency_hz - mode.natural_frequency_hz > np.nan_to_num(limit):
+            rose.append(f"{mode.natural_frequency_hz:.4g} -> {best.natural_frequency_hz:.4g} Hz")
+    if pairs and len(rose) == pairs:
+        raise ParameterError(f"every mode rose from 'before' ({_source(before)}) to 'after' ({_source(after)}): "
+                             f"{', '.join(rose)}; added mass lowers the frequencies: expected 'before' without the "
+                             "masses and 'after' with them (are the records swapped?)")
+
+
+def _source(result: IdentificationResult) -> str:
+    return str(result.settings.get("source", "<array>"))
+
+
 def _scale(mode, other, dm):
     """α, ψ and the Jacobian of (α², ψ) with respect to (ω₀, ω₁, φ₀, φ₁), and the input standard errors."""
     w0, w1 = 2 * np.pi * mode.natural_frequency_hz, 2 * np.pi * other.natural_frequency_hz
@@ -128,11 +168,16 @@ def scale_by_mass_change(before: IdentificationResult, after: IdentificationResu
         and ``mass_kg``, ``stiffness_n_per_m``, ``damping_n_s_per_m`` per channel, with standard errors
         and their correlation; a mode without a partner in ``after`` (MAC ≥ 0.8, lower frequency), or whose
         frequency shift or scale is not determined, is flagged ``scaling_uncertain``.
+
+    Raises
+    ------
+    ParameterError
+        Records of different channels (by number or by name, or in another order), masses at channels not
+        measured or not positive, or records in swapped order (every mode found in both higher in ``after``).
     """
-    if before.n_channels != after.n_channels:
-        raise ParameterError(f"'before' has {before.n_channels} channels and 'after' {after.n_channels}; expected "
-                             "records of the same channels")
+    _same_channels(before, after)
     dm = _masses(added_mass_kg, before)
+    _not_swapped(before, after)
     scaled = []
     for mode in before:
         other = _pair(mode, after)

@@ -47,14 +47,54 @@ def _references(reference_channels, results) -> list[np.ndarray]:
     return refs
 
 
+def _near(mode, other) -> bool:
+    """Whether ``other`` lies near ``mode`` in frequency (see the module docstring)."""
+    gap = abs(other.natural_frequency_hz - mode.natural_frequency_hz)
+    return gap <= max(FREQ_TOL * mode.natural_frequency_hz,
+                      3 * np.nan_to_num(np.hypot(mode.std.natural_frequency_hz, other.std.natural_frequency_hz)))
+
+
+def _check_references(results, refs) -> None:
+    """Refuse a setup whose reference entries disagree with the first setup's in most of the modes both hold.
+
+    A mode found at the same frequency in both setups whose reference entries have a MAC below
+    :data:`REF_MAC` is left out of the merge (``missing_in_setup``); when that is so for most modes, the
+    references are not the same channels (another order, another sensor, a dead reference, a reference in
+    another unit) and the modes that pass do so by chance: the merged shapes would be wrong.
+    """
+    if refs[0].size < 2:
+        return  # one reference: its entries cannot disagree in shape
+    for k, (result, ref) in enumerate(zip(results[1:], refs[1:]), start=2):
+        matched, disagree = 0, []
+        for mode in results[0]:
+            near = [other for other in result if _near(mode, other)]
+            if not near:
+                continue
+            matched += 1
+            best = max(shape_mac(mode.mode_shape[refs[0]], other.mode_shape[ref]) for other in near)
+            if best < REF_MAC:
+                disagree.append(f"{mode.natural_frequency_hz:.4g} Hz (MAC {best:.2f})")
+        if len(disagree) >= 2 and 2 * len(disagree) > matched:
+            src = result.settings.get("source", "<array>")
+            raise ParameterError(f"setup {k} ({src}): the reference channels {_named(result, ref)} disagree with setup "
+                                 f"1's {_named(results[0], refs[0])} in {len(disagree)} of the {matched} modes both hold: "
+                                 f"{', '.join(disagree)}; expected the same reference sensors, in the same order and "
+                                 f"unit, in every setup (MAC >= {REF_MAC:g}): check their order, a dead reference or "
+                                 "a reference in another unit")
+
+
+def _named(result, channels) -> str:
+    """Channels by name (as the setup's file names them; for an array, the 0-based index)."""
+    names = list(result.settings.get("channel_names") or [])
+    return "[" + ", ".join(str(names[c]) if c < len(names) else str(c) for c in channels) + "]"
+
+
 def _find(mode, ref0, result, ref):
     """The mode of ``result`` that is ``mode`` (see the module docstring), or None."""
     best, best_key = None, np.inf
     for other in result:
         gap = abs(other.natural_frequency_hz - mode.natural_frequency_hz)
-        allowed = max(FREQ_TOL * mode.natural_frequency_hz,
-                      3 * np.nan_to_num(np.hypot(mode.std.natural_frequency_hz, other.std.natural_frequency_hz)))
-        if gap > allowed:
+        if not _near(mode, other):
             continue
         if ref.size > 1 and shape_mac(mode.mode_shape[ref0], other.mode_shape[ref]) < REF_MAC:
             continue
@@ -80,11 +120,18 @@ def merge_setups(results, reference_channels) -> IdentificationResult:
         The first setup's modes; each shape holds the first setup's channels, then each further setup's
         non-reference channels in order. A mode missing from a setup has NaN there and the flag
         ``missing_in_setup``.
+
+    Raises
+    ------
+    ParameterError
+        Bad reference lists, or a setup whose reference entries disagree (MAC below :data:`REF_MAC`) with
+        the first setup's in most of the modes both hold: references in another order, dead or in another unit.
     """
     results = list(results)
     if len(results) < 2:
         raise ParameterError(f"merge_setups needs at least 2 setups, got {len(results)}")
     refs = _references(reference_channels, results)
+    _check_references(results, refs)
     others = [np.setdiff1d(np.arange(r.n_channels), ref) for r, ref in zip(results, refs)]
     merged = []
     for mode in results[0]:

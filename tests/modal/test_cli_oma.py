@@ -123,6 +123,10 @@ def test_mass_change_scales_to_k_c_m(tmp_path):
         assert all(s > 0 for s in mode["std"]["mass_kg"])
     table = _run("oma", before, "--band", 1, 60, "--mass-change", after, *words)
     assert table.returncode == 0 and "k [N/m]" in table.stdout
+    # the two records in swapped order: every mode rose with the "added" mass; refused, not flagged numbers
+    swapped = _run("oma", after, "--band", 1, 60, "--mass-change", before, *words)
+    assert swapped.returncode == 1 and swapped.stdout == "" and swapped.stderr.count("\n") == 1
+    assert "every mode rose from 'before'" in swapped.stderr and "are the records swapped?" in swapped.stderr
 
 
 @pytest.mark.parametrize("args, message", [

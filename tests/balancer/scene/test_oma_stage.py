@@ -1,6 +1,9 @@
 """The [oma] stage: a scene takes k, c, M from an operational test scaled by mass change, as from an impact test."""
 from __future__ import annotations
 
+import warnings
+from types import SimpleNamespace
+
 import h5py
 import numpy as np
 import pytest
@@ -93,3 +96,25 @@ def test_bad_oma_sections_are_one_error(records, oma, extra, message):
     with pytest.raises(SceneError, match=message) as info:
         run_scene(_scene_file(folder, "bad.toml", {"file": before, **oma}, **extra))
     assert "\n" not in str(info.value)
+
+
+def test_k_c_m_at_a_channel_that_does_not_move_are_refused(tmp_path):
+    # a fifth sensor, disconnected (amplifier noise alone), named as the rotor's channel: its mass-normalised
+    # shape entry is 0 within its errors and m = 1/psi^2 came out as 1e11 kg (± 3e11), handed to the study
+    M, C, K = chain_matrices(MASSES, SPRINGS, 0.01)
+    rng = np.random.default_rng(5)
+    for name, added, seed in (("before.h5", [0.0] * 4, 1), ("after.h5", ADDED, 2)):
+        rec = ambient_response(M + np.diag(added), C, K, 200.0, 150_000, noise=0.1, seed=seed)
+        dead = 1e-3 * rec.signals[3].std() * rng.standard_normal(rec.signals.shape[1])
+        _write(tmp_path / name, SimpleNamespace(signals=np.vstack([rec.signals, dead]), sample_rate_hz=200.0))
+    oma = {"file": "before.h5", "band_hz": [1.0, 60.0], "mass_change": "after.h5",
+           "added_mass_kg": {str(k + 1): kg for k, kg in enumerate(ADDED)}, "channel": 5, "accept_flagged": True}
+    with pytest.raises(SceneError, match=r"key 'rotor\.M' = 'identified:mode1\.mass': mode 1's shape at channel 5 "
+                                         r"\(.*\) is within 3 standard errors of zero: its k, c, m there rest on "
+                                         r"noise") as info:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            run_scene(_scene_file(tmp_path, "dead.toml", oma))
+    assert "\n" not in str(info.value)
+    # modal oma says so too, of both records
+    assert sum("channel 5 moves in none of the 4 modes" in str(w.message) for w in caught) == 2

@@ -64,3 +64,28 @@ def test_bad_oma_options_exit_2(tmp_path, args, message):
     _write(tmp_path / "a.h5", anchor_record(63, noise=0.1, tones=False, duration_s=300))
     done = _batch(tmp_path, "--out", tmp_path / "r.h5", *args)
     assert done.returncode == 2 and message in done.stderr and "Traceback" not in done.stderr
+
+
+def test_the_files_warnings_are_printed_on_every_run(dask_cluster, tmp_path):
+    # a record with a dropout (15 s of zeros on every channel): modal oma warns of it; the batch printed nothing
+    # of any file's warnings (they were in the archive only), so its table read as clean numbers
+    folder = tmp_path / "ambient"
+    folder.mkdir()
+    rec = anchor_record(63, noise=0.1, tones=False, duration_s=300)
+    rec.signals[:, 10_000:11_500] = 0.0
+    _write(folder / "dropout.h5", rec)
+    _write(folder / "clean.h5", anchor_record(64, noise=0.1, tones=False, duration_s=300))
+    out = tmp_path / "survey.h5"
+    for status in ("fitted", "reused"):  # the warnings come with the results, reused ones too
+        done = _batch(folder, "--oma", "--band", 1, 30, "--out", out, "--scheduler", dask_cluster[0], "--json")
+        assert done.returncode == 0 and json.loads(done.stdout)[status] == 2, done.stderr
+        lines = [line for line in done.stderr.splitlines() if line.startswith("warning: ")]
+        dropout = [line for line in lines if "a dropout or a stuck converter" in line]
+        assert len(dropout) == 1, done.stderr  # one, of dropout.h5: none of clean.h5
+        assert dropout[0].startswith(f"warning: {folder / 'dropout.h5'}: every channel holds the value 0 for 1500 "
+                                     "samples")
+    # the same folder without --oma: each record refused, pointing to the batch's own option
+    fit = _batch(folder, "--out", tmp_path / "fit.h5", "--scheduler", dask_cluster[0])
+    failed = [line for line in fit.stderr.splitlines() if line.startswith("failed: ")]
+    assert fit.returncode == 1 and len(failed) == 2
+    assert all("responses only" in line and "modal batch --oma" in line for line in failed), fit.stderr

@@ -9,7 +9,7 @@ import pytest
 import modal
 from modal.errors import ParameterError
 from modal.operational.selection import shape_mac
-from support.ambient import FN, anchor_record
+from support.ambient import FN, ZETA, anchor_record, anchor_shapes
 
 SETUP1 = [0, 5, 1, 2, 3]  # references 0 and 5 first
 SETUP2 = [0, 5, 4, 6, 7]
@@ -36,9 +36,10 @@ def test_merged_shapes_cover_every_channel():
 
 
 def test_a_mode_missing_from_a_setup_is_flagged():
+    # setup 2 holds the structure's two lowest modes only (its shapes those of the anchor case at its channels)
     one = anchor_record(43, noise=0.1, tones=False)
-    two = modal.synthetic.ambient_modal_response([3.1, 7.4], [0.015, 0.01], np.ones((5, 2)) * [[1.0, 0.5]] +
-                                                 np.arange(5)[:, None] * [[0.1, -0.3]], 100.0, 100_000, seed=44)
+    two = modal.synthetic.ambient_modal_response(FN[:2], ZETA[:2], anchor_shapes()[SETUP2, :2], 100.0, 100_000,
+                                                 seed=44)
     first = _oma(one.signals[SETUP1])
     with pytest.warns(modal.QualityWarning, match="missing_in_setup"):
         merged = modal.merge_setups([first, _oma(two.signals)], reference_channels=[0, 1])
@@ -53,3 +54,22 @@ def test_bad_references_are_refused():
         modal.merge_setups([r], reference_channels=[0])
     with pytest.raises(ParameterError, match="setup 2 is \\[0, 9\\]"):
         modal.merge_setups([r, r], reference_channels=[[0, 1], [0, 9]])
+
+
+@pytest.mark.parametrize("damage", ["swapped", "dead", "in_g"])
+def test_references_that_disagree_are_refused(damage):
+    # setup 2's references in the other order, one of them disconnected (noise alone) or in g among m/s²:
+    # most modes' reference entries disagree with setup 1's; the few that agree do so by chance (with the
+    # references swapped, the 24.3 Hz mode's were antisymmetric and passed: a merged shape of MAC 0.24)
+    one = anchor_record(52, noise=0.1, tones=False, duration_s=300)
+    two = anchor_record(53, noise=0.1, tones=False, duration_s=300).signals[SETUP2]
+    if damage == "swapped":
+        two = two[[1, 0, 2, 3, 4]]
+    elif damage == "dead":
+        two[1] = 1e-3 * two[1].std() * np.random.default_rng(0).standard_normal(two.shape[1])
+    else:
+        two[1] /= 9.80665
+    first = _oma(one.signals[SETUP1])
+    with pytest.raises(ParameterError, match=r"setup 2 \(<array>\): the reference channels \[0, 1\] disagree with "
+                                             r"setup 1's \[0, 1\] in [3-5] of the 5 modes both hold: 3\.\d+ Hz"):
+        modal.merge_setups([first, _oma(two)], reference_channels=[0, 1])
