@@ -33,7 +33,6 @@ import functools
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import special
 
 from ..frf import line_spacing
 from ..model import mode_basis, solve_linear
@@ -164,6 +163,10 @@ def _level(energy: np.ndarray, n_channels: int) -> float:
 @functools.lru_cache(maxsize=64)
 def _exp_mean_median(n_channels: int) -> float:
     """Median of the mean of ``n_channels`` Exp(1) variables: gammaincinv(n, 1/2)/n."""
+    # imported where it is used: scipy.special is half of what ``import modal`` costs (about 0.3 s of CPU),
+    # paid otherwise by every command line, plotting process and Dask worker that never runs a check
+    from scipy import special
+
     return float(special.gammaincinv(n_channels, 0.5)) / n_channels
 
 
@@ -410,6 +413,8 @@ def find_missing_mode(omega: np.ndarray, response: np.ndarray, power: int, regio
     if dof <= 0 or np.sum(rss1) <= 0:
         return None
     f_stat = float((np.sum(rss0 - rss1) / q) / (np.sum(rss1) / dof))
+    from scipy import special  # where it is used, as in _exp_mean_median
+
     f_limit = float(special.fdtri(q, dof, 1 - SIGNIFICANCE))
     # against the noise above: each real part of the noise has variance σ²/2
     ratio = float(np.sum(2 * (rss0 - rss1) / sigma2))
