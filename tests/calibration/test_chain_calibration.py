@@ -15,8 +15,8 @@ standard errors of ζ before, is fitted out) and the spread: the poles' covarian
 29 records (each record's share of the estimate's error projected through the fit, :mod:`modal.record_variance`),
 where the lines' correlation measured over four lags left the frequency's errors up to 1.8 times the scatter
 (spread 0.44–0.78 over seed sets; 0.76 and 0.66 on these seeds). The reported errors rest on 29 records
-(about 26 after the overlap's and the mean's share), so z is Student-t-like with that many degrees of
-freedom: its spread √(26/24) = 1.04, well inside the band. The hammer with an
+(about 27 after the overlap's and the mean's share), so z is Student-t-like with that many degrees of
+freedom: its spread √(27/25) = 1.04, well inside the band. The hammer with an
 exponential window meets the target for both modes: its errors' correlation over the window's tens of
 lines is whitened as it is (not tapered), and the force noise, which at the peaks is most of the error and
 correlates through the force window, is in the noise model.
