@@ -210,8 +210,8 @@ class FRF:
                                          f"lines; expected {freq.size} (one per line)")
             influence = self.noise_model.record_influence
             if influence is not None and influence.shape[1] != freq.size:
-                raise FRFValidationError(f"{src}: field 'noise_model' has records' influences over {influence.shape[1]} "
-                                         f"lines; expected {freq.size} (one per line)")
+                raise FRFValidationError(f"{src}: field 'noise_model' has records' influences over "
+                                         f"{influence.shape[1]} lines; expected {freq.size} (one per line)")
             if order is not None and influence is not None:
                 object.__setattr__(self, "noise_model", replace(self.noise_model, record_influence=influence[:, order]))
             if order is not None and corr is not None:  # the lines were reordered: neighbours are not neighbours

@@ -25,7 +25,8 @@ from ..noise_model import MAX_INFLUENCE_VALUES
 __all__ = ["record_influence", "overlapping_records", "MAX_INFLUENCE_VALUES"]
 
 
-def record_influence(cross: np.ndarray, power: np.ndarray, frf: np.ndarray, input_power: np.ndarray) -> np.ndarray | None:
+def record_influence(cross: np.ndarray, power: np.ndarray, frf: np.ndarray,
+                     input_power: np.ndarray) -> np.ndarray | None:
     """ψ_ik = (p_ik − Ĥ_k q_ik) / S_xx,k (see the module), in the FRF's unit.
 
     Parameters
