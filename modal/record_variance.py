@@ -10,16 +10,16 @@ so their covariance is measured over the records (the linearised block jackknife
 
     V = (JᵀJ)⁻¹ [Σ_i s_i s_iᵀ + Σ_{d=1}^{D} w_d Σ_i (s_i s_{i+d}ᵀ + s_{i+d} s_iᵀ)] (JᵀJ)⁻¹,
 
-D the records each record overlaps (their errors share samples), with Bartlett's weights w_d = 1 − d/(D + 1)
-(Newey & West 1987), which keep the sum positive semi-definite: with full weights it was indefinite on some
-random records (120 s, Hann, 50 % overlap: negative variances), and a sum with full weights scatters twice as
-much (its variance goes as Σ_{|d|≤D} w_d²: 3 against 1.5 for D = 1). The weights leave out (1 − w_d) of a
-correlation between neighbours: for half-overlapping Hann records, whose noise terms correlate by ρ² = 0.03,
-3 % of the variance; a rectangular window's, ρ² = 0.25, about a fifth. No lag window over the lines is needed:
-each s_i holds every line's error of record i, so the correlation of every line with every other enters. The ψ_i are estimated from the records' residuals, which
-sum to zero at every line; for scores uncorrelated beyond the lags that takes n − 1 − 2 Σ_d w_d (n − d)/n of
-n records' worth from the sum in expectation, which :func:`record_covariance` restores. Its scatter is that of
-a variance from a few tens of records (10–20 % on a standard error).
+D the records each record overlaps (their errors share samples), with Bartlett's weights w_d = 1 − d/(D + 1) (Newey
+& West 1987), which keep the sum positive semi-definite: with full weights it was indefinite on some random records
+(120 s, Hann, 50 % overlap: negative variances), and a sum with full weights scatters twice as much (its variance
+goes as Σ_{|d|≤D} w_d²: 3 against 1.5 for D = 1). The weights leave out (1 − w_d) of a correlation between
+neighbours: for half-overlapping Hann records, whose noise terms correlate by ρ² = 0.03, 3 % of the variance; a
+rectangular window's, ρ² = 0.25, about a fifth. No lag window over the lines is needed: each s_i holds every line's
+error of record i, so the correlation of every line with every other enters. The ψ_i are estimated from the
+records' residuals, which sum to zero at every line; for scores uncorrelated beyond the lags that takes n − 1 − 2
+Σ_d w_d (n − d)/n of n records' worth from the sum in expectation, which :func:`record_covariance` restores. Its
+scatter is that of a variance from a few tens of records (10–20 % on a standard error).
 """
 from __future__ import annotations
 
