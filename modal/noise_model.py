@@ -34,9 +34,9 @@ __all__ = ["NoiseModel", "window_line_correlation", "lag_window", "input_noise_s
 
 #: neighbouring lines whose noise correlation is carried, at most
 MAX_LAGS = 64
-#: records × lines whose influences a continuous estimate keeps at most (64 MiB of complex values: 29 records ×
-#: 4097 lines is 0.12 M); above, it carries none and identification reports the errors of the lines' correlation
-#: (:mod:`modal.estimate.record_influence`)
+#: records × lines whose influences a continuous estimate keeps at most (64 MiB of complex values, 160 MiB while
+#: they are formed; 29 records × 4097 lines is 0.12 M); above, it carries none and identification reports the
+#: errors of the lines' correlation (:mod:`modal.estimate.record_influence`)
 MAX_INFLUENCE_VALUES = 1 << 22
 #: a continuous estimate from at least this many records carries its errors' correlation as measured over them
 #: (:mod:`modal.estimate.error_correlation`; fewer scatter too much to whiten by: ±0.25 per line with 16)
