@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .record_variance import projected_scores, record_covariance
+from .record_variance import misfit_ratio, projected_scores, record_covariance
 from .whitening import LineWhitening
 
 __all__ = ["NLSFit", "RowResidual", "fit_modes", "orthonormal_factor", "truncation_shift"]
@@ -355,8 +355,11 @@ def _fill_covariance(mode_cov, dphi, Q, R, Cm, noise_var, correlated_lags=0, res
         if records is not None and np.all(np.isfinite(cov_theta)):
             measured = record_covariance(np.real((E.conj().T @ E) * (Cm.conj() @ Cm.T)),
                                          projected_scores(E, Cm[:, 0], records[0]), records[1])
-        if measured is not None:
-            cov_theta, from_records = measured, True
+        if measured is not None:  # widened by a misfit the records do not see (see misfit_ratio)
+            off = records[0] - Q @ (Q.conj().T @ records[0])
+            dof = dphi.shape[0] - Q.shape[1] - n_theta / (2 * Cm.shape[1])
+            ratio = misfit_ratio(float(noise_var[0]) * dof, off, records[1])
+            cov_theta, from_records = measured * max(ratio, 1.0) if np.isfinite(ratio) else measured, True
         elif correlated_lags > 0 and np.all(np.isfinite(cov_theta)) and _residual_correlated(
                 residual, correlated_lags, region):
             n_freq = dphi.shape[0]

@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["record_covariance", "projected_scores", "MIN_EFFECTIVE_RECORDS"]
+__all__ = ["record_covariance", "projected_scores", "misfit_ratio", "MIN_EFFECTIVE_RECORDS"]
 
 #: the covariance is measured where the records leave at least this many (after the overlap's and the mean's
 #: share, see the module; a standard error from 12 scatters by about 20 %) and outnumber the parameters (else
@@ -98,3 +98,36 @@ def record_covariance(information: np.ndarray, scores: np.ndarray, overlapping: 
     if np.linalg.eigvalsh(covariance / np.outer(spread, spread))[0] <= 0:
         return None
     return covariance
+
+
+def _weighted_sum(gram: np.ndarray, overlapping: int) -> float:
+    """Σ_i G_ii + Σ_d w_d Σ_i 2 Re G_i,i+d with Bartlett's weights, times n over the records' worth (as
+    :func:`record_covariance` sums), for a Gram matrix G of the records' terms."""
+    n = gram.shape[0]
+    weights = 1.0 - np.arange(1, overlapping + 1) / (overlapping + 1.0)
+    effective = n - 1 - 2 * sum(w * (n - d) / n for d, w in enumerate(weights, start=1))
+    total = float(np.trace(gram).real)
+    for d, w in enumerate(weights, start=1):
+        total += 2 * w * float(np.trace(gram, offset=d).real)
+    return total * n / effective if effective > 0 else np.nan
+
+
+def misfit_ratio(residual_power: float, residual_influence: np.ndarray, overlapping: int = 0) -> float:
+    """The fit's residual power over what the records' errors account for of it.
+
+    The records measure the random error only: a misfit of the model (the wrong kind of FRF, a mode or a
+    background left out) is the same in every record and stays out of their sum, though it moves the
+    parameters as well. The Fisher information takes the misfit in through the residual's level; the records'
+    covariance is multiplied by this ratio where it exceeds 1 (the residual holds more than the records' errors).
+
+    Parameters
+    ----------
+    residual_power : float
+        ‖r‖², the fit's residual sum of squares (in the fit's units, weighted and whitened as it is).
+    residual_influence : ndarray, shape (n_freq, n_records)
+        The records' ψ_i in the same units, projected off the design (the part of them the residual keeps).
+    overlapping : int
+        As for :func:`record_covariance`.
+    """
+    expected = _weighted_sum(residual_influence.conj().T @ residual_influence, overlapping)
+    return residual_power / expected if expected > 0 else np.nan

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from modal.nls import fit_modes
-from modal.record_variance import MIN_EFFECTIVE_RECORDS, projected_scores, record_covariance
+from modal.record_variance import MIN_EFFECTIVE_RECORDS, misfit_ratio, projected_scores, record_covariance
 from modal.whitening import LineWhitening
 
 #: Monte-Carlo trials: a variance from T trials has relative standard error √(2/T) (3.2 % at 2000)
@@ -126,3 +126,31 @@ def test_too_few_records_or_a_singular_sum_give_none():
     scores = np.outer([1.0, 2.0], rng.standard_normal(30))
     assert record_covariance(information, scores, 0) is None
     assert record_covariance(information, np.full((2, 30), np.nan), 0) is None
+
+
+def test_misfit_ratio_is_one_without_misfit_and_grows_with_one():
+    # the residual of a linear fit against the records' errors projected off the design: their ratio is 1
+    # on average where the model holds (over 500 draws its mean is within ±2 %), and grows by the misfit's
+    # share where the data hold a term the model leaves out (a ripple as large as the errors: about twice)
+    rng = np.random.default_rng(6)
+    n_records, n_lines = 29, 60
+    lines = np.linspace(-1, 1, n_lines)
+    design = np.column_stack([np.ones(n_lines), lines])
+    basis, _ = np.linalg.qr(design)
+    ripple = np.cos(4 * np.pi * lines)
+    ripple -= basis @ (basis.T @ ripple)  # the part of it no fit of the design takes out
+    misfit = np.sqrt(n_records) * ripple / np.sqrt(np.mean(ripple**2))  # as large as the errors (29 unit terms)
+    ratios, with_misfit, error_power = [], [], []
+    for _ in range(500):
+        terms = _records(rng, n_records, n_lines, 5)
+        off = (terms - terms.mean(axis=0)).T
+        off = off - basis @ (basis.T @ off)
+        residual = terms.sum(axis=0) - basis @ (basis.T @ terms.sum(axis=0))
+        error_power.append(float(residual @ residual))
+        ratios.append(misfit_ratio(error_power[-1], off, 0))
+        residual = residual + misfit
+        with_misfit.append(misfit_ratio(float(residual @ residual), off, 0))
+    assert abs(np.mean(ratios) - 1) < 0.05
+    # the misfit's power over the errors' (the ratio's own scatter, ~1/√29 each, adds a few per cent: 10 %)
+    expected = 1 + float(misfit @ misfit) / np.mean(error_power)
+    assert abs(np.mean(with_misfit) / expected - 1) < 0.1
