@@ -144,7 +144,9 @@ def overlap(omega_n: np.ndarray, damping_ratio: np.ndarray, index: int) -> float
 #: What to do when a flag is raised.
 FLAG_ACTION = {
     "resolution_limited": "measure with a finer line spacing (longer record) around the mode, or trust the "
-                          "nls estimate, which fits the shape of the peak rather than counting lines",
+                          "nls estimate, which fits the shape of the peak rather than counting lines (not that of "
+                          "an FRF estimated from time records: there take longer segments, segment_length / "
+                          "--segment-length, so that the half-power band holds at least 3 lines)",
     "missing_crossing": "widen the band (--band) so that it holds both half-power points, or use method nls",
     "band_edge_peak": "give a band centred on the resonance with --band FMIN FMAX",
     "too_few_points": "widen the band or measure a finer line spacing",

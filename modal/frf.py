@@ -208,6 +208,12 @@ class FRF:
             if variance is not None and variance.size != freq.size:
                 raise FRFValidationError(f"{src}: field 'noise_model' has a variance model over {variance.size} "
                                          f"lines; expected {freq.size} (one per line)")
+            influence = self.noise_model.record_influence
+            if influence is not None and influence.shape[1] != freq.size:
+                raise FRFValidationError(f"{src}: field 'noise_model' has records' influences over "
+                                         f"{influence.shape[1]} lines; expected {freq.size} (one per line)")
+            if order is not None and influence is not None:
+                object.__setattr__(self, "noise_model", replace(self.noise_model, record_influence=influence[:, order]))
             if order is not None and corr is not None:  # the lines were reordered: neighbours are not neighbours
                 object.__setattr__(self, "noise_model", replace(self.noise_model, line_correlation=None))
             if order is not None and variance is not None:
@@ -283,7 +289,10 @@ class FRF:
         resp = self.response * iw ** delta
         units = DEFAULT_UNITS[kind] if self.units == DEFAULT_UNITS[self.kind] else None
         noise = None if self.noise_std is None else self.noise_std * np.abs(self.omega_rad_s) ** delta
-        return replace(self, response=resp, kind=kind, units=units, noise_std=noise)
+        model = self.noise_model
+        if model is not None and model.record_influence is not None:  # each record's error converts as H does
+            model = replace(model, record_influence=model.record_influence * iw ** delta)
+        return replace(self, response=resp, kind=kind, units=units, noise_std=noise, noise_model=model)
 
     def cropped(self, f_low_hz: float, f_high_hz: float) -> "FRF":
         """The lines with ``f_low_hz <= f <= f_high_hz``."""

@@ -77,7 +77,7 @@ def frf_in_si(frf: FRF) -> FRF:
         raise FormatError(f"{frf.source}: the unit {frf.units!r} is a {kind}'s but the FRF is declared a {frf.kind}; "
                           f"expected a unit of a {frf.kind} ({DEFAULT_UNITS[frf.kind]}) or kind={kind!r}")
     noise = None if frf.noise_std is None else np.asarray(frf.noise_std) * factor
-    model = None if frf.noise_model is None else frf.noise_model.scaled(np.full(frf.n_freq, factor**2))
+    model = None if frf.noise_model is None else frf.noise_model.scaled(np.full(frf.n_freq, factor**2), factor)
     return replace(frf, response=np.asarray(frf.response) * factor, noise_std=noise, noise_model=model,
                    units=DEFAULT_UNITS[frf.kind])
 

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .record_variance import misfit_ratio, projected_scores, record_covariance
 from .whitening import LineWhitening
 
 __all__ = ["NLSFit", "RowResidual", "fit_modes", "orthonormal_factor", "truncation_shift"]
@@ -54,6 +55,8 @@ class NLSFit:
         Evaluations of the model (a design and its projection) after the start's.
     capped : bool
         The fit stopped at ``max_evaluations`` before converging: the poles are where it stood then.
+    record_errors : bool
+        The poles' covariance was measured over the records (``record_influence`` given and usable).
     """
 
     omega_n: np.ndarray
@@ -70,6 +73,7 @@ class NLSFit:
     escaped: np.ndarray | None = None
     n_evaluations: int = 0
     capped: bool = False
+    record_errors: bool = False
 
 
 class RowResidual:
@@ -324,16 +328,20 @@ def _project(Phi, Y, y_energy=None):
 
 
 def _fill_covariance(mode_cov, dphi, Q, R, Cm, noise_var, correlated_lags=0, residual=None, region=None,
-                     inverse_scale=None) -> None:
+                     inverse_scale=None, records=None) -> bool:
     """Covariance of (ωn, ζ, Re c, Im c) per mode and channel, in the fit's units, into ``mode_cov``
     (n_modes, n_ch, 4, 4): the poles' from their Fisher information (the Schur complement, by the projected
     Jacobian), the constants' from the linear fit's plus their sensitivity to the poles.
 
     With ``correlated_lags`` > 0 and a ``residual`` (:class:`RowResidual`, FRF unit; ``inverse_scale`` takes
     it to the fit's) whose lines a Ljung–Box test finds correlated over those lags, the poles' covariance is
-    the Newey–West sandwich F⁻¹ B F⁻¹ instead (see :func:`fit_modes`)."""
+    the Newey–West sandwich F⁻¹ B F⁻¹ instead (see :func:`fit_modes`). ``records`` (one channel: the records'
+    influences in the fit's units, (n_freq, n_records), and the records each overlaps): the poles' covariance
+    measured over the records where it can be (:func:`modal.record_variance.record_covariance`); returns
+    whether it was."""
     n_theta = dphi.shape[1]
     n_modes = n_theta // 2
+    from_records = False
     E = dphi - Q @ (Q.conj().T @ dphi)
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         weights = np.where(noise_var > 0, 1.0 / noise_var, np.inf)
@@ -343,7 +351,16 @@ def _fill_covariance(mode_cov, dphi, Q, R, Cm, noise_var, correlated_lags=0, res
     cov_theta = np.full((n_theta, n_theta), np.nan)
     if np.all(np.isfinite(F)):
         cov_theta = _pole_covariance(F)
-        if correlated_lags > 0 and np.all(np.isfinite(cov_theta)) and _residual_correlated(
+        measured = None
+        if records is not None and np.all(np.isfinite(cov_theta)):
+            measured = record_covariance(np.real((E.conj().T @ E) * (Cm.conj() @ Cm.T)),
+                                         projected_scores(E, Cm[:, 0], records[0]), records[1])
+        if measured is not None:  # widened by a misfit the records do not see (see misfit_ratio)
+            off = records[0] - Q @ (Q.conj().T @ records[0])
+            dof = dphi.shape[0] - Q.shape[1] - n_theta / (2 * Cm.shape[1])
+            ratio = misfit_ratio(float(noise_var[0]) * dof, off, records[1])
+            cov_theta, from_records = measured * max(ratio, 1.0) if np.isfinite(ratio) else measured, True
+        elif correlated_lags > 0 and np.all(np.isfinite(cov_theta)) and _residual_correlated(
                 residual, correlated_lags, region):
             n_freq = dphi.shape[0]
             dof = n_freq - Q.shape[1] - n_theta / (2 * Cm.shape[1])
@@ -374,6 +391,7 @@ def _fill_covariance(mode_cov, dphi, Q, R, Cm, noise_var, correlated_lags=0, res
         blk[:, 2, 2] = lin + np.einsum("jc,jk,kc->c", g_re, cov_theta, g_re)
         blk[:, 3, 3] = lin + np.einsum("jc,jk,kc->c", g_im, cov_theta, g_im)
         blk[:, 2, 3] = blk[:, 3, 2] = np.einsum("jc,jk,kc->c", g_re, cov_theta, g_im)
+    return from_records
 
 
 def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, damping_ratio0,
@@ -382,7 +400,8 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
               line_weight: np.ndarray | None = None, channel_scale: np.ndarray | None = None,
               max_damping: float | None = None, errors: bool = True,
               whitening: LineWhitening | None = None, correlated_lags: int = 0,
-              decrement_tol: float = 0.0, max_evaluations: int | None = None) -> NLSFit:
+              decrement_tol: float = 0.0, max_evaluations: int | None = None,
+              record_influence: np.ndarray | None = None, overlapping_records: int = 0) -> NLSFit:
     """Fit poles and modal constants of several modes to many channels at once.
 
     Parameters
@@ -449,6 +468,13 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
         Evaluations of the model (each a design and its projection, the unit of the fit's work) after the
         start's, at most; the fit stops there, not converged, with ``capped`` set (None: no limit but
         ``max_iter``; 0: the start's poles, with their errors).
+    record_influence : ndarray, shape (n_records, n_freq), optional
+        One channel estimated from records: each record's share of its error on the lines, FRF unit
+        (:mod:`modal.estimate.record_influence`); the poles' covariance is then measured over the records
+        (:mod:`modal.record_variance`; ``overlapping_records`` following records overlap each), where it
+        can be, in place of the one above.
+    overlapping_records : int
+        See ``record_influence``.
     """
     omega = np.asarray(omega, float)
     rows = np.ascontiguousarray(np.atleast_2d(np.asarray(response, complex)))  # (n_ch, n_freq), the FRF's unit
@@ -626,8 +652,15 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
     noise_var = rss / dof if dof > 0 else np.full(n_ch, np.nan)
     Cm = C[mode_of]
     mode_cov = np.full((n_modes, n_ch, 4, 4), np.nan)
+    record_errors = False
     if errors:
-        _fill_covariance(mode_cov, dphi, Q, R, Cm, noise_var, correlated_lags, residual, region, inverse_scale)
+        records = None
+        if record_influence is not None and n_ch == 1:  # transformed as the data were
+            influence = np.asarray(record_influence, complex).T * inverse_scale[0]
+            influence = influence if weight is None else influence * weight
+            records = (influence if whitening is None else whitening(influence), overlapping_records)
+        record_errors = _fill_covariance(mode_cov, dphi, Q, R, Cm, noise_var, correlated_lags, residual, region,
+                                         inverse_scale, records)
     # back to physical units: x → ω = x w_ref; c → A = c · ch_scale · w_ref^(2−p)
     a_scale = ch_scale * w_ref ** (2 - power)  # (n_ch,)
     unit = np.empty((n_ch, 4))  # each channel's (ωn, ζ, Re A, Im A) per fitted unit
@@ -650,6 +683,7 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
         escaped=escaped,
         n_evaluations=n_evaluations,
         capped=capped,
+        record_errors=record_errors,
     )
 
 

@@ -30,10 +30,14 @@ import numpy as np
 from .errors import FRFValidationError
 
 __all__ = ["NoiseModel", "window_line_correlation", "lag_window", "input_noise_split", "MAX_LAGS", "CORRELATION_FLOOR",
-           "MEASURED_CORRELATION_RECORDS"]
+           "MEASURED_CORRELATION_RECORDS", "MAX_INFLUENCE_VALUES"]
 
 #: neighbouring lines whose noise correlation is carried, at most
 MAX_LAGS = 64
+#: records × lines whose influences a continuous estimate keeps at most (64 MiB of complex values, 160 MiB while
+#: they are formed; 29 records × 4097 lines is 0.12 M); above, it carries none and identification reports the
+#: errors of the lines' correlation (:mod:`modal.estimate.record_influence`)
+MAX_INFLUENCE_VALUES = 1 << 22
 #: a continuous estimate from at least this many records carries its errors' correlation as measured over them
 #: (:mod:`modal.estimate.error_correlation`; fewer scatter too much to whiten by: ±0.25 per line with 16)
 MEASURED_CORRELATION_RECORDS = 16
@@ -70,6 +74,16 @@ class NoiseModel:
         scatter from few averages. NaN on lines where the excitation's noise is not small against the
         excitation (there H1 is biased and the model does not hold); None when not fitted (no excitation
         noise found, several channels).
+    record_influence : ndarray, shape (n_records, n_freq), complex, or None
+        Each record's share of the estimate's error at each line, in the FRF's unit
+        (:mod:`modal.estimate.record_influence`): identification measures its parameters' variance over
+        the records with them (:mod:`modal.record_variance`). None when not kept (one input and one output,
+        continuous records, at least :data:`MEASURED_CORRELATION_RECORDS` of them, within the memory budget).
+    overlapping_records : int
+        How many following records each record overlaps (1 for half-overlapping records; 0 without overlap).
+    influence_withheld : bool
+        The records' influences would have been kept but exceed the memory budget
+        (:data:`MAX_INFLUENCE_VALUES`).
     """
 
     averages: int
@@ -78,6 +92,9 @@ class NoiseModel:
     lag_window: np.ndarray | None
     sample_interval_s: float
     variance_model: np.ndarray | None = None
+    record_influence: np.ndarray | None = None
+    overlapping_records: int = 0
+    influence_withheld: bool = False
 
     def __post_init__(self) -> None:
         if self.line_correlation is not None:
@@ -101,6 +118,15 @@ class NoiseModel:
                 raise FRFValidationError("field 'variance_model' must hold one variance >= 0 (or NaN) per line")
             variance.setflags(write=False)
             object.__setattr__(self, "variance_model", variance)
+        if self.record_influence is not None:
+            influence = np.array(self.record_influence, dtype=complex)
+            if influence.ndim != 2 or not np.all(np.isfinite(influence)):
+                raise FRFValidationError("field 'record_influence' must be a finite 2-D array (records × lines)")
+            influence.setflags(write=False)
+            object.__setattr__(self, "record_influence", influence)
+        if not (isinstance(self.overlapping_records, (int, np.integer)) and self.overlapping_records >= 0):
+            raise FRFValidationError(f"field 'overlapping_records' is {self.overlapping_records!r}; "
+                                     "expected an integer >= 0")
         if not (np.isfinite(self.sample_interval_s) and self.sample_interval_s > 0):
             raise FRFValidationError(f"field 'sample_interval_s' is {self.sample_interval_s!r}; expected a time in s")
 
@@ -124,23 +150,27 @@ class NoiseModel:
         Lines dropped from inside the run break the neighbour relation: the correlation is then dropped.
         """
         variance = None if self.variance_model is None else self.variance_model[keep]
+        influence = None if self.record_influence is None else self.record_influence[:, keep]
         if self.line_correlation is None:
-            return replace(self, variance_model=variance)
+            return replace(self, variance_model=variance, record_influence=influence)
         lines = np.flatnonzero(keep)
         if lines.size and np.any(np.diff(lines) != 1):
-            return replace(self, line_correlation=None, variance_model=variance)
+            return replace(self, line_correlation=None, variance_model=variance, record_influence=influence)
         corr = self.line_correlation[:, keep].copy()
         for m in range(1, corr.shape[0] + 1):  # the last m lines have no neighbour m lines on
             corr[m - 1, max(corr.shape[1] - m, 0):] = 0
-        return replace(self, line_correlation=corr, variance_model=variance)
+        return replace(self, line_correlation=corr, variance_model=variance, record_influence=influence)
 
-    def scaled(self, factor: np.ndarray) -> "NoiseModel":
+    def scaled(self, factor: np.ndarray, frf_factor: np.ndarray | None = None) -> "NoiseModel":
         """The model of the FRF times a factor per line whose phase is the same on every line (a change of
         kind, (iω)^p): the variance model times ``factor`` (|scale|², one value per line); the correlation
-        is unchanged."""
-        if self.variance_model is None:
-            return self
-        return replace(self, variance_model=self.variance_model * np.asarray(factor, float))
+        is unchanged; the records' influences times ``frf_factor`` (the scale itself, complex; None: they are
+        dropped, their phase unknown)."""
+        influence = None
+        if self.record_influence is not None and frf_factor is not None:
+            influence = self.record_influence * np.asarray(frf_factor)
+        variance = None if self.variance_model is None else self.variance_model * np.asarray(factor, float)
+        return replace(self, variance_model=variance, record_influence=influence)
 
     def correlation_band(self, lines: np.ndarray) -> np.ndarray | None:
         """The correlation matrix R of the errors on the lines with indices ``lines`` (ascending), in LAPACK's

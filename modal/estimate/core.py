@@ -26,6 +26,7 @@ from ..noise_model import (INPUT_NOISE_LIMIT, NoiseModel, input_noise_split, lag
 from ..validate import finite_samples, one_of, per_line, positive_number
 from . import spectra
 from .error_correlation import LEAKAGE_LAGS, MIN_RECORDS, measured_line_correlation
+from .record_influence import MAX_INFLUENCE_VALUES, overlapping_records, record_influence
 from .hits import find_hits, pulse_train
 from .overload import find_overloads
 from .quiet import quiet_noise
@@ -154,7 +155,7 @@ def _as_signals(value, name: str, source: str):
 
 
 def _noise_model(sums, output_correlation, input_window, output_window, sample_rate_hz, overlap_factor,
-                 decay_s=None, frf=None, quiet=None) -> NoiseModel:
+                 decay_s=None, frf=None, quiet=None, overlapping=0, withheld=False) -> NoiseModel:
     """The estimate's :class:`~modal.noise_model.NoiseModel` from its sums and windows.
 
     One input: the errors of lines k and k + m correlate by c_out(m) Σ conj(X_k) X_{k+m} / √(S_xx,k S_xx,k+m)
@@ -173,6 +174,10 @@ def _noise_model(sums, output_correlation, input_window, output_window, sample_r
 
     Continuous records (``sums.error_products`` summed): the correlation measured over the records
     (:func:`~modal.estimate.error_correlation.measured_line_correlation`) replaces the window's model.
+
+    Records kept one by one (``sums.record_cross``): each record's share of the error
+    (:func:`~modal.estimate.record_influence.record_influence`), ``overlapping`` the records each overlaps;
+    ``withheld``: they were not kept, over the memory budget.
 
     One record (a single hit) has no residual over records: ``quiet`` (:func:`~modal.estimate.quiet.quiet_noise`,
     the noise read from the samples where the channels hold noise alone) gives a and b instead.
@@ -223,7 +228,11 @@ def _noise_model(sums, output_correlation, input_window, output_window, sample_r
     lags = lag_window(input_window, output_window, sums.excitation_square / sums.n_records)
     if decay_s is not None:
         lags = lags * np.exp(np.arange(lags.size) * interval / decay_s)
-    return NoiseModel(sums.n_records, dof, correlation, lags, interval, variance)
+    influence = None
+    if sums.record_cross is not None and frf is not None and frf.shape[:2] == (1, 1):
+        influence = record_influence(sums.record_cross, sums.record_power, frf[0, 0], power)
+    return NoiseModel(sums.n_records, dof, correlation, lags, interval, variance, influence,
+                      overlapping if influence is not None else 0, withheld)
 
 
 def _default_segment_length(n_samples: int) -> int:
@@ -416,8 +425,11 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
     window_lags = lags_carried(output_correlation, length // 2 + 1)
     # continuous records, enough of them: the errors' correlation is also measured over the records
     measured = not impact and starts.size >= MIN_RECORDS
+    # ... and each record's share of it kept, within a memory budget
+    keep_records = measured and starts.size * (length // 2 + 1) <= MAX_INFLUENCE_VALUES
     sums = spectra.accumulate(x, y, starts, length, in_w, out_w, lags=window_lags,
-                              error_lags=max(window_lags, LEAKAGE_LAGS) if measured else 0)
+                              error_lags=max(window_lags, LEAKAGE_LAGS) if measured else 0,
+                              keep_records=keep_records)
     factor = spectra.overlap_variance_factor(out_w, step) if not impact else 1.0
     estimate = {"H1": spectra.h1, "H2": spectra.h2, "Hv": spectra.hv}[estimator]
     frf3, coherence3, multiple, variance3 = estimate(sums, source)
@@ -439,7 +451,9 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
             if np.all(np.isfinite(variance)):
                 noise = np.sqrt(variance.reshape(n_out * n_in, n_lines))
     model = _noise_model(sums, output_correlation, in_w, out_w, fs, factor, decay_s=exponential_decay_s,
-                         frf=frf3 if estimator == "H1" else None, quiet=quiet)
+                         frf=frf3 if estimator == "H1" else None, quiet=quiet,
+                         overlapping=0 if impact else overlapping_records(length, step),
+                         withheld=measured and not keep_records and n_in == 1 and n_out == 1)
 
     if response_quantity is not None:
         delta = KIND_POWER[kind] - RESPONSE_QUANTITIES[response_quantity]
@@ -452,7 +466,7 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
             multiple = multiple[:, keep]
             if noise is not None:
                 noise = noise[:, keep] * np.abs(scale)
-            model = model.cropped(keep).scaled(np.abs(scale) ** 2)
+            model = model.cropped(keep).scaled(np.abs(scale) ** 2, scale)
 
     single = n_out * n_in == 1
     return EstimatedFRF(

@@ -45,6 +45,9 @@ class SpectralSums:
         records of p_k conj(p_{k+m}), p_k q_{k+m}, q_k conj(p_{k+m}) and q_k q_{k+m} for m = 0 … n_lags
         (zero past the last line): each line's error products over the records
         (:func:`modal.estimate.error_correlation.measured_line_correlation`).
+    record_cross, record_power : ndarray, shape (n_records, n_lines), optional
+        One input and one output, when asked: each record's Y conj(X) (complex) and |X|² (real), the terms
+        of the sums above record by record (:mod:`modal.estimate.record_influence`).
     """
 
     sxx: np.ndarray
@@ -54,6 +57,8 @@ class SpectralSums:
     sxx_lag: np.ndarray | None = None
     excitation_square: np.ndarray | None = None
     error_products: np.ndarray | None = None
+    record_cross: np.ndarray | None = None
+    record_power: np.ndarray | None = None
 
 
 def _records(signal, starts: np.ndarray, length: int) -> np.ndarray:
@@ -65,7 +70,8 @@ def _records(signal, starts: np.ndarray, length: int) -> np.ndarray:
 
 
 def accumulate(excitation, response, starts, length: int, input_window: np.ndarray,
-               output_window: np.ndarray, lags: int = 0, error_lags: int = 0) -> SpectralSums:
+               output_window: np.ndarray, lags: int = 0, error_lags: int = 0,
+               keep_records: bool = False) -> SpectralSums:
     """Sum the spectra of the records that start at ``starts``.
 
     Parameters
@@ -83,6 +89,8 @@ def accumulate(excitation, response, starts, length: int, input_window: np.ndarr
         (``sxx_lag``) and the excitation's square at each sample (``excitation_square``).
     error_lags : int
         One input and one output: also sum the ``error_products`` over this many lags (0: not).
+    keep_records : bool
+        One input and one output: also keep each record's ``record_cross`` and ``record_power``.
     """
     starts = np.asarray(starts, dtype=np.int64)
     n_in, n_out = excitation.shape[0], response.shape[0]
@@ -95,6 +103,9 @@ def accumulate(excitation, response, starts, length: int, input_window: np.ndarr
     square = np.zeros(length) if one_input else None
     error_lags = min(error_lags, n_lines - 1) if one_input and n_out == 1 else 0
     products = np.zeros((4, error_lags + 1, n_lines), complex) if error_lags > 0 else None
+    keep_records = keep_records and one_input and n_out == 1
+    record_cross = np.zeros((starts.size, n_lines), complex) if keep_records else None
+    record_power = np.zeros((starts.size, n_lines)) if keep_records else None
     per_record = (n_in + n_out) * n_lines * 16 + (n_in + n_out) * length * 8
     block = max(1, int(_BLOCK_BYTES // max(per_record, 1)))
     for first in range(0, starts.size, block):
@@ -110,9 +121,13 @@ def accumulate(excitation, response, starts, length: int, input_window: np.ndarr
             square += np.einsum("sn,sn->n", raw[0], raw[0])
             for m in range(1, min(lags, n_lines - 1) + 1):
                 sxx_lag[m - 1, :-m] += np.einsum("sf,sf->f", xc[0, :, :-m], x[0, :, m:])
-        if products is not None:
-            _add_error_products(products, y[0] * xc[0], (x[0] * xc[0]).real)
-    return SpectralSums(sxx, syx, syy, int(starts.size), sxx_lag, square, products)
+        if products is not None or keep_records:
+            cross, power = y[0] * xc[0], (x[0] * xc[0]).real
+            if products is not None:
+                _add_error_products(products, cross, power)
+            if keep_records:
+                record_cross[first:first + chunk.size], record_power[first:first + chunk.size] = cross, power
+    return SpectralSums(sxx, syx, syy, int(starts.size), sxx_lag, square, products, record_cross, record_power)
 
 
 def _add_error_products(products: np.ndarray, cross: np.ndarray, power: np.ndarray) -> None:

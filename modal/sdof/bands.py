@@ -14,7 +14,7 @@ from ..whitening import LineWhitening
 from ..peaks import ModeBand
 from ..units import TWO_PI
 
-__all__ = ["POLE_CHANNELS", "band_mask", "band_run", "band_lines", "regions", "band_data", "band_peaks",
+__all__ = ["POLE_CHANNELS", "band_mask", "band_run", "band_lines", "regions", "band_data", "band_influence", "band_peaks",
            "channel_weights", "strongest_channels", "band_noise", "line_weight", "line_whitening",
            "constants_at_poles"]
 
@@ -183,6 +183,17 @@ def line_whitening(frf, bands):
         _WHITENINGS.clear()
     _WHITENINGS[key] = (model, whitening)
     return whitening
+
+
+def band_influence(frf, bands):
+    """Each record's share of the error on the bands' lines, (n_records, n_lines), and the records each overlaps,
+    for a one-channel FRF whose noise model carries them (:mod:`modal.estimate.record_influence`); else
+    (None, 0)."""
+    model = frf.noise_model
+    if model is None or model.record_influence is None or frf.n_channels != 1:
+        return None, 0
+    keep, _ = regions(bands, frf.frequency_hz)
+    return model.record_influence[:, keep], model.overlapping_records
 
 
 #: the last whitenings made (the fits of one identification share them), by noise model and lines

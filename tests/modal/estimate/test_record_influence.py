@@ -1,0 +1,81 @@
+"""Each record's share of a continuous estimate's error (modal.estimate.record_influence), carried by its noise
+model, and what identification says about the errors it reports from them."""
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+import modal
+from modal.estimate import core
+from modal.estimate.windows import segment_window
+from modal.synthetic_time import DigitalModes, random_record
+
+FS = 1024.0
+PLANT = DigitalModes(np.array([40.0, 95.0]), np.array([0.02, 0.012]), np.array([0.5, 0.8]), FS)
+
+
+@pytest.fixture(scope="module")
+def record():
+    return random_record(PLANT, 60.0, response_noise=0.05, seed=7).record
+
+
+def _estimate(record, **options):
+    return modal.estimate_frf(record.signals[0], record.signals[1], FS, kind="accelerance", **options)
+
+
+def test_influences_are_each_records_share_of_the_error(record):
+    frf = _estimate(record)
+    model = frf.noise_model
+    length, step = frf.segment_length, frf.segment_length // 2
+    starts = np.arange(0, record.signals.shape[1] - length + 1, step)
+    assert model.record_influence.shape == (starts.size, frf.frequency_hz.size)
+    assert model.overlapping_records == 1 and not model.influence_withheld
+    # one record's share from its own transforms: ψ = (Y − Ĥ X) conj(X) / Σ|X|²
+    window = segment_window("hann", length)
+    x = np.fft.rfft(record.signals[0, starts[:, None] + np.arange(length)] * window, axis=-1)
+    y = np.fft.rfft(record.signals[1, starts[:, None] + np.arange(length)] * window, axis=-1)
+    expected = (y[5] - frf.response * x[5]) * x[5].conj() / np.sum(np.abs(x) ** 2, axis=0)
+    scale = np.abs(expected).max()
+    np.testing.assert_allclose(model.record_influence[5], expected, rtol=0, atol=1e-9 * scale)
+    # H1 leaves no residual correlated with the excitation: the shares sum to zero at every line
+    assert np.abs(model.record_influence.sum(axis=0)).max() <= 1e-9 * scale
+
+
+def test_few_records_hits_and_a_full_budget_carry_none(record, monkeypatch):
+    short = _estimate(record, segment_length=16384)  # 6 records
+    assert short.noise_model.record_influence is None and not short.noise_model.influence_withheld
+    monkeypatch.setattr(core, "MAX_INFLUENCE_VALUES", 1000)
+    withheld = _estimate(record)
+    assert withheld.noise_model.record_influence is None and withheld.noise_model.influence_withheld
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        result = modal.identify(withheld)
+    assert "memory budget" in result.settings["pole_errors"]
+
+
+def test_identify_reports_errors_measured_over_the_records(record):
+    frf = _estimate(record)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        result = modal.identify(frf)
+    n = frf.noise_model.record_influence.shape[0]
+    assert result.settings["pole_errors"].startswith(f"measured over the {n} records")
+
+
+def test_conversions_and_crops_carry_the_influences(record):
+    frf = _estimate(record)
+    influence = frf.noise_model.record_influence
+    keep = (frf.frequency_hz >= 20) & (frf.frequency_hz <= 150)
+    np.testing.assert_array_equal(frf.cropped(20, 150).noise_model.record_influence, influence[:, keep])
+    cropped = frf.cropped(20, 150)
+    receptance = cropped.as_kind("receptance")
+    np.testing.assert_allclose(receptance.noise_model.record_influence,
+                               cropped.noise_model.record_influence * (1j * cropped.omega_rad_s) ** -2)
+    # the response measured as acceleration, the FRF asked as receptance: the influences convert with it
+    direct = modal.estimate_frf(record.signals[0], record.signals[1], FS, kind="receptance",
+                                response_quantity="acceleration")
+    omega = direct.omega_rad_s
+    np.testing.assert_allclose(direct.noise_model.record_influence, influence[:, 1:] * (1j * omega) ** -2,
+                               rtol=1e-9, atol=1e-12 * np.abs(influence[:, 1:] / omega**2).max())
