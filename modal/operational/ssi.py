@@ -231,13 +231,14 @@ class Perturbation:
 
         inner = unflat(solve_triangular(Rn, flat(up_resid), trans="T"))
         dA = unflat(solve_triangular(Rn, flat(q_down - q_up @ A + inner)))
-        Wm = np.linalg.inv(psi) @ dA @ psi  # (blocks, n, n): Ψ⁻¹ ΔA Ψ
+        # W = Ψ⁻¹ ΔA Ψ, only its columns of the poles asked for: (blocks, n, picks)
+        Wm = np.linalg.inv(psi) @ (dA @ psi[:, idx])
         picks = np.arange(idx.size)
-        d_mu = Wm[:, idx, idx]
+        d_mu = Wm[:, idx, picks]
         d_lam = d_mu / mu[idx][None, :] * model.sample_rate_hz
         # eigenvectors: Δψ_i = Σ_{k≠i} ψ_k W_ki / (μ_i − μ_k)
         with np.errstate(divide="ignore", invalid="ignore"):
-            coupling = Wm[:, :, idx] / (mu[idx][None, None, :] - mu[None, :, None])  # (blocks, n, picks)
+            coupling = Wm / (mu[idx][None, None, :] - mu[None, :, None])  # (blocks, n, picks)
         coupling[:, idx, picks] = 0.0
         coupling = np.where(np.isfinite(coupling), coupling, 0.0)
         C = U1[:l]
