@@ -74,12 +74,11 @@ def hankel(R: np.ndarray, block_rows: int, block_cols: int | None = None) -> np.
     """
     p = block_rows
     q = block_rows if block_cols is None else block_cols
-    a = np.arange(p + 1)[:, None]
-    b = np.arange(q)[None, :]
-    blocks = R[..., a + b + 1, :, :]  # (..., p+1, q, l, r)
-    lead = blocks.shape[:-4]
-    l, r = blocks.shape[-2:]
-    return np.swapaxes(blocks, -3, -2).reshape(*lead, (p + 1) * l, q * r)
+    # a view (..., p+1, l, r, q) of lags a+1…a+q for block row a, put in order and copied once by the reshape
+    windows = np.lib.stride_tricks.sliding_window_view(R[..., 1:p + q + 1, :, :], q, axis=-3)
+    lead = R.shape[:-3]
+    l, r = R.shape[-2:]
+    return np.swapaxes(windows, -2, -1).reshape(*lead, (p + 1) * l, q * r)
 
 
 def subspace_model(R: np.ndarray, block_rows: int, max_order: int, sample_rate_hz: float,
