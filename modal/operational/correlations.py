@@ -162,7 +162,9 @@ def choose_references(signals: np.ndarray, n_references: int, probe_lags: int = 
     piece = np.array(signals[:, : min(n, probe_samples + probe_lags)], dtype=np.float32)
     piece /= np.sqrt(np.mean(piece**2, axis=1, keepdims=True))
     m = piece.shape[1] - probe_lags
-    lagged = np.lib.stride_tricks.sliding_window_view(piece, m, axis=1)[:, 1:]  # (n_out, lags 1…, m)
-    columns = lagged.reshape(-1, m) @ piece[:, :m].T  # one column per candidate reference
+    # one column per candidate reference, the rows (channel, lag) for lags 1…probe_lags: one product per lag,
+    # each from the piece itself (no lagged copy of it)
+    columns = np.stack([piece[:, k:k + m] @ piece[:, :m].T for k in range(1, probe_lags + 1)], axis=1)
+    columns = columns.reshape(n_out * probe_lags, n_out)
     _, _, pivots = qr(columns.astype(float), mode="economic", pivoting=True)
     return tuple(sorted(int(p) for p in pivots[:n_references]))
