@@ -123,25 +123,13 @@ def check_channels(signals: np.ndarray, src: str, names=(), dtype=float,
         The channels with their means removed (a new array; each divided by its RMS with ``unit_rms``) and
         their RMS about the mean.
     """
-    if signals.ndim != 2:
-        raise ParameterError(f"{src}: 'data' has shape {signals.shape}; expected (n_channels, n_samples)")
-    if signals.shape[0] < 2:
-        raise ParameterError(f"{src}: {signals.shape[0]} channel; operational modal analysis needs at least 2 "
-                             "response channels (data of shape (n_channels, n_samples))")
+    _check_shape(signals, src)
     centred = np.empty(signals.shape, dtype)
     rms = np.empty(signals.shape[0])
     n = signals.shape[1]
     buffer = np.empty(min(n, CHUNK_SAMPLES))
     for ch, row in enumerate(signals):  # channel by channel: no temporary as large as the record
-        mean = row.mean(dtype=np.float64)  # each channel's arithmetic in double, whatever it is stored in
-        if not np.isfinite(mean):  # a NaN or infinite sample (or finite ones whose sum overflows)
-            bad = ~np.isfinite(signals)
-            if bad.any():
-                ch, i = (int(v) for v in np.argwhere(bad)[0])
-                raise ParameterError(f"{src}: channel {ch + 1}{_name(names, ch)}, sample {i}: {signals[ch, i]}; "
-                                     f"expected finite samples ({int(bad.sum())} are not)")
-            raise ParameterError(f"{src}: channel {ch + 1}{_name(names, ch)}: samples up to {np.abs(row).max():g}; "
-                                 "expected values whose sum fits double precision (rescale the record)")
+        mean = _finite_mean(signals, ch, src, names)
         squares = 0.0
         for start in range(0, n, CHUNK_SAMPLES):
             piece = buffer[:min(CHUNK_SAMPLES, n - start)]
@@ -157,6 +145,45 @@ def check_channels(signals: np.ndarray, src: str, names=(), dtype=float,
         raise ParameterError(f"{src}: channel(s) {listing} constant; expected a varying response on every channel "
                              "(drop dead channels)")
     return centred, rms
+
+
+def _check_shape(signals: np.ndarray, src: str) -> None:
+    if signals.ndim != 2:
+        raise ParameterError(f"{src}: 'data' has shape {signals.shape}; expected (n_channels, n_samples)")
+    if signals.shape[0] < 2:
+        raise ParameterError(f"{src}: {signals.shape[0]} channel; operational modal analysis needs at least 2 "
+                             "response channels (data of shape (n_channels, n_samples))")
+
+
+def _finite_mean(signals: np.ndarray, ch: int, src: str, names) -> float:
+    """Channel ``ch``'s mean in double precision, whatever it is stored in; refused, naming the first NaN or
+    infinite sample of the record, when it is not finite (or naming the channel when its finite samples' sum
+    overflows)."""
+    row = signals[ch]
+    mean = row.mean(dtype=np.float64)
+    if not np.isfinite(mean):
+        bad = ~np.isfinite(signals)
+        if bad.any():
+            ch, i = (int(v) for v in np.argwhere(bad)[0])
+            raise ParameterError(f"{src}: channel {ch + 1}{_name(names, ch)}, sample {i}: {signals[ch, i]}; "
+                                 f"expected finite samples ({int(bad.sum())} are not)")
+        raise ParameterError(f"{src}: channel {ch + 1}{_name(names, ch)}: samples up to {np.abs(row).max():g}; "
+                             "expected values whose sum fits double precision (rescale the record)")
+    return mean
+
+
+def _centred_decimated(signals: np.ndarray, factor: int, src: str, names) -> np.ndarray:
+    """Each channel less its mean (in double precision), decimated by ``factor``: one channel at a time, so that
+    no double-precision copy of the whole record is made (a 10⁶ × 64 record's would be 512 MB)."""
+    _check_shape(signals, src)
+    out = None
+    for ch in range(signals.shape[0]):
+        mean = _finite_mean(signals, ch, src, names)
+        reduced = decimate((signals[ch] - mean)[None, :], factor)[0]
+        if out is None:
+            out = np.empty((signals.shape[0], reduced.size))
+        out[ch] = reduced
+    return out
 
 
 def _name(names, ch) -> str:
@@ -185,8 +212,7 @@ def prepare(data, sample_rate_hz=None, band_hz=None, quantity: str | None = None
     # single precision from here on (the correlations' FFTs are single precision anyway: their rounding, 1e-7,
     # lies far below the estimates' scatter); a record to be decimated is filtered in double first
     if factor > 1:
-        centred, _ = check_channels(signals, src, names, dtype=float)
-        work = decimate(centred, factor)
+        work = _centred_decimated(signals, factor, src, names)
         if work.shape[1] < 2:
             raise ParameterError(f"{src}: {signals.shape[1]} samples; too short a record for the band up to "
                                  f"{high:g} Hz")
