@@ -125,16 +125,18 @@ def correlations(signals: np.ndarray, sample_rate_hz: float, references, max_lag
     # float32 FFTs: their rounding (1e-7 relative) lies far below the estimates' scatter (1/√samples)
     data = np.ascontiguousarray(signals, dtype=np.float32)
     windows = np.lib.stride_tricks.sliding_window_view(data, n_seg + max_lag, axis=1)
-    spectra = np.empty((n_blocks, n_out, refs.size, n_fft // 2 + 1), np.complex64)
+    spectra = np.empty((n_blocks, n_fft // 2 + 1, n_out, refs.size), np.complex64)
     for b in range(n_blocks):
-        ext = windows[:, edges[b] * n_seg:(edges[b + 1] - 1) * n_seg + 1:n_seg]  # (n_out, segs, n_seg + lag)
-        future = sfft.rfft(ext, n=n_fft, axis=-1)  # every output, extended by the longest lag
-        past = sfft.rfft(ext[refs, :, :n_seg], n=n_fft, axis=-1)  # the references' segments, zero-padded
+        # (samples, n_out, segs): transformed along the first axis, the spectra come out line by line, each
+        # line's (outputs × segments) matrix contiguous for the product below
+        ext = windows[:, edges[b] * n_seg:(edges[b + 1] - 1) * n_seg + 1:n_seg].transpose(2, 0, 1)
+        future = sfft.rfft(ext, n=n_fft, axis=0)  # every output, extended by the longest lag
+        past = sfft.rfft(ext[:n_seg, refs], n=n_fft, axis=0)  # the references' segments, zero-padded
         # Σ over the block's segments of Y_o(f) conj(X_r(f)): one (outputs × segments)(segments × refs)
         # product per line
-        spectra[b] = np.matmul(future.transpose(2, 0, 1), past.conj().transpose(2, 1, 0)).transpose(1, 2, 0)
-    lagged = sfft.irfft(spectra, n=n_fft, axis=-1)[..., :max_lag + 1]  # (blocks, n_out, refs, lags)
-    lagged = np.ascontiguousarray(np.moveaxis(lagged, -1, 1), dtype=float)
+        np.matmul(future, past.conj().transpose(0, 2, 1), out=spectra[b])
+    lagged = sfft.irfft(spectra, n=n_fft, axis=1)[:, :max_lag + 1]  # (blocks, lags, n_out, refs)
+    lagged = lagged.astype(float)
     weights = (np.diff(edges) * n_seg).astype(float)
     return Correlations(lagged / weights[:, None, None, None], weights, float(sample_rate_hz),
                         tuple(int(r) for r in refs))
@@ -160,7 +162,9 @@ def choose_references(signals: np.ndarray, n_references: int, probe_lags: int = 
     piece = np.array(signals[:, : min(n, probe_samples + probe_lags)], dtype=np.float32)
     piece /= np.sqrt(np.mean(piece**2, axis=1, keepdims=True))
     m = piece.shape[1] - probe_lags
-    lagged = np.lib.stride_tricks.sliding_window_view(piece, m, axis=1)[:, 1:]  # (n_out, lags 1…, m)
-    columns = lagged.reshape(-1, m) @ piece[:, :m].T  # one column per candidate reference
+    # one column per candidate reference, the rows (channel, lag) for lags 1…probe_lags: one product per lag,
+    # each from the piece itself (no lagged copy of it)
+    columns = np.stack([piece[:, k:k + m] @ piece[:, :m].T for k in range(1, probe_lags + 1)], axis=1)
+    columns = columns.reshape(n_out * probe_lags, n_out)
     _, _, pivots = qr(columns.astype(float), mode="economic", pivoting=True)
     return tuple(sorted(int(p) for p in pivots[:n_references]))

@@ -20,6 +20,9 @@ __all__ = ["Prepared", "prepare", "check_band", "check_channels"]
 CONSTANT_CHANNEL = 1e-12
 #: the record must hold at least this many times the longest correlation lag
 MIN_LAGS_IN_RECORD = 40
+#: the input check centres each channel this many samples at a time, in a double-precision buffer (512 kB)
+#: that stays in cache while the piece is centred, squared and stored
+CHUNK_SAMPLES = 1 << 16
 
 
 @dataclass(frozen=True)
@@ -107,40 +110,81 @@ def check_band(band_hz, nyquist_hz: float, src: str) -> tuple[float, float]:
     return low, high
 
 
-def check_channels(signals: np.ndarray, src: str, names=(), dtype=float) -> tuple[np.ndarray, np.ndarray]:
+def check_channels(signals: np.ndarray, src: str, names=(), dtype=float,
+                   unit_rms: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """Two or more channels of finite samples, none constant.
+
+    Each channel is read from memory twice: once for its mean, once more :data:`CHUNK_SAMPLES` at a time,
+    each piece centred in double precision in a buffer that stays in cache, its squares summed and the piece
+    stored in ``dtype``; with ``unit_rms`` the stored channel, still in cache, is then divided by its RMS.
 
     Returns
     -------
     (centred, rms) : ndarray (n_channels, n_samples) of ``dtype``, ndarray (n_channels,)
-        The channels with their means removed (in double precision, a new array) and their RMS about the mean.
+        The channels with their means removed (a new array; each divided by its RMS with ``unit_rms``) and
+        their RMS about the mean.
     """
-    if signals.ndim != 2:
-        raise ParameterError(f"{src}: 'data' has shape {signals.shape}; expected (n_channels, n_samples)")
-    if signals.shape[0] < 2:
-        raise ParameterError(f"{src}: {signals.shape[0]} channel; operational modal analysis needs at least 2 "
-                             "response channels (data of shape (n_channels, n_samples))")
+    _check_shape(signals, src)
     centred = np.empty(signals.shape, dtype)
     rms = np.empty(signals.shape[0])
+    n = signals.shape[1]
+    buffer = np.empty(min(n, CHUNK_SAMPLES))
     for ch, row in enumerate(signals):  # channel by channel: no temporary as large as the record
-        mean = row.mean(dtype=np.float64)  # each channel's arithmetic in double, whatever it is stored in
-        if not np.isfinite(mean):  # a NaN or infinite sample (or finite ones whose sum overflows)
-            bad = ~np.isfinite(signals)
-            if bad.any():
-                ch, i = (int(v) for v in np.argwhere(bad)[0])
-                raise ParameterError(f"{src}: channel {ch + 1}{_name(names, ch)}, sample {i}: {signals[ch, i]}; "
-                                     f"expected finite samples ({int(bad.sum())} are not)")
-            raise ParameterError(f"{src}: channel {ch + 1}{_name(names, ch)}: samples up to {np.abs(row).max():g}; "
-                                 "expected values whose sum fits double precision (rescale the record)")
-        row = row - mean
-        rms[ch] = np.sqrt(np.dot(row, row) / row.size)
-        centred[ch] = row
+        mean = _finite_mean(signals, ch, src, names)
+        squares = 0.0
+        for start in range(0, n, CHUNK_SAMPLES):
+            piece = buffer[:min(CHUNK_SAMPLES, n - start)]
+            np.subtract(row[start:start + CHUNK_SAMPLES], mean, out=piece)
+            squares += np.dot(piece, piece)
+            centred[ch, start:start + CHUNK_SAMPLES] = piece
+        rms[ch] = np.sqrt(squares / n)
+        if unit_rms and rms[ch] > 0:  # (a constant channel is refused below)
+            centred[ch] /= centred.dtype.type(rms[ch])
     constant = np.flatnonzero(~(rms > CONSTANT_CHANNEL * rms.max()))
     if constant.size:
         listing = ", ".join(f"{k + 1}{_name(names, k)}" for k in constant)
         raise ParameterError(f"{src}: channel(s) {listing} constant; expected a varying response on every channel "
                              "(drop dead channels)")
     return centred, rms
+
+
+def _check_shape(signals: np.ndarray, src: str) -> None:
+    if signals.ndim != 2:
+        raise ParameterError(f"{src}: 'data' has shape {signals.shape}; expected (n_channels, n_samples)")
+    if signals.shape[0] < 2:
+        raise ParameterError(f"{src}: {signals.shape[0]} channel; operational modal analysis needs at least 2 "
+                             "response channels (data of shape (n_channels, n_samples))")
+
+
+def _finite_mean(signals: np.ndarray, ch: int, src: str, names) -> float:
+    """Channel ``ch``'s mean in double precision, whatever it is stored in; refused, naming the first NaN or
+    infinite sample of the record, when it is not finite (or naming the channel when its finite samples' sum
+    overflows)."""
+    row = signals[ch]
+    mean = row.mean(dtype=np.float64)
+    if not np.isfinite(mean):
+        bad = ~np.isfinite(signals)
+        if bad.any():
+            ch, i = (int(v) for v in np.argwhere(bad)[0])
+            raise ParameterError(f"{src}: channel {ch + 1}{_name(names, ch)}, sample {i}: {signals[ch, i]}; "
+                                 f"expected finite samples ({int(bad.sum())} are not)")
+        raise ParameterError(f"{src}: channel {ch + 1}{_name(names, ch)}: samples up to {np.abs(row).max():g}; "
+                             "expected values whose sum fits double precision (rescale the record)")
+    return mean
+
+
+def _centred_decimated(signals: np.ndarray, factor: int, src: str, names) -> np.ndarray:
+    """Each channel less its mean (in double precision), decimated by ``factor``: one channel at a time, so that
+    no double-precision copy of the whole record is made (a 10⁶ × 64 record's would be 512 MB)."""
+    _check_shape(signals, src)
+    out = None
+    for ch in range(signals.shape[0]):
+        mean = _finite_mean(signals, ch, src, names)
+        reduced = decimate((signals[ch] - mean)[None, :], factor)[0]
+        if out is None:
+            out = np.empty((signals.shape[0], reduced.size))
+        out[ch] = reduced
+    return out
 
 
 def _name(names, ch) -> str:
@@ -171,16 +215,14 @@ def prepare(data, sample_rate_hz=None, band_hz=None, quantity: str | None = None
     factor = decimation_factor(rate, high)
     # single precision from here on (the correlations' FFTs are single precision anyway: their rounding, 1e-7,
     # lies far below the estimates' scatter); a record to be decimated is filtered in double first
-    centred, scale = check_channels(signals, src, names, dtype=np.float32 if factor == 1 else float)
-    if screen:
-        screen_samples(signals, rate, names, src)
     if factor > 1:
-        work = decimate(centred, factor)
+        work = _centred_decimated(signals, factor, src, names)
         if work.shape[1] < 2:
             raise ParameterError(f"{src}: {signals.shape[1]} samples; too short a record for the band up to "
                                  f"{high:g} Hz")
-        work, scale = check_channels(work, src, names, dtype=np.float32)
     else:
-        work = centred
-    work /= scale[:, None].astype(np.float32)
+        work = signals
+    work, scale = check_channels(work, src, names, dtype=np.float32, unit_rms=True)
+    if screen:  # on the samples as recorded, known finite by now
+        screen_samples(signals, rate, names, src)
     return Prepared(work, rate / factor, scale, (low, high), factor, rate, quantity or file_quantity, names, src)

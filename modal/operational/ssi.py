@@ -74,12 +74,11 @@ def hankel(R: np.ndarray, block_rows: int, block_cols: int | None = None) -> np.
     """
     p = block_rows
     q = block_rows if block_cols is None else block_cols
-    a = np.arange(p + 1)[:, None]
-    b = np.arange(q)[None, :]
-    blocks = R[..., a + b + 1, :, :]  # (..., p+1, q, l, r)
-    lead = blocks.shape[:-4]
-    l, r = blocks.shape[-2:]
-    return np.swapaxes(blocks, -3, -2).reshape(*lead, (p + 1) * l, q * r)
+    # a view (..., p+1, l, r, q) of lags a+1…a+q for block row a, put in order and copied once by the reshape
+    windows = np.lib.stride_tricks.sliding_window_view(R[..., 1:p + q + 1, :, :], q, axis=-3)
+    lead = R.shape[:-3]
+    l, r = R.shape[-2:]
+    return np.swapaxes(windows, -2, -1).reshape(*lead, (p + 1) * l, q * r)
 
 
 def subspace_model(R: np.ndarray, block_rows: int, max_order: int, sample_rate_hz: float,
@@ -162,9 +161,9 @@ class Perturbation:
         dH = hankel(d_R, model.block_rows, model.block_cols)
         G = dH @ V[:, :top]  # (blocks, p, top): ΔH V₁ for every order up to top
         B_right = np.swapaxes(U.T @ G, 1, 2)  # (blocks, top, k): (Uᵀ ΔH V₁)ᵀ
-        self.B_right = B_right.astype(float)
+        self.B_right = B_right  # kept in single precision, as are the products of each order with it
         E = G - U @ np.swapaxes(B_right, 1, 2)  # the part of ΔH V₁ outside the range of H
-        self.B_left = ((np.swapaxes(U[:, :top], 0, 1) @ dH) @ V).astype(float)  # (blocks, top, k): U₁ᵀ ΔH V
+        self.B_left = (np.swapaxes(U[:, :top], 0, 1) @ dH) @ V  # (blocks, top, k): U₁ᵀ ΔH V
         # E enters every order only through its first l rows and these projections, whose leading n × n
         # blocks are those of order n: formed once for all orders
         l, rows = model.n_outputs, model.n_outputs * model.block_rows
@@ -197,10 +196,13 @@ class Perturbation:
         # U₂ᵀ ΔH V₁ and (U₁ᵀ ΔH V₂)ᵀ, each (blocks, k − n, n)
         left = np.swapaxes(self.B_right[:, :n, n:], 1, 2)
         right = np.swapaxes(self.B_left[:, :n, n:], 1, 2)
+        single = np.float32
         with np.errstate(divide="ignore", invalid="ignore"):
-            gap = s1[None, :] ** 2 - s2[:, None] ** 2  # (k − n, n)
-            inside = (left * s1[None, None, :] + s2[None, :, None] * right) / gap
-        inside = np.where(np.isfinite(inside), inside, 0.0)
+            # the gaps in double precision (close singular values), the rest in single, as the deviations
+            inverse_gap = (1.0 / (s1[None, :] ** 2 - s2[:, None] ** 2)).astype(single)  # (k − n, n)
+            inside = (left * s1[None, None, :].astype(single) + s2[None, :, None].astype(single) * right) \
+                * inverse_gap
+        inside = np.where(np.isfinite(inside), inside, single(0.0))
         # each perturbed singular vector's part outside the signal subspace, ΔU₁ = U₂ inside + E/σ₁ (the
         # part inside only rotates the basis, which leaves the eigenvalues and the observed shapes as they
         # are). ΔU₁ enters only projected: Qᵀ ΔO_down, Qᵀ ΔO_up, ΔO_upᵀ (O_down − O_up A) and its first l
@@ -212,11 +214,12 @@ class Perturbation:
         U1, U2 = U[:, :n], U[:, n:]
         resid = U1[l:] - U1[:rows] @ A
         per_column = s1[None, None, :]
-        q_down = Qn.T @ U2[l:] @ inside + self.QtE_down[:, :n, :n] / per_column  # (blocks, n, n): Qᵀ ΔO_down
-        q_up = Qn.T @ U2[:rows] @ inside + self.QtE_up[:, :n, :n] / per_column  # Qᵀ ΔO_up
-        up_resid = np.swapaxes(inside, 1, 2) @ (U2[:rows].T @ resid) \
+        # the products with `inside` (blocks × (k − n) × n each) in single precision, their sums in double
+        q_down = (Qn.T @ U2[l:]).astype(single) @ inside + self.QtE_down[:, :n, :n] / per_column  # Qᵀ ΔO_down
+        q_up = (Qn.T @ U2[:rows]).astype(single) @ inside + self.QtE_up[:, :n, :n] / per_column  # Qᵀ ΔO_up
+        up_resid = np.swapaxes(inside, 1, 2) @ (U2[:rows].T @ resid).astype(single) \
             + (self.EtU_down[:, :n, :n] - self.EtU_up[:, :n, :n] @ A) / s1[None, :, None]  # ΔO_upᵀ (O_down − O_up A)
-        d_C = U2[:l] @ inside + self.E_C[:, :, :n] / per_column  # (blocks, l, n)
+        d_C = U2[:l].astype(single) @ inside + self.E_C[:, :, :n] / per_column  # (blocks, l, n)
         # ΔA = R⁻¹ [Qᵀ (ΔO_down − ΔO_up A) + R⁻ᵀ ΔO_upᵀ (O_down − O_up A)], R upper triangular: two
         # triangular solves for all blocks at once
         from scipy.linalg import solve_triangular
@@ -231,13 +234,14 @@ class Perturbation:
 
         inner = unflat(solve_triangular(Rn, flat(up_resid), trans="T"))
         dA = unflat(solve_triangular(Rn, flat(q_down - q_up @ A + inner)))
-        Wm = np.linalg.inv(psi) @ dA @ psi  # (blocks, n, n): Ψ⁻¹ ΔA Ψ
+        # W = Ψ⁻¹ ΔA Ψ, only its columns of the poles asked for: (blocks, n, picks)
+        Wm = np.linalg.inv(psi) @ (dA @ psi[:, idx])
         picks = np.arange(idx.size)
-        d_mu = Wm[:, idx, idx]
+        d_mu = Wm[:, idx, picks]
         d_lam = d_mu / mu[idx][None, :] * model.sample_rate_hz
         # eigenvectors: Δψ_i = Σ_{k≠i} ψ_k W_ki / (μ_i − μ_k)
         with np.errstate(divide="ignore", invalid="ignore"):
-            coupling = Wm[:, :, idx] / (mu[idx][None, None, :] - mu[None, :, None])  # (blocks, n, picks)
+            coupling = Wm / (mu[idx][None, None, :] - mu[None, :, None])  # (blocks, n, picks)
         coupling[:, idx, picks] = 0.0
         coupling = np.where(np.isfinite(coupling), coupling, 0.0)
         C = U1[:l]

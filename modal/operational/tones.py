@@ -110,13 +110,12 @@ def nearly_undamped(estimate: PoleEstimate) -> bool:
     return bool(zeta < TONE_DAMPING and (zeta + margin < TONE_DAMPING or zeta < margin))
 
 
-def _evidence(estimate: PoleEstimate, prepared: Prepared, spectra: dict, resolution_hz: float | None):
-    """(nearly zero damping, band-passed response non-Gaussian) for one estimate; ``spectra`` caches each
-    channel's FFT."""
+def _band_is_peaky(estimate: PoleEstimate, prepared: Prepared, spectra: dict, resolution_hz: float | None) -> bool:
+    """Whether the response band-passed around one estimate is non-Gaussian (kurtosis below
+    :data:`KURTOSIS_LIMIT`); ``spectra`` caches each channel's FFT."""
     from scipy.fft import rfft
 
     zeta = estimate.damping_ratio if np.isfinite(estimate.damping_ratio) else 0.0
-    undamped = nearly_undamped(estimate)
     f = estimate.natural_frequency_hz
     channel = int(np.argmax(np.abs(estimate.shape) / prepared.scale))  # where it is strongest against the rest
     width = max(4 * max(zeta, 0.0) * f, MIN_BANDWIDTH_TIME / prepared.duration_s)
@@ -124,11 +123,11 @@ def _evidence(estimate: PoleEstimate, prepared: Prepared, spectra: dict, resolut
     if channel not in spectra:
         spectra[channel] = rfft(prepared.signals[channel])
     centre = f
-    if (undamped or not estimate.damping_known) and resolution_hz:
+    if (nearly_undamped(estimate) or not estimate.damping_known) and resolution_hz:
         centre = strongest_line_hz(spectra[channel], n, prepared.sample_rate_hz, f - resolution_hz / 2,
                                    f + resolution_hz / 2)
     kurtosis = band_kurtosis(spectra[channel], n, prepared.sample_rate_hz, centre, width)
-    return bool(undamped), bool(np.isfinite(kurtosis) and kurtosis < KURTOSIS_LIMIT)
+    return bool(np.isfinite(kurtosis) and kurtosis < KURTOSIS_LIMIT)
 
 
 def separate_tones(estimates: list[PoleEstimate], prepared: Prepared, rotor_speed_hz: float | None,
@@ -145,19 +144,27 @@ def separate_tones(estimates: list[PoleEstimate], prepared: Prepared, rotor_spee
         The estimates in the same order, those on a harmonic that are not tones with the flag added.
     """
     spectra: dict = {}
-    evidence = [_evidence(e, prepared, spectra, resolution_hz) for e in estimates]
+    peaky: dict[int, bool] = {}
+
+    def is_peaky(k: int) -> bool:  # the kurtosis costs a record-long FFT: taken only where it decides
+        if k not in peaky:
+            peaky[k] = _band_is_peaky(estimates[k], prepared, spectra, resolution_hz)
+        return peaky[k]
+
+    undamped = [nearly_undamped(e) for e in estimates]
     fundamental = rotor_speed_hz
     if fundamental is None:
         # the tones the data show clearly: nearly undamped and non-Gaussian (or non-Gaussian where the method
         # measures no damping)
-        clear = [(e.natural_frequency_hz, e.std_frequency_hz) for e, (a, b) in zip(estimates, evidence)
-                 if b and (a or not e.damping_known)]
+        clear = [(e.natural_frequency_hz, e.std_frequency_hz) for k, e in enumerate(estimates)
+                 if (undamped[k] or not e.damping_known) and is_peaky(k)]
         fundamental = _fundamental([f for f, _ in clear], [s for _, s in clear])
     is_tone, out = [], []
-    for estimate, (undamped, peaky) in zip(estimates, evidence):
+    for k, estimate in enumerate(estimates):
         on_comb = fundamental is not None and harmonic_of(estimate.natural_frequency_hz,
                                                           estimate.std_frequency_hz, fundamental) > 0
-        tone = undamped + peaky + on_comb >= 2
+        others = undamped[k] + on_comb  # two of the three pieces of evidence make a tone
+        tone = others == 2 or (others == 1 and is_peaky(k))
         is_tone.append(tone)
         out.append(replace(estimate, flags=estimate.flags | {"harmonic"}) if on_comb and not tone else estimate)
     return is_tone, out

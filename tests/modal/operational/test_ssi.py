@@ -70,3 +70,15 @@ def test_hankel_blocks():
     for a in range(4):
         for b in range(3):
             assert np.array_equal(H[2 * a:2 * a + 2, b], R[a + b + 1, :, 0])
+
+
+def test_hankel_blocks_of_many_records_with_more_lags_than_used():
+    # a stack of 3 blocks' correlations, 3 outputs × 2 references, p = 2 block rows and q = 4 block columns:
+    # block (a, b) holds lag a + b + 1 of its own record; the lags beyond p + q are not used
+    R = np.random.default_rng(0).standard_normal((3, 12, 3, 2))
+    H = hankel(R, 2, 4)
+    assert H.shape == (3, 9, 8)
+    for blk in range(3):
+        for a in range(3):
+            for b in range(4):
+                assert np.array_equal(H[blk, 3 * a:3 * a + 3, 2 * b:2 * b + 2], R[blk, a + b + 1])

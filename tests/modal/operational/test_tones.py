@@ -80,3 +80,29 @@ def test_a_damped_mode_is_judged_on_its_own_band_even_beside_a_tone():
     # the same line judged as a tone's pole (undamped) is one
     tone = _estimate(21.5, 0.0, 0.0005, 2)
     assert separate_tones([tone], prepared, None, resolution_hz=fs / 20)[0] == [True]
+
+
+def test_the_kurtosis_is_taken_only_where_it_decides(monkeypatch):
+    # damped poles with no tone to set a fundamental (and no running speed) cannot be tones whatever their
+    # kurtosis: no record-long FFT is taken for them. With a running speed, a damped pole on its comb has one
+    # piece of evidence and is judged on its kurtosis; one off the comb is not
+    from modal.operational import tones
+
+    fs, n = 200.0, 40_000
+    rec = ambient_modal_response([20.0, 33.0], [0.02, 0.02], np.array([[1.0, 0.5], [0.6, -1.0]]), fs, n,
+                                 noise=0.1, seed=6)
+    prepared = prepare(rec.signals, fs, (2.0, 50.0))
+    modes = [_estimate(20.0, 0.02, 0.002, 2), _estimate(33.0, 0.02, 0.002, 2)]
+    judged = []
+    real = tones._band_is_peaky
+
+    def counting(estimate, *args):
+        judged.append(estimate.natural_frequency_hz)
+        return real(estimate, *args)
+
+    monkeypatch.setattr(tones, "_band_is_peaky", counting)
+    is_tone, out = separate_tones(modes, prepared, None, resolution_hz=fs / 20)
+    assert is_tone == [False, False] and judged == []
+    is_tone, out = separate_tones(modes, prepared, 10.0, resolution_hz=fs / 20)
+    assert judged == [20.0] and is_tone == [False, False]
+    assert "harmonic" in out[0].flags and "harmonic" not in out[1].flags
