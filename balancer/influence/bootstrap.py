@@ -47,7 +47,8 @@ def redrawn_jobs(initial, trial_runs, trial_unbalance_kg_m, reading_noise: float
     v0_b = redraw(v0, reading_noise, rng)
     runs_b = redraw(runs, reading_noise, rng)
     alpha_b = np.swapaxes(runs_b - v0_b[:, None, :], 1, 2) / trials
-    u_b = np.stack([np.linalg.lstsq(a * w[:, None], -v * w, rcond=None)[0] for a, v in zip(alpha_b, v0_b)])
+    # least squares of every draw at once, through the stacked pseudo-inverses (lstsq does not stack)
+    u_b = -np.einsum("bpn,bn->bp", np.linalg.pinv(alpha_b * w[:, None]), v0_b * w)
     return v0_b, alpha_b, u_b, rng
 
 
