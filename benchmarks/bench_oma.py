@@ -226,7 +226,7 @@ def tone_calls(n_records: int) -> str:
 def speed(runs: int = 3) -> str:
     """CPU and wall time of ``modal.oma`` per record size (median of ``runs`` after one warm-up call), SSI,
     band 1-30 Hz at 100 Hz. The header names the ``modal`` package measured: run this file with another
-    tree's interpreter (``/work/main/.venv/bin/python benchmarks/bench_oma.py --records 0 --speed`` from outside
+    tree's interpreter (``OTHER/.venv/bin/python OTHER/benchmarks/bench_oma.py --records 0 --speed`` from outside
     either tree) to time that tree's code on the same records."""
     from modal.synthetic import ambient_modal_response
 
