@@ -36,9 +36,11 @@ def _harmonics(v):
     return v if v == "exact" else tuple(list_of(INT)(v))
 
 
-def _mount_vector(v):
-    """A mount's stiffness or damping: three values (x, y, z), or one identified value for all three."""
-    return ref_or(POS, ("identified",))(v) if isinstance(v, str) else list_of(NONNEG, length=3)(v)
+def _mount_vector(field):
+    """A mount's stiffness or damping (``field``): three values (x, y, z), or one identified value for all three."""
+    def check(v):
+        return ref_or(POS, ("identified",), (field,))(v) if isinstance(v, str) else list_of(NONNEG, length=3)(v)
+    return check
 
 
 def _time_channel(v):
@@ -233,7 +235,8 @@ REGISTRY: dict[str, Stage] = {stage.name: stage for stage in (
     Stage(
         "rotor", run=f"{_STAGES}:stage_rotor", needs=("rotor", "adb"),
         config={
-            "rotor": {"M": ref_or(POS, ("identified",)), "k": ref_or(POS), "c": ref_or(NONNEG, ("identified",)),
+            "rotor": {"M": ref_or(POS, ("identified",), ("mass",)), "k": ref_or(POS, fields=("stiffness",)),
+                      "c": ref_or(NONNEG, ("identified",), ("damping",)),
                       "e": NONNEG, "mass_includes_balls": BOOL},
             "adb.m": POS, "adb.n": INT, "adb.R": POS, "adb.D": NONNEG,
         },
@@ -249,8 +252,8 @@ REGISTRY: dict[str, Stage] = {stage.name: stage for stage in (
         "adb_response", run=f"{_STAGES}:stage_adb_response", needs=("rotor", "adb", "adb.response"),
         depends=("rotor",),
         config={"adb.response": {
-            "speed_rad_s": ref_or(POS, ("drive",)), "speed_start_rad_s": NONNEG,
-            "speed_end_rad_s": ref_or(POS, ("drive",)), "ramp_s": POS, "t_end_s": POS,
+            "speed_rad_s": ref_or(POS, ("drive",), ("speed",)), "speed_start_rad_s": NONNEG,
+            "speed_end_rad_s": ref_or(POS, ("drive",), ("speed",)), "ramp_s": POS, "t_end_s": POS,
             "initial_ball_angles_rad": list_of(NUM), "rtol": POS,
         }},
         figures=f"{_PLOTS}:response_figures", plot_inputs=("adb_response", "rotor"),
@@ -272,8 +275,9 @@ REGISTRY: dict[str, Stage] = {stage.name: stage for stage in (
         config={
             "compressor.body": {"mass_kg": POS, "inertia_kg_m2": list_of(list_of(NUM, length=3), length=3),
                                 "crank_centre_m": list_of(NUM, length=3), "damping_ratio": NONNEG},
-            "compressor.mounts": [{"position_m": list_of(NUM, length=3), "stiffness_n_per_m": _mount_vector,
-                                   "damping_n_s_per_m": _mount_vector}],
+            "compressor.mounts": [{"position_m": list_of(NUM, length=3),
+                                   "stiffness_n_per_m": _mount_vector("stiffness"),
+                                   "damping_n_s_per_m": _mount_vector("damping")}],
         },
         required={"compressor.body": ("mass_kg", "inertia_kg_m2", "crank_centre_m"),
                   "compressor.mounts": ("position_m", "stiffness_n_per_m")},

@@ -93,13 +93,23 @@ def list_of(check, length=None, min_length=1):
     return run
 
 
-def ref_or(check, sources=("identified", "drive")):
-    """A reference to one of ``sources`` (a :class:`Reference`), or a value ``check`` accepts."""
+def ref_or(check, sources=("identified", "drive"), fields=None):
+    """A reference to one of ``sources`` (a :class:`Reference`), or a value ``check`` accepts.
+
+    ``fields`` names the one quantity the key holds (``"mass"``, ``"stiffness"``, ...): a reference to
+    another quantity (a rotor mass written ``identified:mode1.stiffness``) is refused, since its number
+    would be read in the wrong unit.
+    """
     def run(v):
         if isinstance(v, str):
             ref = parse_reference(v)
             if ref.source not in sources:
                 raise ValueError(f"a number or a reference to {' or '.join(sources)}")
+            if fields is not None and ref.field not in fields:
+                wanted = " or ".join(f'"{source}:{"modeN." if source == "identified" else ""}{field}"'
+                                     for source in sources for field in fields
+                                     if field in (IDENTIFIED_FIELDS if source == "identified" else DRIVE_FIELDS))
+                raise ValueError(f"a {'/'.join(fields)}: a number or {wanted}; got a reference to a {ref.field}")
             return ref
         return check(v)
     return run

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 import modal
-from modal.errors import SceneError
+from modal.errors import SceneError, warn
 from modal.units import TWO_PI
 
 from ..adb import ADBParameters, ParameterStd, identified_std, stable_speed_intervals
@@ -399,6 +399,38 @@ def stage_drive(scene: Scene) -> DriveStage:
     return DriveStage(drive, handover)
 
 
+def _check_one_mode(scene: Scene, rotor) -> None:
+    """A Jeffcott rotor's M, k and c are those of one mode: references to different modes are refused."""
+    modes = {key: rotor[key].mode for key in ("M", "k", "c")
+             if isinstance(rotor[key], Reference) and rotor[key].source == "identified"}
+    if len(set(modes.values())) > 1:
+        taken = ", ".join(f"{key} from mode {mode}" for key, mode in modes.items())
+        raise SceneError(f"{scene.source}: key 'rotor': {taken}; expected M, k and c of one mode (the rotor's "
+                         "bending mode): a rotor built from several modes has a natural frequency none of them has")
+
+
+#: relative difference between the rotor's sqrt(k/M) and the identified mode's natural frequency above which
+#: the scene warns: a hammer test's frequency is known to a fraction of a percent, so 10 % is a wrong number
+#: (a mass weighed without the hub, a stiffness from the wrong support), not scatter
+NATURAL_FREQUENCY_MISMATCH = 0.10
+
+
+def _check_natural_frequency(scene: Scene, rotor, params: ADBParameters, identified) -> None:
+    """Warn when a rotor mixing identified and given values has a natural frequency the test did not find."""
+    refs = [rotor[key] for key in ("M", "k") if isinstance(rotor[key], Reference) and rotor[key].source == "identified"]
+    if identified is None or len(refs) != 1:
+        return  # both from the mode: sqrt(k/M) is its frequency by construction; neither: nothing to compare
+    mode = identified[refs[0].mode - 1]
+    measured = TWO_PI * float(mode.natural_frequency_hz)
+    model = math.sqrt(params.k / (params.M + params.n * params.m))
+    if abs(model / measured - 1.0) > NATURAL_FREQUENCY_MISMATCH:
+        given = "M" if refs[0].field == "stiffness" else "k"
+        warn(f"{scene.source}: key 'rotor.{given}': the rotor's natural frequency sqrt(k/(M + n m)) = "
+             f"{model / TWO_PI:.4g} Hz differs by {100 * (model / measured - 1):+.0f} % from mode {refs[0].mode}'s "
+             f"{measured / TWO_PI:.4g} Hz, which {refs[0].text!r} comes from; expected the rotor's own "
+             f"{'mass' if given == 'M' else 'stiffness'} (the ball balancer's stability follows that frequency)")
+
+
 def stage_rotor(scene: Scene, identify=None, drive=None, oma=None) -> RotorStage:
     """Ball-balancer parameters, with M, k, c resolved from identification (an impact or an operational test)
     or the drive."""
@@ -411,6 +443,7 @@ def stage_rotor(scene: Scene, identify=None, drive=None, oma=None) -> RotorStage
         used = (f" ({describe_mode(identify, raw, scene)})"
                 if isinstance(raw, Reference) and raw.source == "identified" else "")
         sources.append(f"{key} = {raw.text if isinstance(raw, Reference) else raw!r}{used}")
+    _check_one_mode(scene, rotor)
     std = {"k": 0.0, "c": 0.0, "M": 0.0}
     modes_of: dict[str, int] = {}
     correlation = np.eye(3)
@@ -438,6 +471,7 @@ def stage_rotor(scene: Scene, identify=None, drive=None, oma=None) -> RotorStage
                              f"({adb['n']} x {adb['m']} kg) is not positive")
     params = ADBParameters(M=M, m=adb["m"], n=adb["n"], R=adb["R"], e=rotor["e"], k=values["k"], c=values["c"],
                            D=adb["D"])
+    _check_natural_frequency(scene, rotor, params, identify)
     return RotorStage(params, ParameterStd(**std, correlation=correlation), tuple(sources))
 
 

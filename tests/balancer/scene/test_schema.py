@@ -29,6 +29,19 @@ BAD_SCENES = [
      "reference like"),
     ({"outputs": {"tables": ["adb_stability"]}, "frf": SYNTH_FRF, "adb": ADB, "rotor": {**ROTOR, "M": "drive:speed"}},
      "reference to identified"),
+    # a reference to another quantity would be read in the wrong unit (a stiffness of 1e4 N/m as a 1e4 kg rotor)
+    ({"outputs": {"tables": ["adb_stability"]}, "frf": SYNTH_FRF, "adb": ADB,
+      "rotor": {**ROTOR, "M": "identified:mode1.stiffness"}}, "'rotor.M' = 'identified:mode1.stiffness': expected a mass"),
+    ({"outputs": {"tables": ["adb_stability"]}, "frf": SYNTH_FRF, "adb": ADB,
+      "rotor": {**ROTOR, "c": "identified:mode1.mass"}}, "expected a damping"),
+    ({"outputs": {"tables": ["adb_stability"]}, "frf": SYNTH_FRF, "adb": ADB, "rotor": {**ROTOR, "k": "drive:speed"}},
+     "expected a stiffness: a number or \"identified:modeN.stiffness\" or \"drive:stiffness\""),
+    ({"outputs": {"tables": ["mounts"]}, "frf": SYNTH_FRF, "compressor": {**COMPRESSOR, "mounts": [
+        {"position_m": [0.0, 0.0, 0.0], "stiffness_n_per_m": "identified:mode1.damping"}]}}, "expected a stiffness"),
+    # M, k and c of different modes make a rotor whose natural frequency the test did not find
+    ({"outputs": {"tables": ["adb_stability"]}, "frf": SYNTH_FRF, "adb": ADB,
+      "rotor": {**ROTOR, "M": "identified:mode2.mass"}}, "M from mode 2, k from mode 1, c from mode 1; expected M, k "
+     "and c of one mode"),
     ({"outputs": {"tables": ["identify"]}, "frf": {"file": "x.csv", **SYNTH_FRF}}, "both 'file' and 'synthetic'"),
     ({"outputs": {"tables": ["identify"]}, "frf": {"kind": "mobility"}}, "needs 'file'"),
     ({"outputs": {"tables": ["identify"]}, "frf": {"file": "missing.csv"}}, "missing.csv"),

@@ -245,3 +245,23 @@ def test_a_hammer_record_in_volts_hands_no_k_c_m_to_the_studies(tmp_path):
         run_scene(config)
     messages = " ".join(str(w.message) for w in said)
     assert "is taken as the excitation" in messages and "k, c, m are not given (flag units_unknown)" in messages
+
+
+@pytest.mark.parametrize("given", [{"M": 1.5}, {"k": 6.0e3}])
+def test_a_rotor_mixing_given_and_identified_values_warns_of_a_frequency_the_test_did_not_find(given):
+    """SYNTH_FRF's mode 1 (15.6 Hz, A = 0.96 1/kg: m = 1.042 kg with the two 20 g balls, k = 1.0e4 N/m). A rotor
+    mass of 1.5 kg (or a stiffness of 6 kN/m) with the test's k (or M) gives a rotor 18 % (or 23 %) below the
+    measured frequency: warned, naming the key. The rig's own mass (1.0 kg without balls) gives 15.6 Hz: silent."""
+    import warnings
+
+    from modal.errors import ModalWarning
+    from support.scenes import ROTOR, SYNTH_FRF
+
+    config = scene(frf=SYNTH_FRF, rotor={**ROTOR, **given}, adb=ADB, outputs={"tables": ["rotor"]})
+    with pytest.warns(ModalWarning, match=rf"key 'rotor\.{next(iter(given))}': the rotor's natural frequency "
+                                          r"sqrt\(k/\(M \+ n m\)\) = 1[23]\.\d+ Hz differs by -(18|23) % from "
+                                          r"mode 1's 15\.6 Hz"):
+        run_scene(config)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ModalWarning)
+        run_scene(scene(frf=SYNTH_FRF, rotor={**ROTOR, "M": 1.0}, adb=ADB, outputs={"tables": ["rotor"]}))
