@@ -131,6 +131,21 @@ def _csv_runs(path: Path, source: str) -> dict[str, tuple[list[float], list[floa
     return runs
 
 
+#: a job with at least this many phase readings, every one within ±2π, was probably written in radians: with
+#: phases spread over the circle, six degree readings all within ±6.3° happen with odds of about 1 in 10⁸
+RADIAN_PHASE_READINGS = 6
+
+
+def _warn_radian_phases(phases: list[float], where, key_prefix: str) -> None:
+    """Warn when every phase of a job lies within ±2π: radians written where degrees are expected."""
+    values = np.abs(np.asarray(phases, dtype=float))
+    if values.size >= RADIAN_PHASE_READINGS and np.all(values <= 2 * np.pi) and np.any(values > 0):
+        from modal.errors import warn
+
+        warn(f"{where}: key '{key_prefix}phase_deg': all {values.size} phases lie within ±2π (largest "
+             f"{values.max():.4g}); expected degrees: radians would put every correction at the wrong angle")
+
+
 def parse_job(config: dict, source: str = "<balance>", folder: Path | str = ".", key_prefix: str = "") -> BalanceJob:
     """Validate a job given as a dict (a TOML file's content or a scene's ``[balance]``).
 
@@ -204,6 +219,10 @@ def parse_job(config: dict, source: str = "<balance>", folder: Path | str = ".",
         after = _readings(config["after"], key_prefix + "after", units, source)
     if after.size and after.shape != initial.shape:
         raise _err(source, key_prefix + "after.amplitude", f"{after.size} readings but initial has {initial.size}")
+    raw_phases = ([p for _, phases in csv_runs.values() for p in phases] if csv_runs is not None else
+                  [p for table in [config["initial"], *trials, config.get("after", {})] for p in table.get("phase_deg", [])])
+    _warn_radian_phases(raw_phases, Path(folder) / str(config["readings"]) if csv_runs is not None else source,
+                        key_prefix)
     sensors = config.get("sensors", [f"reading {i + 1}" for i in range(initial.size)])
     if not isinstance(sensors, list) or len(sensors) != initial.size:
         raise _err(source, key_prefix + "sensors", f"expected {initial.size} labels, one per reading")

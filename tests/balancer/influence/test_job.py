@@ -38,6 +38,37 @@ def test_csv_readings_equal_inline_readings(tmp_path):
     np.testing.assert_allclose(from_csv.trial_runs, job.trial_runs, rtol=1e-13)
 
 
+@pytest.mark.parametrize("csv", [False, True])
+def test_phases_written_in_radians_are_warned(tmp_path, csv):
+    """The bundled job's 12 phases written in radians (0.94 for 54°, ..., 4.69 for 269°): a correction at the wrong angle with no
+    word before. The same job in degrees (and in a CSV file) reads silently."""
+    import tomllib
+    import warnings
+
+    from modal.errors import ModalWarning
+
+    config = tomllib.loads(READINGS.read_text())
+    runs = [config["initial"], *config["trial"]]
+    if csv:
+        rows = ["run,amplitude,phase_deg"] + [f"{name},{a},{np.deg2rad(p):.2f}" for name, run in
+                                               zip(["initial", "trial1", "trial2"], runs)
+                                               for a, p in zip(run["amplitude"], run["phase_deg"])]
+        (tmp_path / "runs.csv").write_text("\n".join(rows) + "\n")
+        radians = {**config, "readings": "runs.csv"}
+        radians.pop("initial")
+        radians["trial"] = [{k: v for k, v in t.items() if k in ("mass", "angle_deg")} for t in config["trial"]]
+    else:
+        radians = tomllib.loads(READINGS.read_text())
+        for run in [radians["initial"], *radians["trial"]]:
+            run["phase_deg"] = [round(float(np.deg2rad(p)), 2) for p in run["phase_deg"]]
+    with pytest.warns(ModalWarning, match=r"key 'phase_deg': all 12 phases lie within ±2π \(largest 4\.69\); "
+                                          r"expected degrees"):
+        parse_job(radians, "job.toml", tmp_path)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ModalWarning)
+        parse_job(config, "job.toml", tmp_path)
+
+
 @pytest.mark.parametrize("edit, key", [
     (lambda c: c.pop("units"), "units"),
     (lambda c: c["trial"][0].pop("mass"), "trial[0].mass"),
