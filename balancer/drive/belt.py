@@ -119,6 +119,11 @@ ARC_CORRECTION_VV = CorrectionTable(
 
 
 # --------------------------------------------------------------------------- geometry
+#: fastest belt speed accepted (m/s): classical V-belts are rated to about 30 m/s, narrow wedge belts to 40-50 m/s;
+#: above this a pulley diameter was given in the wrong unit
+MAX_BELT_SPEED_M_S = 60.0
+
+
 def _check_pulleys(driver_diameter_m: float, driven_diameter_m: float, center_distance_m: float) -> tuple[float, float, float]:
     d1 = positive("driver_diameter_m", driver_diameter_m, "m")
     d2 = positive("driven_diameter_m", driven_diameter_m, "m")
@@ -476,6 +481,11 @@ def belt_stage(
         standard, c_standard = length, c
     theta = arc_of_contact_rad(d1, d2, c)
     speed = 0.5 * omega1 * d1
+    if speed > MAX_BELT_SPEED_M_S:
+        raise ParameterError(
+            f"driver_diameter_m = {d1:.6g} m at {n1_rpm:.6g} rpm runs the belt at {speed:.4g} m/s; expected below "
+            f"{MAX_BELT_SPEED_M_S:.0f} m/s (V-belts are rated to 30-50 m/s): diameters in mm written as m?"
+        )
     pull = power / speed
 
     if per_belt_rating_w is not None:

@@ -385,17 +385,26 @@ def stage_drive(scene: Scene) -> DriveStage:
     from ..drive.belt import BeltStageSpec, belt_drive
     from ..drive.shaft import ShaftGeometry, rotor_handover
 
+    from modal.errors import ModalError
+
     cfg = scene.section("drive")
     specs = [BeltStageSpec(**{k: v for k, v in s.items()}) for s in cfg["stages"]]
-    drive = belt_drive(cfg["motor_speed_rpm"], cfg["power_w"], specs, service_factor=cfg.get("service_factor", 1.0))
+    try:
+        drive = belt_drive(cfg["motor_speed_rpm"], cfg["power_w"], specs,
+                           service_factor=cfg.get("service_factor", 1.0))
+    except ModalError as exc:
+        raise SceneError(f"{scene.source}: key 'drive': {exc}") from None
     handover = None
     shaft = cfg.get("shaft")
     if shaft:
-        geometry = ShaftGeometry(shaft["length_m"], shaft["bearing_a_m"], shaft["bearing_b_m"])
         last = drive.stages[-1]
         kwargs = {"youngs_modulus_pa": shaft["youngs_modulus_pa"]} if "youngs_modulus_pa" in shaft else {}
-        handover = rotor_handover(last.driven_speed_rpm * TWO_PI / 60, geometry, shaft["diameter_m"],
-                                  shaft["rotor_position_m"], shaft["rotor_mass_kg"], **kwargs)
+        try:
+            geometry = ShaftGeometry(shaft["length_m"], shaft["bearing_a_m"], shaft["bearing_b_m"])
+            handover = rotor_handover(last.driven_speed_rpm * TWO_PI / 60, geometry, shaft["diameter_m"],
+                                      shaft["rotor_position_m"], shaft["rotor_mass_kg"], **kwargs)
+        except ModalError as exc:
+            raise SceneError(f"{scene.source}: key 'drive.shaft': {exc}") from None
     return DriveStage(drive, handover)
 
 

@@ -173,6 +173,11 @@ def stages(draw):
 
 def check_belt(geometry, speed_rpm, power_w, service) -> None:
     d, big, centre = geometry
+    if math.pi * d * speed_rpm / 60 > drive.belt.MAX_BELT_SPEED_M_S:
+        # faster than any V-belt runs (a diameter in mm written as m): refused, not computed
+        with pytest.raises(ParameterError, match="runs the belt at"):
+            drive.belt_stage(d, big, centre, speed_rpm, power_w, service, arc_correction_factor=0.6)
+        return
     if abs(big - d) / centre > ARC_TABLE_MAX:
         # a valid geometry outside the catalogue table: the documented answer is a
         # ParameterError asking for the factor; with the factor given it must compute
@@ -218,6 +223,12 @@ def check_drive(geometries, efficiencies, speed, power) -> None:
     specs = [drive.BeltStageSpec(d, big, c, efficiency=e,
                                  arc_correction_factor=0.6 if abs(big - d) / c > ARC_TABLE_MAX else None)
              for (d, big, c), e in zip(geometries, efficiencies)]
+    driver_speeds = speed / np.cumprod([1.0] + [big / d for d, big, _ in geometries[:-1]])
+    if any(math.pi * d * n / 60 > drive.belt.MAX_BELT_SPEED_M_S for (d, _, _), n in zip(geometries, driver_speeds)):
+        # a stage faster than any V-belt runs: refused, not computed
+        with pytest.raises(ParameterError, match="runs the belt at"):
+            drive.belt_drive(speed, power, specs)
+        return
     result = drive.belt_drive(speed, power, specs)
     ratio = np.prod([big / d for d, big, _ in geometries])
     assert result.output_speed_rpm == pytest.approx(speed / ratio, rel=1e-12)
@@ -307,6 +318,12 @@ def check_shaft(geometry, loads, diameter, masses) -> None:
             shaft.critical_speed(geometry, diameter, [1.0], at_bearing[:1])
     positions = [p.position_m for p in loads
                  if p.position_m not in (geometry.bearing_a_m, geometry.bearing_b_m)]
+    if diameter >= geometry.length_m:
+        # not a slender shaft (a diameter in mm written as m): the bending formulas are refused, not evaluated
+        if positions:
+            with pytest.raises(ParameterError, match="slender shaft"):
+                shaft.critical_speed(geometry, diameter, [1.0], positions[:1])
+        return
     # within 1e-100 of the length of a bearing (a bearing drawn at a subnormal 2e-309 m, a load
     # at 0) the stiffness ~ EI/d³ may overflow: then the position is refused as numerically
     # on the bearing, and either outcome is right (STRESS_SEED=8 found this case)

@@ -94,6 +94,10 @@ def bending_stiffness_n_per_m(geometry: ShaftGeometry, position_m: float, diamet
     """
     layout = rotor_layout(geometry, position_m)
     ei = positive("youngs_modulus_pa", youngs_modulus_pa, "Pa") * second_moment_of_area_m4(diameter_m)
+    if diameter_m >= geometry.length_m:
+        raise ParameterError(
+            f"diameter_m = {diameter_m:.6g} m is not below the shaft's length_m = {geometry.length_m:.6g} m; expected "
+            "a slender shaft (the bending formulas hold for lengths many diameters long): a diameter in mm written as m?")
     x, span = float(position_m), geometry.span_m
     if layout == "between bearings":
         a, b = x - geometry.bearing_a_m, geometry.bearing_b_m - x

@@ -275,3 +275,15 @@ def test_results_are_frozen_and_archivable(stage_a):
     assert _archivable(stage_a) and _archivable(result)
     with pytest.raises(dataclasses.FrozenInstanceError):
         stage_a.belt_length_m = 1.0  # type: ignore[misc]
+
+
+def test_pulley_diameters_in_millimetres_are_refused():
+    """Stage A's pulleys written in mm as m (100 and 120 m, centres 300 m) ran a 4869 m/s belt and printed a drive
+    with exit 0; V-belts run below 30-50 m/s, and a belt faster than 60 m/s is refused naming the diameter. At the
+    limit's edge a real fast drive (a 0.25 m pulley at 3600 rpm: 47 m/s) still computes."""
+    from modal.errors import ParameterError
+
+    with pytest.raises(ParameterError, match=r"driver_diameter_m = 100 m at 930 rpm runs the belt at 4869 m/s; "
+                                             r"expected below 60 m/s"):
+        belt_stage(100.0, 120.0, 300.0, 930.0, 750.0)
+    assert belt_stage(0.25, 0.5, 1.0, 3600.0, 5000.0).belt_speed_m_s == pytest.approx(math.pi * 0.25 * 60, rel=1e-12)

@@ -6,7 +6,7 @@ import pytest
 from balancer import run_scene
 
 from modal.errors import SceneError
-from support.scenes import SYNTH_FRF, ROTOR, ADB, COMPRESSOR
+from support.scenes import SYNTH_FRF, ROTOR, ADB, COMPRESSOR, DRIVE
 
 
 BAD_SCENES = [
@@ -42,6 +42,13 @@ BAD_SCENES = [
     ({"outputs": {"tables": ["adb_stability"]}, "frf": SYNTH_FRF, "adb": ADB,
       "rotor": {**ROTOR, "M": "identified:mode2.mass"}}, "M from mode 2, k from mode 1, c from mode 1; expected M, k "
      "and c of one mode"),
+    # pulley and shaft diameters in mm written as m: a 4869 m/s belt, a 25 m shaft on 1.3 m
+    ({"outputs": {"tables": ["drive"]}, "drive": {**DRIVE, "stages": [{**DRIVE["stages"][0], "driver_diameter_m": 100.0,
+                                                                      "driven_diameter_m": 120.0,
+                                                                      "center_distance_m": 300.0}]}},
+     "key 'drive': driver_diameter_m = 100 m at 930 rpm runs the belt at 4869 m/s"),
+    ({"outputs": {"tables": ["drive"]}, "drive": {**DRIVE, "shaft": {**DRIVE["shaft"], "diameter_m": 25.0}}},
+     "key 'drive.shaft': diameter_m = 25 m is not below the shaft's length_m = 1.3 m"),
     ({"outputs": {"tables": ["identify"]}, "frf": {"file": "x.csv", **SYNTH_FRF}}, "both 'file' and 'synthetic'"),
     ({"outputs": {"tables": ["identify"]}, "frf": {"kind": "mobility"}}, "needs 'file'"),
     ({"outputs": {"tables": ["identify"]}, "frf": {"file": "missing.csv"}}, "missing.csv"),

@@ -89,3 +89,13 @@ def test_speed_margin_checks_1x_and_2x():
     assert margin.ok_1x and not margin.ok_2x and not margin.supercritical
     above = speed_margin(300.0, 210.0)
     assert above.supercritical and above.separation_1x == pytest.approx(0.3, rel=1e-12)
+
+
+def test_a_shaft_diameter_in_millimetres_is_refused():
+    """25 (mm written as m) on the 1.3 m shaft made k = 4.0e17 N/m and a hand-over with Ω/ω_crit = 1.8e-7, exit 0:
+    the bending formulas hold for a slender shaft only, and a diameter not below the length is refused."""
+    from modal.errors import ParameterError
+
+    with pytest.raises(ParameterError, match=r"diameter_m = 25 m is not below the shaft's length_m = 1\.3 m; "
+                                             r"expected a slender shaft"):
+        bending_stiffness_n_per_m(SHAFT_1, 1.30, 25.0)
