@@ -260,7 +260,7 @@ REGISTRY: dict[str, Stage] = {stage.name: stage for stage in (
         plot_modules=("balancer.adb.plots", _STAGES),
         digest=f"{_SUMMARY}:response_digest", rows=f"{_SUMMARY}:response_rows"),
     Stage(
-        "compressor", run=f"{_STAGES}:stage_compressor", needs=("compressor",),
+        "compressor", run=f"{_STAGES}:stage_compressor", needs=("compressor",), prepare=f"{_STAGES}:check_compressor",
         config={"compressor.crank_radius_m": POS, "compressor.rod_length_m": POS,
                 "compressor.rotating_mass_kg": NONNEG, "compressor.reciprocating_mass_kg": NONNEG,
                 "compressor.speed_rpm": POS, "compressor.harmonics": _harmonics, "compressor.counterweight_k": NONNEG},
@@ -271,7 +271,7 @@ REGISTRY: dict[str, Stage] = {stage.name: stage for stage in (
         digest=f"{_SUMMARY}:compressor_digest", rows=f"{_SUMMARY}:compressor_rows"),
     Stage(
         "mounts", run=f"{_STAGES}:stage_mounts", needs=("compressor", "compressor.body", "compressor.mounts"),
-        depends=("compressor",),
+        depends=("compressor",), prepare=f"{_STAGES}:check_mounts",
         config={
             "compressor.body": {"mass_kg": POS, "inertia_kg_m2": list_of(list_of(NUM, length=3), length=3),
                                 "crank_centre_m": list_of(NUM, length=3), "damping_ratio": NONNEG},

@@ -27,7 +27,7 @@ __all__ = [
     "RotorStage", "StabilityStage", "DriveStage", "CompressorStage", "MountsStage",
     "stage_frf", "stage_identify", "stage_drive", "stage_rotor", "stage_adb_stability", "stage_adb_response",
     "stage_compressor", "stage_mounts", "resolve", "BalanceStage", "stage_balance", "check_frf", "read_balance_job",
-    "stage_oma", "check_oma",
+    "stage_oma", "check_oma", "check_compressor", "check_mounts",
 ]
 
 
@@ -514,6 +514,32 @@ def stage_adb_response(scene: Scene, rotor: RotorStage, drive=None) -> Simulatio
         speed = LinearRunUp(cfg.get("speed_start_rad_s", 0.0), end, cfg["ramp_s"])
     t_end = cfg.get("t_end_s", 2 * cfg.get("ramp_s", 1.0))
     return simulate(rotor.params, speed, t_end, cfg.get("initial_ball_angles_rad"), rtol=cfg.get("rtol", 1e-8))
+
+
+#: fastest mean piston speed accepted (m/s): compressors run 2-6 m/s, racing engines about 25 m/s
+MAX_MEAN_PISTON_SPEED_M_S = 30.0
+
+
+def check_compressor(scene: Scene) -> None:
+    """A crank whose mean piston speed no machine reaches: a radius in the wrong unit."""
+    cfg = scene.section("compressor")
+    piston_speed = 4.0 * cfg["crank_radius_m"] * cfg["speed_rpm"] / 60.0  # mean piston speed: two strokes a turn
+    if piston_speed > MAX_MEAN_PISTON_SPEED_M_S:
+        raise SceneError(f"{scene.source}: key 'compressor.crank_radius_m' = {cfg['crank_radius_m']:.6g} m at "
+                         f"{cfg['speed_rpm']:.6g} rpm moves the piston at {piston_speed:.4g} m/s on average; expected "
+                         f"below {MAX_MEAN_PISTON_SPEED_M_S:.0f} m/s (the fastest engines run about 25 m/s): "
+                         "a radius in mm written as m?")
+
+
+def check_mounts(scene: Scene) -> None:
+    """A body lighter than the crank's moving parts it holds: masses in the wrong unit."""
+    cfg = scene.section("compressor")
+    moving = cfg["rotating_mass_kg"] + cfg["reciprocating_mass_kg"]
+    body_mass = scene.section("compressor.body")["mass_kg"]
+    if moving >= body_mass:
+        raise SceneError(f"{scene.source}: key 'compressor.body.mass_kg' = {body_mass:.6g} kg is not above the "
+                         f"crank's moving masses ({moving:.6g} kg), which are part of the body; expected the whole "
+                         "body's mass: masses in g written as kg?")
 
 
 def stage_compressor(scene: Scene) -> CompressorStage:

@@ -49,6 +49,16 @@ BAD_SCENES = [
      "key 'drive': driver_diameter_m = 100 m at 930 rpm runs the belt at 4869 m/s"),
     ({"outputs": {"tables": ["drive"]}, "drive": {**DRIVE, "shaft": {**DRIVE["shaft"], "diameter_m": 25.0}}},
      "key 'drive.shaft': diameter_m = 25 m is not below the shaft's length_m = 1.3 m"),
+    # a crank radius in mm written as m (2340 m/s mean piston speed), crank masses in g written as kg (245 kg of
+    # moving parts in a 16.3 kg compressor): refused before any stage runs
+    ({"outputs": {"tables": ["compressor"]}, "compressor": {**COMPRESSOR, "crank_radius_m": 11.9, "rod_length_m": 50.0}},
+     "key 'compressor.crank_radius_m' = 11.9 m at 2950 rpm moves the piston at 2340 m/s on average; expected below 30"),
+    ({"outputs": {"tables": ["mounts"]}, "compressor": {
+        **COMPRESSOR, "rotating_mass_kg": 96.656, "reciprocating_mass_kg": 148.344,
+        "body": {"mass_kg": 16.3, "inertia_kg_m2": [[0.067, 0, 0], [0, 0.059, 0], [0, 0, 0.0405]],
+                 "crank_centre_m": [0.005, 0.008, 0.005]},
+        "mounts": [{"position_m": [0.0, 0.076, -0.056], "stiffness_n_per_m": [3e4, 3e4, 6e4]}]}},
+     "key 'compressor.body.mass_kg' = 16.3 kg is not above the crank's moving masses (245 kg)"),
     ({"outputs": {"tables": ["identify"]}, "frf": {"file": "x.csv", **SYNTH_FRF}}, "both 'file' and 'synthetic'"),
     ({"outputs": {"tables": ["identify"]}, "frf": {"kind": "mobility"}}, "needs 'file'"),
     ({"outputs": {"tables": ["identify"]}, "frf": {"file": "missing.csv"}}, "missing.csv"),
