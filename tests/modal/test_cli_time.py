@@ -290,3 +290,21 @@ def test_hammer_hits_saved_in_several_files_are_averaged_as_one_test(tmp_path):
     out = run("fit", first, other, "--impact")
     assert out.returncode == 1 and out.stderr.count("\n") == 1
     assert "other.csv: channel 2 (names) is '2+Z'" in out.stderr and "expected the same channels" in out.stderr
+
+
+def test_a_band_above_the_files_nyquist_frequency_names_the_sample_rate(tmp_path):
+    # a random-excitation MAT file whose fs is 1.024 (kHz written as a number): nothing in the record contradicts
+    # it (no hits), so it is read with a warning; a band in Hz above its Nyquist frequency (0.512 Hz) then says
+    # which rate it lies above instead of "band holds 0 lines"
+    from scipy.io import savemat
+
+    force, displacement = _records(n=2**14)
+    path = tmp_path / "random.mat"
+    savemat(path, {"signals": np.vstack([force, displacement]), "fs": FS / 1000,
+                   "units": np.array(["N", "m", "m"], dtype=object)})
+    out = run("fit", path, "--band", 30, 50)
+    assert out.returncode == 1 and "Traceback" not in out.stderr
+    assert "field 'fs' gives a sample rate of 1.024 Hz" in out.stderr
+    error = [line for line in out.stderr.splitlines() if line.startswith("error: ")]
+    assert error == [f"error: {path}: --band 30 50 Hz lies above the Nyquist frequency 0.512 Hz of the file's sample "
+                     "rate 1.024 Hz; expected bands below it (is the file's sample rate in kHz?)"]
