@@ -327,9 +327,14 @@ def read_archive(path: str | os.PathLike) -> Archive:
     try:
         f = h5py.File(path, "r")
     except OSError as exc:
-        raise ArchiveError(f"{src}: not a readable HDF5 file ({exc})") from None
+        raise ArchiveError(f"{src}: not a readable HDF5 file ({' '.join(str(exc).split())}); expected an archive "
+                           "of python -m modal fit --archive or python -m balancer run") from None
     with f:
         check_schema(f, src, error=ArchiveError)
+        frfs = f.get("frf")
+        if isinstance(frfs, h5py.Group) and "__type__" not in frfs.attrs:  # /frf/<name>: modal.io.write_frf's layout
+            raise ArchiveError(f"{src}: an FRF file (/frf/<name>, as modal frf --out writes it), not an archive of "
+                               f"results; expected an archive of a fit: python -m modal fit {src} --archive OUT.h5")
         attrs = {k: str(v) for k, v in f.attrs.items()}
         scene = None
         if "scene" in f:
