@@ -3,8 +3,8 @@
 Exit codes: 0 every file fitted, 1 some failed (the archive holds the others) or the output is in use by
 another run, 2 bad usage.
 stdout: one summary line, or one JSON document with ``--json``; stderr: each file's warnings and
-the failures, one line each, a note per group of files that look like takes of one test, and a
-progress bar when stderr is a terminal.
+the failures, one line each, a note per group of files that hold the same bytes and per group that
+look like takes of one test, and a progress bar when stderr is a terminal.
 """
 from __future__ import annotations
 
@@ -36,7 +36,7 @@ def add_batch_parser(sub, add_fit_options) -> argparse.ArgumentParser:
     batch.add_argument("--table", metavar="RESULTS.csv", help="the CSV table (default: the archive's name with .csv)")
     batch.add_argument("--json", action="store_true",
                        help="print one JSON document: files, fitted, reused, failed, warnings (per file, with its "
-                            "flagged modes), takes, archive, table, wall_time_s")
+                            "flagged modes), takes, duplicates, archive, table, wall_time_s")
     batch.add_argument("--scheduler", metavar="tcp://HOST:PORT",
                        help="address of a running Dask scheduler (workers need this package installed and the "
                             "files at the same paths); default: a local cluster")
@@ -110,6 +110,9 @@ def run_batch(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
             print(f"warning: {failure_line(outcome.file, text)}", file=sys.stderr)
     for item in result.failed:
         print(f"failed: {failure_line(item['file'], item['error'])}", file=sys.stderr)
+    for files in result.duplicates:
+        print(f"note: {len(files)} files hold the same bytes (copies?): {', '.join(files)}; the table holds their "
+              "results once for each", file=sys.stderr)
     for files in result.takes:  # said once per group, never acted on: the folder may hold repeats on purpose
         print(f"note: {len(files)} files look like takes of one test (one hammer hit each, the same channels at "
               f"the same sample rate): {', '.join(files)}; each was fitted alone, from one hit; to average the "

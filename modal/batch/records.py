@@ -157,6 +157,8 @@ class Outcome:
         The warnings the file's fit raised (one line each), as ``modal fit`` prints them.
     take_setup : str
         As in :class:`FileFit`: set for a time file of one hammer hit.
+    sha256 : str
+        SHA-256 (hex) of the file's bytes (empty when it could not be read).
     """
 
     file: str
@@ -166,3 +168,4 @@ class Outcome:
     fit: FileFit | None = field(default=None, repr=False)
     warnings: tuple[str, ...] = field(default=(), repr=False)
     take_setup: str = field(default="", repr=False)
+    sha256: str = field(default="", repr=False)

@@ -90,13 +90,25 @@ class BatchResult:
                 groups.setdefault(o.take_setup, []).append(o.file)
         return [files for files in groups.values() if len(files) >= 2]
 
+    @property
+    def duplicates(self) -> list[list[str]]:
+        """Files that hold the same bytes (a file copied into the folder twice), in groups of two or more, in file
+        order: the table holds the same results once for each."""
+        groups: dict[str, list[str]] = {}
+        for o in self.outcomes:
+            if o.sha256:
+                groups.setdefault(o.sha256, []).append(o.file)
+        return [files for files in groups.values() if len(files) >= 2]
+
     def summary(self) -> dict[str, Any]:
         """The ``--json`` document: files, fitted, reused, failed, warnings (:attr:`warned`), takes (:attr:`takes`
-        with the command that fits each group together), archive, table, wall_time_s."""
+        with the command that fits each group together), duplicates (:attr:`duplicates`), archive, table,
+        wall_time_s."""
         return {"files": len(self.outcomes), "fitted": self.fitted, "reused": self.reused, "failed": self.failed,
                 "warnings": self.warned, "takes": [{"files": files, "command": takes_command(files)}
                                                    for files in self.takes],
-                "archive": self.archive, "table": self.table, "wall_time_s": self.wall_time_s}
+                "duplicates": self.duplicates, "archive": self.archive, "table": self.table,
+                "wall_time_s": self.wall_time_s}
 
 
 def takes_command(files: Sequence[str]) -> str:
@@ -202,7 +214,7 @@ def _check_timeout(value) -> float | None:
 
 def _outcome(entry: Entry, status: str) -> Outcome:
     return Outcome(entry.source, status, entry.error, parse_table(entry.source, entry.table, entry.warnings),
-                   entry.fit, entry.warnings, entry.take_setup)
+                   entry.fit, entry.warnings, entry.take_setup, entry.sha256)
 
 
 def _run(files: list[str], options: FitOptions, client, out, table, workers, progress,

@@ -105,10 +105,10 @@ def test_cluster_and_local_runs_give_identical_tables(dask_cluster, small_set, t
     assert local.returncode == 0, local.stderr
     for done in (remote, local):
         doc = json.loads(done.stdout)
-        assert set(doc) == {"files", "fitted", "reused", "failed", "warnings", "takes", "archive", "table",
-                            "wall_time_s"}
+        assert set(doc) == {"files", "fitted", "reused", "failed", "warnings", "takes", "duplicates", "archive",
+                            "table", "wall_time_s"}
         assert (doc["files"], doc["fitted"], doc["reused"], doc["failed"]) == (12, 12, 0, [])
-        assert (doc["warnings"], doc["takes"]) == ([], [])  # clean FRF files: nothing to look at
+        assert (doc["warnings"], doc["takes"], doc["duplicates"]) == ([], [], [])  # clean FRF files: nothing to say
         assert doc["wall_time_s"] > 0 and "Traceback" not in done.stderr
     assert json.loads(remote.stdout)["table"] == str(tmp_path / "remote.csv")  # default: beside the archive
     rows = read_table(tmp_path / "remote.csv")

@@ -1,7 +1,7 @@
 """``modal batch`` on files whose fits warn: the warnings and the count of flagged modes in the table and the
-JSON document (they were printed on stderr only, so the table a lab opens in a spreadsheet looked clean), and
+JSON document (they were printed on stderr only, so the table a lab opens in a spreadsheet looked clean),
 one-hit hammer files that look like takes of one test (said once, with the command that averages them; never
-combined by the batch). On a real Dask cluster (the session fixture ``dask_cluster``), the CLI in a subprocess."""
+combined by the batch), and files copied in twice. On a real Dask cluster (the session fixture ``dask_cluster``), the CLI in a subprocess."""
 from __future__ import annotations
 
 import csv
@@ -52,12 +52,19 @@ def test_warnings_and_flagged_modes_are_in_the_table_and_takes_are_named_once(da
     takes = cut_hits(folder, range(3))  # three hits at one point, saved one per file
     other = cut_hits(folder, [3], rename=("1+Z [m/s^2]", "2+Z [m/s^2]"))[0]  # one hit of another point
     write_frf(mobility(), folder / "clean.uff")  # an FRF file that fits cleanly
+    (folder / "sub").mkdir()
+    (folder / "sub" / "clean_copy.uff").write_bytes((folder / "clean.uff").read_bytes())  # copied in twice
     out = tmp_path / "survey.h5"
     for status in ("fitted", "reused"):  # what is said comes with the results, reused ones too
         done = _batch(folder, "--out", out, "--scheduler", dask_cluster[0], "--json")
         assert done.returncode == 0, done.stderr
         summary = json.loads(done.stdout)
-        assert summary[status] == 5
+        assert summary[status] == 6
+        # the copy: named once, with the file it copies (the table has both, as they were found)
+        assert summary["duplicates"] == [[str(folder / "clean.uff"), str(folder / "sub" / "clean_copy.uff")]]
+        copies = [line for line in done.stderr.splitlines() if "hold the same bytes" in line]
+        assert copies == [f"note: 2 files hold the same bytes (copies?): {folder / 'clean.uff'}, "
+                          f"{folder / 'sub' / 'clean_copy.uff'}; the table holds their results once for each"]
         with open(tmp_path / "survey.csv", newline="", encoding="utf-8") as fh:
             reader = csv.DictReader(fh)
             assert tuple(reader.fieldnames) == TABLE_COLUMNS and TABLE_COLUMNS[-2:] == ("warnings", "flagged_modes")
@@ -84,7 +91,7 @@ def test_warnings_and_flagged_modes_are_in_the_table_and_takes_are_named_once(da
         # the three hits of one point: one note and one JSON group, not the other point's hit, not the FRF file
         command = "python -m modal fit " + " ".join(shlex.quote(str(p)) for p in takes) + " --impact"
         assert summary["takes"] == [{"files": [str(p) for p in takes], "command": command}]
-        notes = [line for line in done.stderr.splitlines() if line.startswith("note: ")]
+        notes = [line for line in done.stderr.splitlines() if line.startswith("note: ") and "takes" in line]
         assert len(notes) == 1 and notes[0].startswith("note: 3 files look like takes of one test")
         assert notes[0].endswith(command) and str(other) not in notes[0]
     # the text summary counts the files to look at
