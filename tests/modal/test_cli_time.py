@@ -284,6 +284,13 @@ def test_hammer_hits_saved_in_several_files_are_averaged_as_one_test(tmp_path):
     modes = [json.loads(out.stdout)["modes"] for out in (both, whole)]
     assert [m["natural_frequency_hz"] for m in modes[0]] == pytest.approx(
         [m["natural_frequency_hz"] for m in modes[1]], rel=1e-9)
+    # a take given twice (a copy in the folder, or the same name twice): averaged with itself its noise looked
+    # smaller, the fit turned model_inadequate and found a mode at 470 Hz; refused naming both files
+    copy = tmp_path / "hit_a_copy.csv"
+    copy.write_bytes(first.read_bytes())
+    out = run("fit", first, copy, second, "--impact")
+    assert out.returncode == 1 and out.stderr.count("\n") == 1
+    assert f"{copy}: holds the same bytes as {first}; expected each of the takes once" in out.stderr
     # a file of other channels is not a take of the same test
     other = tmp_path / "other.csv"
     other.write_text("\n".join([header.replace("1+Z [m/s^2]", "2+Z [m/s^2]")] + rows[:cut]) + "\n")
