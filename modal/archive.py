@@ -90,7 +90,7 @@ class Archive:
 def _set_units(node, name: str, unit: str | None = None) -> None:
     """``units`` attribute: the explicit unit, else the name's, else "1" for integers and booleans
     (counts, indices, orders, flags)."""
-    unit = unit or units_of(name)
+    unit = (unit if isinstance(unit, str) else None) or units_of(name)
     if unit is None and node.dtype.kind in "biu":
         unit = "1"
     if unit is not None:
@@ -101,7 +101,10 @@ def write_node(parent: h5py.Group, name: str, obj: Any, unit: str | None = None)
     """Write ``obj`` as child ``name`` of ``parent`` (recursively).
 
     ``unit`` overrides the unit derived from the name (a dataclass's ``archive_units()``);
-    the items of a tuple, list or dict take the unit of the container (or of their key).
+    the items of a tuple, list or dict take the unit of the container (or of their key). A dict as
+    ``unit`` holds the units of a dataclass's fields that its container knows and it does not (the
+    modal constants of a result whose FRF was in V/V): it goes to the dataclass, or to each dataclass
+    of a tuple or list.
     """
     from .frf import FRF
 
@@ -116,9 +119,11 @@ def write_node(parent: h5py.Group, name: str, obj: Any, unit: str | None = None)
         group.attrs["__type__"] = "dataclass"
         group.attrs["__class__"] = f"{cls.__module__}:{cls.__qualname__}"
         explicit = obj.archive_units() if callable(getattr(obj, "archive_units", None)) else {}
+        if isinstance(unit, dict):  # what the container knows of this dataclass's units comes first
+            explicit = {**explicit, **unit}
         for f in dataclasses.fields(obj):
             write_node(group, f.name, getattr(obj, f.name), unit=explicit.get(f.name))
-            if f.name in explicit and isinstance(group[f.name], h5py.Dataset):
+            if isinstance(explicit.get(f.name), str) and isinstance(group[f.name], h5py.Dataset):
                 group[f.name].attrs["units"] = explicit[f.name]  # units the field name cannot say
         return
     if obj is None:
@@ -322,9 +327,14 @@ def read_archive(path: str | os.PathLike) -> Archive:
     try:
         f = h5py.File(path, "r")
     except OSError as exc:
-        raise ArchiveError(f"{src}: not a readable HDF5 file ({exc})") from None
+        raise ArchiveError(f"{src}: not a readable HDF5 file ({' '.join(str(exc).split())}); expected an archive "
+                           "of python -m modal fit --archive or python -m balancer run") from None
     with f:
         check_schema(f, src, error=ArchiveError)
+        frfs = f.get("frf")
+        if isinstance(frfs, h5py.Group) and "__type__" not in frfs.attrs:  # /frf/<name>: modal.io.write_frf's layout
+            raise ArchiveError(f"{src}: an FRF file (/frf/<name>, as modal frf --out writes it), not an archive of "
+                               f"results; expected an archive of a fit: python -m modal fit {src} --archive OUT.h5")
         attrs = {k: str(v) for k, v in f.attrs.items()}
         scene = None
         if "scene" in f:

@@ -140,9 +140,12 @@ def _fit(args) -> int:
     if args.channel is not None and not 1 <= args.channel <= frf.n_channels:
         raise ModalError(f"--channel {args.channel}: no such channel; expected 1..{frf.n_channels}")
     if args.json:
+        from .frf_units import result_units
+
         rows = [dict(row, channel=row["channel"] + 1) for result in results for row in result.rows()]
         doc = {"file": args.path[0] if len(args.path) == 1 else list(args.path), "kind": frf.kind, "n_channels": frf.n_channels,
-               "methods": methods, "driving_point": _driving_point_doc(results, args.driving_point), "modes": rows}
+               "methods": methods, "driving_point": _driving_point_doc(results, args.driving_point),
+               "modal_constant_units": result_units(frf.kind, results[0].settings)["modal_constant"], "modes": rows}
         json.dump(jsonable(doc), sys.stdout, indent=1, allow_nan=False)
         sys.stdout.write("\n")
     else:

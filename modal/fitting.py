@@ -216,6 +216,7 @@ def fit_path(path: str | os.PathLike | Sequence[str | os.PathLike], options: Fit
     if any(wants_time(args, p) for p in paths):  # several time files are takes of one test
         frf, *record = frf_from_time(paths[0] if len(paths) == 1 else paths, args, report)
         time_data = tuple(record)
+        _check_bands_below_nyquist(options.bands_hz, record[0])
         if report_estimate is not None:
             report_estimate(frf)
     else:
@@ -234,6 +235,16 @@ def fit_path(path: str | os.PathLike | Sequence[str | os.PathLike], options: Fit
                              **budget)
                     for method in methods)
     return FitOutput(frf=frf, results=results, time_data=time_data)
+
+
+def _check_bands_below_nyquist(bands_hz, record) -> None:
+    """A band wholly above half a time record's sample rate: the rate (or the band) is in the wrong unit."""
+    nyquist = record.sample_rate_hz / 2
+    for low, high in bands_hz or ():
+        if low >= nyquist:
+            raise ParameterError(f"{record.source}: --band {low:g} {high:g} Hz lies above the Nyquist frequency "
+                                 f"{nyquist:.6g} Hz of the file's sample rate {record.sample_rate_hz:.6g} Hz; expected "
+                                 "bands below it (is the file's sample rate in kHz?)")
 
 
 def _oma_from_args(args: Any):

@@ -272,7 +272,8 @@ class FRF:
 
     # ------------------------------------------------------------ transforms
     def as_kind(self, kind: Kind) -> "FRF":
-        """Exact conversion to another FRF kind (multiplies by (iω)**Δp; ``noise_std`` by |ω|**Δp).
+        """Exact conversion to another FRF kind (multiplies by (iω)**Δp; ``noise_std`` by |ω|**Δp, the noise
+        model's variance model by |ω|**(2Δp) and its records' influences by (iω)**Δp).
 
         Converting a line at 0 Hz to a lower kind (for example accelerance to
         receptance) divides by zero and is refused.
@@ -289,9 +290,9 @@ class FRF:
         resp = self.response * iw ** delta
         units = DEFAULT_UNITS[kind] if self.units == DEFAULT_UNITS[self.kind] else None
         noise = None if self.noise_std is None else self.noise_std * np.abs(self.omega_rad_s) ** delta
-        model = self.noise_model
-        if model is not None and model.record_influence is not None:  # each record's error converts as H does
-            model = replace(model, record_influence=model.record_influence * iw ** delta)
+        # the variance model scales as the variance, |iω|^(2Δp); each record's error converts as H does
+        scale = iw ** delta
+        model = None if self.noise_model is None else self.noise_model.scaled(np.abs(scale) ** 2, scale)
         return replace(self, response=resp, kind=kind, units=units, noise_std=noise, noise_model=model)
 
     def cropped(self, f_low_hz: float, f_high_hz: float) -> "FRF":

@@ -17,7 +17,7 @@ import numpy as np
 from .errors import FormatError, QualityWarning, warn_caller
 from .frf import DEFAULT_UNITS, FRF
 
-__all__ = ["parse_frf_unit", "frf_in_si", "si_units", "withhold_physical"]
+__all__ = ["parse_frf_unit", "frf_in_si", "si_units", "withhold_physical", "result_units"]
 
 #: response units: (what they measure, factor to SI)
 _RESPONSE_UNITS = {
@@ -91,7 +91,8 @@ def withhold_physical(result, frf: FRF):
     if si_units(frf) or parse_frf_unit(frf.units) is not None:
         return result
     given = frf.units and "not given" not in frf.units
-    settings = {**result.settings, "modal_constant_units": f"{frf.units}-based" if given else "unknown"}
+    settings = {**result.settings, "modal_constant_units": f"{frf.units}-based" if given else "unknown",
+                "frf_units": frf.units if given else "unknown"}
     modes = []
     for mode in result.modes:
         if not np.any(mode.driving_point):
@@ -105,3 +106,34 @@ def withhold_physical(result, frf: FRF):
         warn_caller(f"{frf.source}: the FRF's unit {frf.units!r} is not one the toolkit converts to SI: k, c, m are "
                     "not given (flag units_unknown)", QualityWarning)
     return replace(result, modes=tuple(modes), settings=settings)
+
+
+#: the receptance modal constant A = H_receptance (ωn² − ω² + 2iζωnω) is the FRF's unit times s^(p − 2) for an FRF
+#: of power p (accelerance 2, mobility 1, receptance 0: 1/kg in SI); the upper residual is a receptance, s^p
+_CONSTANT_POWER = {"accelerance": "", "mobility": "/s", "receptance": "/s^2"}
+_RECEPTANCE_POWER = {"accelerance": " s^2", "mobility": " s", "receptance": ""}
+
+
+def result_units(kind: str, settings: dict) -> dict[str, str]:
+    """The units of an identification result's modal constants, line noise and residuals: 1/kg, the kind's SI
+    unit and m/N, 1/kg in SI; derived from the FRF's own unit where it was not converted
+    (``settings["frf_units"]``, set by :func:`withhold_physical`): an accelerance in V/V gives constants in
+    V/V, a mobility in V/V constants in (V/V)/s; ``unknown`` where the FRF carried no unit.
+
+    Returns
+    -------
+    dict
+        ``modal_constant``, ``noise_std``, ``upper_residual``, ``lower_residual``.
+    """
+    unit = settings.get("frf_units")
+    if not unit and "modal_constant_units" in settings:  # results written before the FRF's unit was kept
+        unit = "unknown"
+    if not unit:
+        return {"modal_constant": "1/kg", "noise_std": DEFAULT_UNITS[kind], "upper_residual": "m/N",
+                "lower_residual": "1/kg"}
+    if unit == "unknown":
+        return dict.fromkeys(("modal_constant", "noise_std", "upper_residual", "lower_residual"), "unknown")
+    base = f"({unit})" if "/" in unit or " " in unit else unit
+    constant = unit if kind == "accelerance" else f"{base}{_CONSTANT_POWER[kind]}"
+    upper = unit if kind == "receptance" else f"{base}{_RECEPTANCE_POWER[kind]}"
+    return {"modal_constant": constant, "noise_std": unit, "upper_residual": upper, "lower_residual": constant}

@@ -167,10 +167,14 @@ class IdentificationResult:
 
     def archive_units(self) -> dict[str, str]:
         """Units of the fields whose names do not say them (for :mod:`modal.archive`)."""
-        from .frf import DEFAULT_UNITS
+        from .frf_units import result_units
 
-        return {"noise_std": DEFAULT_UNITS[self.kind], "n_channels": "1",
-                "residuals": "m/N (column 0: upper residual), 1/kg (column 1: lower residual)"}
+        units = result_units(self.kind, self.settings)
+        constant = {"modal_constant": units["modal_constant"]}
+        return {"noise_std": units["noise_std"], "n_channels": "1",
+                "residuals": f"{units['upper_residual']} (column 0: upper residual), {units['lower_residual']} "
+                             "(column 1: lower residual)",
+                "modes": {**constant, "std": constant}}  # the modes' constants are in the FRF's unit, as the result
 
     def synthesize(self, frequency_hz) -> "FRF":
         """The identified model (modes, plus residual terms where fitted) as an FRF on any axis.

@@ -55,10 +55,12 @@ def frf_from_time(path, args, report: Callable[[str], None] | None = None):
     (EstimatedFRF, TimeRecord, list of int, list of int)
         The estimate, the record, and the excitation and response channel indices.
     """
+    from .io._common import refuse_copies
     from .io.timedata import read_time
     from .io.timejoin import join_takes
 
     paths = [path] if isinstance(path, (str, os.PathLike)) else list(path)
+    refuse_copies(paths, "takes", "a take given twice is averaged with itself: its noise looks smaller than it is")
     record = join_takes([read_time(p) for p in paths])
     plan = plan_time_frf(record, args, report)
     return estimate_time_frf(record, plan, args), record, list(plan.inputs), list(plan.outputs)

@@ -2,8 +2,9 @@
 
 Exit codes: 0 every file fitted, 1 some failed (the archive holds the others) or the output is in use by
 another run, 2 bad usage.
-stdout: one summary line, or one JSON document with ``--json``; stderr: the failures, one line
-each, and a progress bar when stderr is a terminal.
+stdout: one summary line, or one JSON document with ``--json``; stderr: each file's warnings and
+the failures, one line each, a note per group of files that hold the same bytes and per group that
+look like takes of one test, and a progress bar when stderr is a terminal.
 """
 from __future__ import annotations
 
@@ -34,7 +35,8 @@ def add_batch_parser(sub, add_fit_options) -> argparse.ArgumentParser:
                             "meanwhile, so an interrupted run resumes; RESULTS.h5.lock says which run holds it)")
     batch.add_argument("--table", metavar="RESULTS.csv", help="the CSV table (default: the archive's name with .csv)")
     batch.add_argument("--json", action="store_true",
-                       help="print one JSON document: files, fitted, reused, failed, archive, table, wall_time_s")
+                       help="print one JSON document: files, fitted, reused, failed, warnings (per file, with its "
+                            "flagged modes), takes, duplicates, archive, table, wall_time_s")
     batch.add_argument("--scheduler", metavar="tcp://HOST:PORT",
                        help="address of a running Dask scheduler (workers need this package installed and the "
                             "files at the same paths); default: a local cluster")
@@ -70,7 +72,7 @@ def run_batch(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
     from ..errors import ModalError, ParameterError
     from ..fitting import FitOptions
     from ..report import jsonable
-    from .run import fit_files
+    from .run import fit_files, takes_command
 
     if args.scheduler and args.workers is not None:
         parser.error("--workers applies to the local cluster; the cluster at --scheduler has its own workers")
@@ -108,11 +110,20 @@ def run_batch(args: argparse.Namespace, parser: argparse.ArgumentParser) -> int:
             print(f"warning: {failure_line(outcome.file, text)}", file=sys.stderr)
     for item in result.failed:
         print(f"failed: {failure_line(item['file'], item['error'])}", file=sys.stderr)
+    for files in result.duplicates:
+        print(f"note: {len(files)} files hold the same bytes (copies?): {', '.join(files)}; the table holds their "
+              "results once for each", file=sys.stderr)
+    for files in result.takes:  # said once per group, never acted on: the folder may hold repeats on purpose
+        print(f"note: {len(files)} files look like takes of one test (one hammer hit each, the same channels at "
+              f"the same sample rate): {', '.join(files)}; each was fitted alone, from one hit; to average the "
+              f"hits, fit them together: {takes_command(files)}", file=sys.stderr)
     if args.json:
         json.dump(jsonable(result.summary()), sys.stdout, indent=1, allow_nan=False)
         sys.stdout.write("\n")
     else:
+        warned = len(result.warned)
         print(f"{len(result.outcomes)} files: {result.fitted} fitted, {result.reused} reused, "
-              f"{len(result.failed)} failed in {result.wall_time_s:.1f} s; archive {result.archive}, "
-              f"table {result.table}")
+              f"{len(result.failed)} failed in {result.wall_time_s:.1f} s"
+              + (f", {warned} with warnings or flagged modes (table columns warnings, flagged_modes)" if warned else "")
+              + f"; archive {result.archive}, table {result.table}")
     return 1 if result.failed else 0

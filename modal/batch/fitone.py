@@ -11,7 +11,7 @@ from .discover import file_sha256
 from .records import FileFit, one_line
 from .store import table_text
 
-__all__ = ["fit_one"]
+__all__ = ["fit_one", "take_setup"]
 
 
 def fit_one(path: str, options: FitOptions, sha256: str | None = None) -> FileFit:
@@ -62,4 +62,23 @@ def fit_one(path: str, options: FitOptions, sha256: str | None = None) -> FileFi
                      frequency_range_hz=(float(frf.frequency_hz[0]), float(frf.frequency_hz[-1])))
     return FileFit(source=path, sha256=sha256, settings=settings, settings_hash=settings_hash, **shape,
                    results=tuple(out.results), warnings=texts, fit_time_s=time.perf_counter() - start,
-                   table=table_text(out.results))
+                   table=table_text(out.results), take_setup=take_setup(out.time_data))
+
+
+def take_setup(time_data) -> str:
+    """A time record whose one excitation channel holds one hammer hit: its sample rate and channels as one line
+    (files that agree on it look like takes of one test); empty for anything else (FRF files, several hits,
+    continuous excitation)."""
+    from ..estimate.hits import pulse_train
+
+    if time_data is None:
+        return ""
+    record, inputs, _ = time_data
+    if len(inputs) != 1 or len(record.take_lengths or ()) > 1:
+        return ""
+    train = pulse_train(record.signals[inputs[0]], record.sample_rate_hz)
+    if not (train.impulsive and train.count == 1):
+        return ""
+    channels = "; ".join(f"{n} [{q or 'unknown'}, {u or 'no unit'}]"
+                         for n, q, u in zip(record.names, record.quantities, record.units))
+    return f"{float(record.sample_rate_hz)!r} Hz, excitation {inputs[0] + 1}: {channels}"

@@ -54,6 +54,10 @@ class FileFit:
     table : str
         This file's rows of the batch table as CSV lines, without the ``file`` column
         (kept so that a rerun writes the table without reading every result back).
+    take_setup : str
+        A time file whose excitation holds one hammer hit: its sample rate and channels (names,
+        quantities, units) as one line, the key by which files that look like takes of one test are
+        found (:meth:`modal.batch.BatchResult.takes`); empty for every other file.
     """
 
     source: str
@@ -70,6 +74,7 @@ class FileFit:
     warnings: tuple[str, ...] = ()
     fit_time_s: float = float("nan")
     table: str = ""
+    take_setup: str = ""
 
     @property
     def ok(self) -> bool:
@@ -84,7 +89,7 @@ class Entry:
 
     Attributes
     ----------
-    source, sha256, error, retry, table, warnings
+    source, sha256, error, retry, table, warnings, take_setup
         As in :class:`FileFit`.
     location : tuple of (str, str) or None
         HDF5 file and group holding the :class:`FileFit`.
@@ -100,6 +105,7 @@ class Entry:
     location: tuple[str, str] | None = None
     fit: FileFit | None = None
     warnings: tuple[str, ...] = ()
+    take_setup: str = ""
 
 
 @dataclass(frozen=True)
@@ -149,6 +155,10 @@ class Outcome:
         with an archive, read it from there: ``read_archive(out)["files"]``.
     warnings : tuple of str
         The warnings the file's fit raised (one line each), as ``modal fit`` prints them.
+    take_setup : str
+        As in :class:`FileFit`: set for a time file of one hammer hit.
+    sha256 : str
+        SHA-256 (hex) of the file's bytes (empty when it could not be read).
     """
 
     file: str
@@ -157,3 +167,5 @@ class Outcome:
     rows: tuple[dict, ...] = field(default=(), repr=False)
     fit: FileFit | None = field(default=None, repr=False)
     warnings: tuple[str, ...] = field(default=(), repr=False)
+    take_setup: str = field(default="", repr=False)
+    sha256: str = field(default="", repr=False)

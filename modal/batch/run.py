@@ -12,13 +12,14 @@ from typing import Any
 
 from ..errors import ParameterError
 from ..fitting import FitOptions
+from ..flags import INFORMATIONAL
 from .discover import file_sha256, find_files
 from .fitproc import DEFAULT_FILE_TIMEOUT_S
 from .lock import RunLock, lock_path
 from .records import BatchInfo, Entry, FileFit, Outcome, one_line
 from .store import PartStore, entry_of, parse_table, parts_folder, write_batch_archive, write_table
 
-__all__ = ["BatchResult", "iter_fit", "fit_files", "default_table"]
+__all__ = ["BatchResult", "iter_fit", "fit_files", "default_table", "takes_command"]
 
 
 def default_table(archive: str | os.PathLike) -> Path:
@@ -63,10 +64,58 @@ class BatchResult:
         """The table: one dict per file, method, mode and channel (``pandas.DataFrame(result.rows())``)."""
         return [row for o in self.outcomes for row in o.rows]
 
+    @property
+    def warned(self) -> list[dict[str, Any]]:
+        """``[{"file", "warnings", "flagged_modes"}]`` for every fitted file whose fit warned or flagged a mode:
+        its warnings (one line each) and how many of its modes carry a flag that is not informational (over
+        its methods)."""
+        out = []
+        for o in self.outcomes:
+            flagged = {(row["method"], row["mode"]) for row in o.rows
+                       if set(row["flags"].split()) - INFORMATIONAL}
+            if o.status != "failed" and (o.warnings or flagged):
+                out.append({"file": o.file, "warnings": list(o.warnings), "flagged_modes": len(flagged)})
+        return out
+
+    @property
+    def takes(self) -> list[list[str]]:
+        """Files that look like takes of one test, fitted one by one: groups of two or more time files whose
+        excitation holds one hammer hit each, recorded with the same channels (names, quantities, units) at the
+        same sample rate (:attr:`FileFit.take_setup`), in file order. A single hit gives a single average:
+        together (``modal fit FILE... --impact``) the hits are averaged and their scatter measures the noise.
+        They are never combined by the batch itself (the folder may hold repeats of one point on purpose)."""
+        groups: dict[str, list[str]] = {}
+        for o in self.outcomes:
+            if o.take_setup and o.status != "failed":
+                groups.setdefault(o.take_setup, []).append(o.file)
+        return [files for files in groups.values() if len(files) >= 2]
+
+    @property
+    def duplicates(self) -> list[list[str]]:
+        """Files that hold the same bytes (a file copied into the folder twice), in groups of two or more, in file
+        order: the table holds the same results once for each."""
+        groups: dict[str, list[str]] = {}
+        for o in self.outcomes:
+            if o.sha256:
+                groups.setdefault(o.sha256, []).append(o.file)
+        return [files for files in groups.values() if len(files) >= 2]
+
     def summary(self) -> dict[str, Any]:
-        """The ``--json`` document: files, fitted, reused, failed, archive, table, wall_time_s."""
+        """The ``--json`` document: files, fitted, reused, failed, warnings (:attr:`warned`), takes (:attr:`takes`
+        with the command that fits each group together), duplicates (:attr:`duplicates`), archive, table,
+        wall_time_s."""
         return {"files": len(self.outcomes), "fitted": self.fitted, "reused": self.reused, "failed": self.failed,
-                "archive": self.archive, "table": self.table, "wall_time_s": self.wall_time_s}
+                "warnings": self.warned, "takes": [{"files": files, "command": takes_command(files)}
+                                                   for files in self.takes],
+                "duplicates": self.duplicates, "archive": self.archive, "table": self.table,
+                "wall_time_s": self.wall_time_s}
+
+
+def takes_command(files: Sequence[str]) -> str:
+    """The command that estimates one-hit files together, as takes of one test (their hits averaged)."""
+    import shlex
+
+    return " ".join(["python -m modal fit", *map(shlex.quote, files), "--impact"])
 
 
 def _progress(total: int, enabled: bool):
@@ -164,8 +213,8 @@ def _check_timeout(value) -> float | None:
 
 
 def _outcome(entry: Entry, status: str) -> Outcome:
-    return Outcome(entry.source, status, entry.error, parse_table(entry.source, entry.table), entry.fit,
-                   entry.warnings)
+    return Outcome(entry.source, status, entry.error, parse_table(entry.source, entry.table, entry.warnings),
+                   entry.fit, entry.warnings, entry.take_setup, entry.sha256)
 
 
 def _run(files: list[str], options: FitOptions, client, out, table, workers, progress,

@@ -34,13 +34,20 @@ __all__ = ["PartStore", "TABLE_COLUMNS", "table_text", "parse_table", "write_tab
            "parts_folder"]
 
 #: Columns of the batch table (one row per file, method, mode and channel; channels counted from 1, as
-#: ``modal fit`` numbers them and ``--driving-point`` names them).
+#: ``modal fit`` numbers them and ``--driving-point`` names them). The last two are the file's: ``warnings``,
+#: what its fit warned of (one line each without the file's name, joined by " | "; empty when it fitted cleanly)
+#: and ``flagged_modes``,
+#: how many of the file's modes of that method carry a flag beyond the informational ones.
 TABLE_COLUMNS = ("file", "method", "mode", "channel", "natural_frequency_hz", "std_natural_frequency_hz",
                  "damping_ratio", "std_damping_ratio", "stiffness_n_per_m", "std_stiffness_n_per_m",
-                 "damping_n_s_per_m", "std_damping_n_s_per_m", "mass_kg", "std_mass_kg", "flags")
+                 "damping_n_s_per_m", "std_damping_n_s_per_m", "mass_kg", "std_mass_kg", "flags", "warnings",
+                 "flagged_modes")
 _STD_NAMES = ("natural_frequency_hz", "damping_ratio", "stiffness_n_per_m", "damping_n_s_per_m", "mass_kg")
-_INTEGER = ("mode", "channel")
-_TEXT = ("file", "method", "flags")
+_INTEGER = ("mode", "channel", "flagged_modes")
+_TEXT = ("file", "method", "flags", "warnings")
+#: the columns a file's stored rows hold (:func:`table_text`); the file's own columns are added when written
+_STORED = TABLE_COLUMNS[1:TABLE_COLUMNS.index("flags") + 1]
+WARNING_SEPARATOR = " | "
 
 
 def parts_folder(archive: str | os.PathLike) -> Path:
@@ -70,10 +77,26 @@ def table_text(results) -> str:
     return buffer.getvalue()
 
 
-def parse_table(source: str, text: str) -> tuple[dict, ...]:
-    """Rows (dicts over :data:`TABLE_COLUMNS`) from :func:`table_text` (NaN for empty numbers)."""
+def _file_cells(source: str, rows: list[list[str]], warnings: Sequence[str]) -> list[list[str]]:
+    """Each stored row (cells of :func:`table_text`) with the file's ``warnings`` (without the file's name, which
+    the row's first column gives) and ``flagged_modes`` cells: the modes of the row's method with a flag that
+    is not informational (on any of their channels)."""
+    from ..flags import INFORMATIONAL
+
+    method, mode, flags = (_STORED.index(name) for name in ("method", "mode", "flags"))
+    flagged: dict[str, set[str]] = {}
+    for cells in rows:
+        if set(cells[flags].split()) - INFORMATIONAL:
+            flagged.setdefault(cells[method], set()).add(cells[mode])
+    text = WARNING_SEPARATOR.join(w.removeprefix(f"{source}: ") for w in warnings)
+    return [[*cells, text, str(len(flagged.get(cells[method], ())))] for cells in rows]
+
+
+def parse_table(source: str, text: str, warnings: Sequence[str] = ()) -> tuple[dict, ...]:
+    """Rows (dicts over :data:`TABLE_COLUMNS`) from :func:`table_text` and the file's ``warnings`` (NaN for empty
+    numbers)."""
     rows = []
-    for cells in csv.reader(io.StringIO(text)):
+    for cells in _file_cells(source, list(csv.reader(io.StringIO(text))), warnings):
         row: dict = {"file": source}
         for name, cell in zip(TABLE_COLUMNS[1:], cells):
             if name in _TEXT:
@@ -94,7 +117,7 @@ def write_table(path: str | os.PathLike, entries: Sequence[Entry]) -> Path:
             writer = csv.writer(fh, lineterminator="\n")
             writer.writerow(TABLE_COLUMNS)
             for entry in entries:
-                for cells in csv.reader(io.StringIO(entry.table)):
+                for cells in _file_cells(entry.source, list(csv.reader(io.StringIO(entry.table))), entry.warnings):
                     writer.writerow([entry.source, *cells])
     return path
 
@@ -117,7 +140,7 @@ def _entry(node, location: tuple[str, str]) -> Entry | None:
     try:
         return Entry(source=_text(node["source"]), sha256=_text(node["sha256"]), error=_text(node["error"]),
                      retry=bool(node["retry"][()]), table=_text(node["table"]), location=location,
-                     warnings=_texts(node.get("warnings")))
+                     warnings=_texts(node.get("warnings")), take_setup=_text(node.get("take_setup")) or "")
     except KeyError:
         return None
 
@@ -178,7 +201,8 @@ class PartStore:
         part = self.folder / f"{fits[0].settings_hash[:16]}-{key}.h5"
         write_archive(part, {"files": list(fits)})
         return [Entry(source=fit.source, sha256=fit.sha256, error=fit.error, retry=fit.retry, table=fit.table,
-                      location=(str(part), f"/files/{i}"), warnings=fit.warnings) for i, fit in enumerate(fits)]
+                      location=(str(part), f"/files/{i}"), warnings=fit.warnings, take_setup=fit.take_setup)
+                for i, fit in enumerate(fits)]
 
     def clear(self) -> None:
         """Remove the parts folder (once the archive holds everything)."""
@@ -269,6 +293,6 @@ def write_batch_archive(path: str | os.PathLike, info: BatchInfo, entries: Seque
 def entry_of(fit: FileFit) -> Entry:
     """An entry holding the fit itself (not stored in a part)."""
     return Entry(source=fit.source, sha256=fit.sha256, error=fit.error, retry=fit.retry, table=fit.table, fit=fit,
-                 warnings=fit.warnings)
+                 warnings=fit.warnings, take_setup=fit.take_setup)
 
 

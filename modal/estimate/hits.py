@@ -45,6 +45,9 @@ PULSE_DUTY_LIMIT = 0.02
 #: ... and those pulses hold at least this share of the force's energy (a few outliers of a heavy-tailed
 #: random force hold far less; the hits of a hammer record hold nearly all of it)
 PULSE_ENERGY_SHARE = 0.5
+#: hits that peak at exactly one value this many times were clipped, each in a sample or two (hits not clipped
+#: scatter in amplitude by several per cent; :func:`modal.estimate.overload.find_overloads`)
+REPEATED_PEAKS = 3
 
 
 @dataclass(frozen=True)
@@ -293,7 +296,9 @@ def find_hits(force, response, sample_rate_hz: float, *, threshold: float | None
     start = trigger - pre
     tail = max(1, record_length // 16)
     window = np.ones(record_length) if decay_window is None else np.asarray(decay_window, float)
-    overloads = find_overloads(np.vstack([force[None, :], response]), full_scale)
+    # three hits peaking at the very same value are clipped (hits scatter by several per cent in amplitude)
+    overloads = find_overloads(np.vstack([force[None, :], response]), full_scale,
+                               repeated_peaks=REPEATED_PEAKS if trigger.size >= REPEATED_PEAKS else None)
     accepted = np.ones(trigger.size, bool)
     rejected: list[dict] = []
     pulse_len = 1

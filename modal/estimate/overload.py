@@ -13,6 +13,13 @@ is an overload, even a single one (a short hit that touched the rail).
 
 A declared full scale (``TimeRecord.full_scale``, ``estimate_frf(full_scale=)``)
 makes every sample at or beyond 99.9 % of it an overload as well.
+
+A hammer hit sampled in two or three samples touches the rail in one: no run, but
+every clipped hit then peaks at the very same value, where hits that were not
+clipped scatter in amplitude by several per cent. For a record of hits
+(``repeated_peaks=``) the extreme reached by that many separate samples, each a
+steep peak, is a rail as well, unless the samples beside them are equal too (the
+same pulse repeated exactly, as a record without noise can hold).
 """
 from __future__ import annotations
 
@@ -26,6 +33,9 @@ __all__ = ["ChannelOverload", "find_overloads", "FULL_SCALE_FRACTION"]
 FULL_SCALE_FRACTION = 0.999
 #: samples beside a flat top must lie this many quantisation steps below it
 _STEEP_CODES = 4
+#: equal peaks of a record of hits mark a rail when the samples beside them spread by more than this fraction of
+#: the peak (hits differ by per cents; a pulse repeated without noise differs by rounding, 1e-16 of it)
+_FLANK_SPREAD = 1e-6
 
 
 @dataclass(frozen=True)
@@ -79,27 +89,39 @@ def _quantisation_step(x: np.ndarray) -> float:
     return float(np.min(np.diff(values)))
 
 
-def _rail(x: np.ndarray, extreme: float) -> np.ndarray | None:
-    """Samples on the rail at ``extreme`` when the channel shows a flat top there, else None."""
+def _rail(x: np.ndarray, extreme: float, repeated_peaks: int | None = None) -> np.ndarray | None:
+    """Samples on the rail at ``extreme`` when the channel shows a flat top there (or, with ``repeated_peaks``,
+    reaches it in that many separate samples), else None."""
     on = x == extreme
     starts, stops = _runs(on)
     long = (stops - starts) >= 2
+    # separate peaks on the rail, each counted (a run of one sample at a hit's peak), when there are enough
+    peaks = repeated_peaks is not None and starts.size >= repeated_peaks
+    if peaks:
+        long[:] = True
     if not long.any():
         return None
     step = _quantisation_step(x)
-    if step > 0:
-        margin = _STEEP_CODES * step
-        steep = np.zeros(starts.size, bool)
-        for k in np.flatnonzero(long):
-            before = x[starts[k] - 1] if starts[k] > 0 else None
-            after = x[stops[k]] if stops[k] < x.size else None
-            steep[k] = all(v is None or abs(v - extreme) > margin for v in (before, after))
-        if not steep.any():
-            return None
+    steep = np.ones(starts.size, bool)
+    sides = []
+    for k in np.flatnonzero(long):
+        before = x[starts[k] - 1] if starts[k] > 0 else None
+        after = x[stops[k]] if stops[k] < x.size else None
+        sides.append((before, after))
+        if step > 0:
+            steep[k] = all(v is None or abs(v - extreme) > _STEEP_CODES * step for v in (before, after))
+    flat_tops = long & steep & ((stops - starts) >= 2)
+    # equal peaks whose flanks are equal too (to rounding) are equal pulses (a record without noise), not pulses of
+    # several heights cut at one level
+    flanks = np.array([[np.nan if v is None else v for v in pair] for pair in sides], float)
+    spread = np.nanmax(np.nanmax(flanks, axis=0) - np.nanmin(flanks, axis=0)) if flanks.size else 0.0
+    cut = peaks and steep.sum() >= repeated_peaks and spread > _FLANK_SPREAD * abs(extreme)
+    if not (flat_tops.any() or cut):
+        return None
     return on
 
 
-def find_overloads(signals, full_scale=None) -> list[ChannelOverload]:
+def find_overloads(signals, full_scale=None, repeated_peaks: int | None = None) -> list[ChannelOverload]:
     """Clipped (flat tops at the extreme) and overloaded (declared full scale) samples, per channel.
 
     Parameters
@@ -109,6 +131,9 @@ def find_overloads(signals, full_scale=None) -> list[ChannelOverload]:
     full_scale : float or sequence of (float or None), optional
         Declared full scale of every channel (one value) or of each channel, in the
         channels' units; None where unknown.
+    repeated_peaks : int, optional
+        A record of separate events (hammer hits): the extreme reached exactly by this many
+        separate samples is a rail too (hits clipped in one sample each).
 
     Returns
     -------
@@ -140,7 +165,7 @@ def find_overloads(signals, full_scale=None) -> list[ChannelOverload]:
         for extreme in (float(ch.max()), float(ch.min())):
             if extreme == 0:
                 continue
-            rail = _rail(ch, extreme)
+            rail = _rail(ch, extreme, repeated_peaks)
             if rail is not None:
                 mask |= rail
                 if how is None:

@@ -17,7 +17,7 @@ import numpy as np
 
 from ..errors import FormatError
 from ..frf import FRF
-from ._common import check_file, check_hints, source_name
+from ._common import check_file, check_hints, refuse_copies, source_name
 
 __all__ = ["read_frf", "write_frf", "sniff_format", "WRITE_FORMATS"]
 
@@ -137,6 +137,7 @@ def read_frf(path: str | os.PathLike | Sequence[str | os.PathLike], **hints: Any
     paths = list(path)
     if not paths:
         raise FormatError("read_frf: an empty list of files; expected at least one path")
+    refuse_copies(paths, "files combined on one axis", "a file given twice gives its channels twice")
     per_file = {k: v for k, v in hints.items() if k not in ("response_points", "reference_points", "units")}
     frfs = [_read_one(p, per_file) for p in paths]
     return _combine(frfs, paths, hints)

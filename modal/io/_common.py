@@ -19,7 +19,7 @@ from ..frf_units import frf_in_si
 from ..units import TWO_PI
 
 __all__ = [
-    "HINTS", "check_hints", "check_file", "source_name", "resolve_kind", "frequency_factor",
+    "HINTS", "check_hints", "check_file", "refuse_copies", "source_name", "resolve_kind", "frequency_factor",
     "frequency_unit_from_text", "build_frf", "KIND_ALIASES",
 ]
 
@@ -56,6 +56,25 @@ def check_hints(hints: dict[str, Any]) -> None:
     unknown = sorted(set(hints) - HINTS)
     if unknown:
         raise TypeError(f"read_frf() got unknown hint(s) {', '.join(unknown)}; known: {', '.join(sorted(HINTS))}")
+
+
+def refuse_copies(paths, what: str, why: str) -> None:
+    """Refuse a list of files in which one holds the same bytes as another (given twice, or copied): ``what`` the
+    files are and ``why`` a copy is wrong (in the message)."""
+    import hashlib
+
+    seen: dict[tuple[int, bytes], str] = {}
+    for path in paths:
+        try:
+            with open(path, "rb") as fh:
+                digest = hashlib.file_digest(fh, "sha256").digest()
+            key = (os.path.getsize(path), digest)
+        except OSError:
+            continue  # the reader says what is wrong with it
+        if key in seen:
+            raise FormatError(f"{source_name(path)}: holds the same bytes as {seen[key]}; expected each of the "
+                              f"{what} once ({why})")
+        seen[key] = source_name(path)
 
 
 def check_file(path: str | os.PathLike) -> Path:

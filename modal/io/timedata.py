@@ -60,6 +60,10 @@ _TIME_FACTOR = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6, "μs": 1e-6}
 #: a sample rate below this (Hz) from a time column that gives no unit is named: it is what a column in
 #: milliseconds read as seconds gives at rates up to 20 kHz, and below what vibration tests sample at
 LOW_RATE_HZ = 20.0
+#: a hammer hit lasts from about 0.1 ms (a steel tip) to 20 ms (a soft tip on a heavy structure): force pulses
+#: longer than this at the rate a file states are no hits at that rate, the rate is off by its unit (a rate in
+#: kHz written as Hz makes a 2 ms hit last 2 s), s
+MAX_HIT_DURATION_S = 0.1
 
 
 @dataclass(frozen=True)
@@ -227,12 +231,35 @@ def _check_samples(values: np.ndarray, src: str, where: str) -> None:
         raise FormatError(f"{src}: {where}, {at}: {what}; expected finite samples (|value| < {LARGEST_SAMPLE:g})")
 
 
-def _check(signals: np.ndarray, rate: float, src: str) -> None:
+def _check(signals: np.ndarray, rate: float, src: str, quantities=(), field: str = "sample rate") -> None:
+    """Shape, rate and samples; and the rate against the hammer hits of the channels that say they measured force
+    (``field`` names where the rate came from)."""
     if signals.ndim != 2 or signals.shape[1] < 2:
         raise FormatError(f"{src}: field 'signals' has shape {signals.shape}; expected (channels, samples >= 2)")
     if not (np.isfinite(rate) and rate > 0):
         raise FormatError(f"{src}: sample rate {rate!r}; expected a positive number of samples per second")
     _check_samples(signals, src, "field 'signals'")
+    _check_hit_durations(signals, rate, src, quantities, field)
+
+
+def _check_hit_durations(signals: np.ndarray, rate: float, src: str, quantities, field: str) -> None:
+    """Refuse a rate at which a force channel's hits (short pulses holding its energy) last longer than any hammer
+    hit does (:data:`MAX_HIT_DURATION_S`): the rate, or the time axis it came from, is in the wrong unit."""
+    timed = field.startswith("column") or field == "field 'time'"
+    hint = ("is the time in ms? say so in its name: 'time [ms]'" if timed else "is it in kHz?")
+    from ..estimate.hits import pulse_train
+
+    for k, quantity in enumerate(quantities):
+        if quantity != "force":
+            continue
+        train = pulse_train(signals[k], rate)
+        if not train.impulsive:
+            continue
+        duration = train.duty * signals.shape[1] / train.count / rate
+        if duration > MAX_HIT_DURATION_S:
+            raise FormatError(f"{src}: {field} gives {rate:.6g} samples/s, at which the {train.count} hit(s) of force "
+                              f"channel {k + 1} last {duration:.3g} s each; expected a rate in Hz at which hammer "
+                              f"hits last at most {MAX_HIT_DURATION_S:g} s ({hint})")
 
 
 def _time_column(header: str) -> str | None:
@@ -243,7 +270,7 @@ def _time_column(header: str) -> str | None:
     return next((unit for unit in match.groups() if unit), "")
 
 
-def _rate_from_time(time: np.ndarray, src: str, field: str = "time", unit_given: bool = False) -> float:
+def _rate_from_time(time: np.ndarray, src: str, field: str = "time") -> float:
     time = np.asarray(time, float).ravel()
     if time.size < 2 or not np.all(np.isfinite(time)):
         raise FormatError(f"{src}: field {field!r} holds {time.size} values or non-finite ones; expected a time axis in s")
@@ -252,11 +279,21 @@ def _rate_from_time(time: np.ndarray, src: str, field: str = "time", unit_given:
     if mean <= 0 or np.max(np.abs(step - mean)) > 1e-6 * mean + 1e-9 * abs(time[-1]):
         raise FormatError(f"{src}: field {field!r} is not uniformly increasing; expected samples at one rate "
                           "(resample first)")
-    rate = 1.0 / mean
-    if not unit_given and rate < LOW_RATE_HZ:
+    return 1.0 / mean
+
+
+def _warn_low_rate(rate: float, src: str, field: str, time_axis: bool) -> None:
+    """Name a sample rate below :data:`LOW_RATE_HZ` that a time axis without a unit (read in s) or a rate field
+    gave: what milliseconds read as seconds, or kHz as Hz, give. After the record's checks, which refuse it
+    outright where its hammer hits contradict it."""
+    if rate >= LOW_RATE_HZ:
+        return
+    if time_axis:
         warn(f"{src}: field {field!r} gives no unit and is read in s: a sample rate of {rate:.6g} Hz; if it "
              "holds milliseconds, say so in its name ('time [ms]')", QualityWarning)
-    return rate
+    else:
+        warn(f"{src}: field {field!r} gives a sample rate of {rate:.6g} Hz, below what vibration tests sample "
+             "at; if it holds kHz, write it in Hz", QualityWarning)
 
 
 def _uff_time_step(block, d: dict, src: str) -> float:
@@ -348,7 +385,7 @@ def _read_uff(path, src: str) -> TimeRecord:
     # within that rounding (5e-6 relative) of a whole number of samples per second is taken as that number
     if abs(rate - round(rate)) <= 5e-6 * rate:
         rate = float(round(rate))
-    _check(signals, rate, src)
+    _check(signals, rate, src, quantities, "the time step (record 7, abscissa_inc)")
     return TimeRecord(signals, rate, tuple(names), tuple(quantities), tuple(units), src)
 
 
@@ -433,7 +470,7 @@ def _read_csv(path, src: str) -> TimeRecord:
                                       "expected numbers below the header") from None
         raise
     factor = _TIME_FACTOR[time_unit.lower()] if time_unit else 1.0
-    rate = _rate_from_time(table[:, 0] * factor, src, field=header[0], unit_given=bool(time_unit))
+    rate = _rate_from_time(table[:, 0] * factor, src, field=header[0])
     scale = _csv_full_scale(comments, len(header) - 1, src)
     signals, names, quantities, units, scales = [], [], [], [], []
     for j, text in enumerate(header[1:], start=1):
@@ -446,7 +483,9 @@ def _read_csv(path, src: str) -> TimeRecord:
         level = None if scale is None else scale[j - 1]
         scales.append(None if level is None else level * _SI_FACTOR.get(_normalise_unit(unit) or "", 1.0))
     signals = np.array(signals)
-    _check(signals, rate, src)
+    _check(signals, rate, src, quantities, f"column {header[0]!r}")
+    if not time_unit:
+        _warn_low_rate(rate, src, header[0], time_axis=True)
     declared = tuple(scales) if any(v is not None for v in scales) else None
     return TimeRecord(signals, rate, tuple(names), tuple(quantities), tuple(units), src, declared)
 
@@ -507,11 +546,19 @@ def _from_mapping(get, src: str) -> TimeRecord:
         raise FormatError(f"{src}: no variable 'signals'; expected a time file: 'signals' (channels x samples) and "
                           "'sample_rate_hz' or 'time'")
     signals = _signals(signals, src)
+    rate_field = "sample_rate_hz"
     rate = _number(get("sample_rate_hz"), "sample_rate_hz", src)
     if rate is None:
-        rate = _number(get("fs"), "fs", src)
+        rate_field, rate = "fs", _number(get("fs"), "fs", src)
+    time = get("time")
+    if rate is not None and time is not None:  # a time for every sample beside the rate: the two must agree
+        time = np.asarray(time, float).ravel()
+        step = (time[-1] - time[0]) / (time.size - 1) if time.size == signals.shape[1] >= 2 else np.nan
+        # 1e-4: far above a single-precision time vector's rounding, far below a unit's factor of 1000
+        if np.isfinite(step) and step > 0 and abs(1 / step - rate) > 1e-4 * rate:
+            raise FormatError(f"{src}: field {rate_field!r} is {rate:.6g} but field 'time' steps {step:.6g} s "
+                              f"({1 / step:.6g} Hz); expected the same sample rate in Hz (is {rate_field!r} in kHz?)")
     if rate is None:
-        time = get("time")
         if time is None:
             raise FormatError(f"{src}: neither 'sample_rate_hz' nor 'time'; expected one of them beside 'signals'")
         time = np.asarray(time, float).ravel()
@@ -520,7 +567,7 @@ def _from_mapping(get, src: str) -> TimeRecord:
         if signals.shape[1] != time.size:
             raise FormatError(f"{src}: field 'time' has {time.size} values and 'signals' {signals.shape[1]} samples "
                               "per channel; expected one time per sample")
-        rate = _rate_from_time(time, src)
+        rate_field, rate = "time", _rate_from_time(time, src)
     n_ch = signals.shape[0]
     names = _strings(get("names"), "names", src) or [str(k + 1) for k in range(n_ch)]
     quantities = _strings(get("quantities"), "quantities", src) or [""] * n_ch
@@ -549,7 +596,8 @@ def _from_mapping(get, src: str) -> TimeRecord:
         factor = _SI_FACTOR.get(_normalise_unit(stored_units[k]) or "", 1.0)
         scales.append(None if level is None else level * factor)
     signals = np.array(out)
-    _check(signals, rate, src)
+    _check(signals, rate, src, quants, f"field {rate_field!r}")
+    _warn_low_rate(rate, src, rate_field, time_axis=rate_field == "time")
     declared = tuple(scales) if any(v is not None for v in scales) else None
     return TimeRecord(signals, rate, tuple(names), tuple(quants), tuple(si_units), src, declared)
 

@@ -6,6 +6,8 @@ import numpy as np
 import pytest
 
 from modal.archive import read_archive, write_archive
+from modal.io import write_frf
+from modal.synthetic import modal_frf
 from support.paths import SYNTHETIC
 
 PLATE_FRF = SYNTHETIC / "plate_frf.uff"
@@ -70,6 +72,10 @@ def test_report_and_gif_of_the_plate(plate_archive, tmp_path):
     (lambda p: write_archive(p, {"batch": {"n_files": 3}}), "is a batch archive (many files)"),
     (lambda p: p.write_text("frequency,re,im\n"), "not a readable HDF5 file"),
     (lambda p: None, "no such archive file"),
+    # an FRF file (what modal frf --out writes), not a fit: it failed with "node /frf has unknown type None"
+    (lambda p: write_frf(modal_frf(np.linspace(1.0, 100.0, 200), [40.0], [0.02], [1.0]), p),
+     "an FRF file (/frf/<name>, as modal frf --out writes it), not an archive of results; expected an archive of a "
+     "fit: python -m modal fit"),
 ])
 def test_what_cannot_be_reported_is_one_line_and_exit_1(tmp_path, make, expect):
     path = tmp_path / "x.h5"

@@ -284,9 +284,34 @@ def test_hammer_hits_saved_in_several_files_are_averaged_as_one_test(tmp_path):
     modes = [json.loads(out.stdout)["modes"] for out in (both, whole)]
     assert [m["natural_frequency_hz"] for m in modes[0]] == pytest.approx(
         [m["natural_frequency_hz"] for m in modes[1]], rel=1e-9)
+    # a take given twice (a copy in the folder, or the same name twice): averaged with itself its noise looked
+    # smaller, the fit turned model_inadequate and found a mode at 470 Hz; refused naming both files
+    copy = tmp_path / "hit_a_copy.csv"
+    copy.write_bytes(first.read_bytes())
+    out = run("fit", first, copy, second, "--impact")
+    assert out.returncode == 1 and out.stderr.count("\n") == 1
+    assert f"{copy}: holds the same bytes as {first}; expected each of the takes once" in out.stderr
     # a file of other channels is not a take of the same test
     other = tmp_path / "other.csv"
     other.write_text("\n".join([header.replace("1+Z [m/s^2]", "2+Z [m/s^2]")] + rows[:cut]) + "\n")
     out = run("fit", first, other, "--impact")
     assert out.returncode == 1 and out.stderr.count("\n") == 1
     assert "other.csv: channel 2 (names) is '2+Z'" in out.stderr and "expected the same channels" in out.stderr
+
+
+def test_a_band_above_the_files_nyquist_frequency_names_the_sample_rate(tmp_path):
+    # a random-excitation MAT file whose fs is 1.024 (kHz written as a number): nothing in the record contradicts
+    # it (no hits), so it is read with a warning; a band in Hz above its Nyquist frequency (0.512 Hz) then says
+    # which rate it lies above instead of "band holds 0 lines"
+    from scipy.io import savemat
+
+    force, displacement = _records(n=2**14)
+    path = tmp_path / "random.mat"
+    savemat(path, {"signals": np.vstack([force, displacement]), "fs": FS / 1000,
+                   "units": np.array(["N", "m", "m"], dtype=object)})
+    out = run("fit", path, "--band", 30, 50)
+    assert out.returncode == 1 and "Traceback" not in out.stderr
+    assert "field 'fs' gives a sample rate of 1.024 Hz" in out.stderr
+    error = [line for line in out.stderr.splitlines() if line.startswith("error: ")]
+    assert error == [f"error: {path}: --band 30 50 Hz lies above the Nyquist frequency 0.512 Hz of the file's sample "
+                     "rate 1.024 Hz; expected bands below it (is the file's sample rate in kHz?)"]

@@ -111,7 +111,7 @@ def test_uff_unit_labels_are_converted(tmp_path, numerator, denominator, factor)
 
 
 def test_the_table_does_not_call_constants_in_an_unknown_unit_1_per_kg():
-    # the modal constants of an FRF in V/V are in V/V (times s^2 for accelerance), not 1/kg: the table's header says so
+    # the modal constants of an FRF in V/V are in V/V (an accelerance; (V/V)/s for a mobility), not 1/kg: the table's header says so
     si = modal_frf(FREQUENCY, [40.0], [0.02], [[1.0]], kind="accelerance", response_points=["1+Z"],
                    reference_points=["1+Z"])
     volts = modal.FRF(si.frequency_hz, si.response * 0.01, kind="accelerance", units="V/V",
@@ -123,3 +123,48 @@ def test_the_table_does_not_call_constants_in_an_unknown_unit_1_per_kg():
         table = format_table(modal.identify(volts, "nls"))
         assert "A [1/kg]" in format_table(modal.identify(si, "nls"))
     assert "A [V/V-based]" in table and "1/kg" not in table
+
+
+@pytest.mark.parametrize("kind, constant, upper", [("accelerance", "V/V", "(V/V) s^2"),
+                                                   ("mobility", "(V/V)/s", "(V/V) s"),
+                                                   ("receptance", "(V/V)/s^2", "V/V")])
+def test_the_archive_and_the_json_carry_the_constants_true_unit(tmp_path, kind, constant, upper):
+    # A = H_receptance (ωn² − ω² + 2iζωnω) is the FRF's unit times s^(p − 2) (1/kg for an accelerance in m/s²/N):
+    # an FRF in V/V gives constants in V/V (accelerance), (V/V)/s (mobility), (V/V)/s² (receptance). The archive
+    # wrote "1/kg" on them (and on their errors), and the line noise in the kind's SI unit
+    import json
+    import subprocess
+    import sys
+
+    import h5py
+
+    from modal.archive import read_archive, write_archive
+
+    si = modal_frf(FREQUENCY, [40.0, 120.0], [0.02, 0.01], [1.0, 0.5], kind=kind, response_points=["1+Z"],
+                   reference_points=["1+Z"])
+    volts = modal.FRF(si.frequency_hz, si.response * 0.01, kind=kind, units="V/V", response_points=["1+Z"],
+                      reference_points=["1+Z"])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        result = modal.identify(volts, "nls")
+        reference = modal.identify(si, "nls")
+    write_archive(tmp_path / "volts.h5", {"identify_nls": result, "si": reference})
+    with h5py.File(tmp_path / "volts.h5", "r") as f:
+        assert f["identify_nls/modes/0/modal_constant"].attrs["units"] == constant
+        assert f["identify_nls/modes/1/std/modal_constant"].attrs["units"] == constant
+        assert f["identify_nls/noise_std"].attrs["units"] == "V/V"
+        assert f["identify_nls/modes/0/natural_frequency_hz"].attrs["units"] == "Hz"  # the rest as before
+        assert f["si/modes/0/modal_constant"].attrs["units"] == "1/kg"  # an SI FRF's constants are in 1/kg
+        assert f["si/noise_std"].attrs["units"] == modal.frf.DEFAULT_UNITS[kind]
+    assert read_archive(tmp_path / "volts.h5")["identify_nls"].settings["frf_units"] == "V/V"
+    # the residual terms (where a method fits them): the upper one a receptance, the lower one as the constants
+    assert result.archive_units()["residuals"] == (f"{upper} (column 0: upper residual), {constant} "
+                                                   "(column 1: lower residual)")
+    # modal fit --json says the constants' unit beside them
+    for frf, expected in ((volts, constant), (si, "1/kg")):
+        path = tmp_path / f"{expected.replace('/', '_')}.csv"
+        write_frf(frf, path)
+        done = subprocess.run([sys.executable, "-m", "modal", "fit", str(path), "--method", "nls", "--json"],
+                              capture_output=True, text=True, timeout=120)
+        assert done.returncode == 0, done.stderr
+        assert json.loads(done.stdout)["modal_constant_units"] == expected

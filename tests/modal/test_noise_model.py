@@ -170,3 +170,29 @@ def test_input_noise_split_recovers_both_noise_powers():
     lines = np.ones(h.size, bool)
     lines[:100] = False
     np.testing.assert_allclose(input_noise_split(spoiled, h, lines), (a, b), rtol=0.05)
+
+
+def test_a_change_of_kind_scales_the_variance_model_as_the_data(plant):
+    """The variance model is in the FRF's unit squared: accelerance converted to receptance divides it by ω⁴,
+    as the estimator does when it gives receptance from the same accelerations. It was left in (m/s²/N)²:
+    the converted FRF's noise shape was then off by ω⁴ (10⁸ at 100 Hz) against its own noise_std."""
+    hits = 0.5 + 4.0 * np.arange(6)
+    rec = impact_record(plant, hits, 24.5, response_noise=0.002, force_noise=0.002, seed=3).record
+
+    def estimate(kind):
+        return modal.estimate_frf(rec.signals[0], rec.signals[1], FS, impact=True, window="exponential",
+                                  exponential_decay_s=0.5, response_quantity="acceleration", kind=kind)
+
+    accelerance = estimate("accelerance")
+    assert accelerance.noise_model.variance_model is not None
+    converted = accelerance.cropped(0.5, FS / 2).as_kind("receptance")
+    direct = estimate("receptance")  # the model of the converted data, from the estimator itself
+    np.testing.assert_array_equal(converted.frequency_hz, direct.frequency_hz)
+    # the same numbers up to rounding (both are the accelerance model times |2πf|⁻⁴)
+    np.testing.assert_allclose(converted.noise_model.variance_model, direct.noise_model.variance_model,
+                               rtol=1e-10, equal_nan=True)
+    # and the model keeps its ratio to the converted lines' own noise (both are variances of one unit)
+    held = np.isfinite(converted.noise_model.variance_model)
+    np.testing.assert_allclose((converted.noise_model.variance_model / converted.noise_std ** 2)[held],
+                               (accelerance.noise_model.variance_model[1:] / accelerance.noise_std[1:] ** 2)[held],
+                               rtol=1e-10)

@@ -133,6 +133,13 @@ def test_several_files_combine_into_channels(tmp_path):
     got = read_frf(paths)
     assert got.n_channels == 3
     _assert_same(got, frf)
+    # a file given twice, or copied under another name: its channels would come twice (two identical rows in
+    # every shape); refused naming both
+    (tmp_path / "copy.csv").write_bytes(paths[1].read_bytes())
+    for again in (paths[1], tmp_path / "copy.csv"):
+        with pytest.raises(FormatError, match=rf"{again.name}: holds the same bytes as .*c1\.csv; expected each of "
+                                              r"the files combined on one axis once"):
+            read_frf([*paths, again])
 
 
 # ----------------------------------------------------------------- HDF5

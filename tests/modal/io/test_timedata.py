@@ -365,3 +365,45 @@ def test_a_unit_that_contradicts_the_data_type_is_refused(tmp_path):
     _uff(path, channels)
     assert_refused(path, "dataset 1", "record 9, field ordinate_axis_units_lab", "'m/s^2' is of acceleration",
            "measured force")
+
+
+@pytest.mark.parametrize("suffix, field", [(".mat", "field 'sample_rate_hz'"), (".h5", "field 'sample_rate_hz'"),
+                                           (".uff", "the time step (record 7, abscissa_inc)"),
+                                           (".csv", "column 'time [s]'")])
+def test_a_rate_in_khz_is_refused_where_the_hammer_hits_contradict_it(tmp_path, suffix, field):
+    # 1024 samples/s stored as 1.024 (kHz written as a number in Hz): every file read it as 1.024 Hz, and the fit
+    # gave modes at 0.0156 Hz with k 1000² too small, unflagged. At that rate the 2 ms hits last 2 s each, which no
+    # hammer hit does: refused, naming the field the rate came from
+    record = replace(_record(), sample_rate_hz=FS / 1000)
+    path = tmp_path / f"khz{suffix}"
+    write_time(record, path)
+    message = assert_refused(path, field, "1.024 samples/s", "2 hit(s) of force channel 1 last ", "at most 0.1 s")
+    # the part of a 2 ms half-sine above the trigger threshold, 1000 times too long: between 1 and 2 s
+    assert 1.0 <= float(message.split(" last ")[1].split(" s ")[0]) <= 2.0, message
+    assert ("kHz" in message) != ("'time [ms]'" in message)  # the hint that fits where the rate came from
+    # the same file at its true rate reads without a word, and so do hits as long as a soft tip's (20 ms)
+    for record in (_record(), _record(pulse_width_s=0.02)):
+        write_time(record, path)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            assert read_time(path).sample_rate_hz == pytest.approx(FS, rel=1e-9)
+
+
+def test_a_mat_rate_and_time_vector_that_disagree_are_refused(tmp_path):
+    from scipy.io import savemat
+
+    from modal.errors import QualityWarning
+
+    record = _record()
+    time = np.arange(record.signals.shape[1]) / FS
+    path = tmp_path / "both.mat"
+    units = np.array(["N", "m/s^2", "m/s^2"], dtype=object)
+    savemat(path, {"signals": record.signals, "fs": FS / 1000, "time": time, "units": units})
+    assert_refused(path, "field 'fs' is 1.024 but field 'time' steps 0.000976562 s (1024 Hz)", "in kHz?")
+    # agreeing to a single-precision time vector's rounding: read
+    savemat(path, {"signals": record.signals, "fs": FS, "time": time.astype(np.float32), "units": units})
+    assert read_time(path).sample_rate_hz == FS
+    # a rate in kHz without hits to contradict it (responses only): read, and named
+    savemat(path, {"signals": record.signals[1:], "fs": FS / 1000, "units": units[1:]})
+    with pytest.warns(QualityWarning, match=r"both\.mat: field 'fs' gives a sample rate of 1\.024 Hz.*write it in Hz"):
+        read_time(path)
