@@ -40,18 +40,21 @@ def test_single_and_double_precision_records_agree():
     assert np.array_equal(c.channel(3), b.channel(3))
 
 
-def test_mean_and_rms_are_exact_with_a_large_offset():
+@pytest.mark.parametrize("offset, rtol", [(0.0, 1e-11), (1e6, 1e-9)])
+def test_mean_and_rms_are_exact(offset, rtol):
     # read in pieces (200 000 samples: three whole pieces and a partial one) and pooled: the channels' mean and
-    # RMS about it, as from each whole channel centred in double precision. Samples at 10⁶ of RMS 1-8 carry
-    # 1e-10 of absolute rounding each, so the RMS holds to 1e-9; a sum of squares about zero would have lost
-    # 10¹² × 2e-16 = 2e-4 of the variance to cancellation
-    signals = _record() + 1e6
+    # RMS about it, as from each whole channel centred in double precision. With a mean of 3 and an RMS of 1-8,
+    # a piece's sum of squares about its mean is the difference of sums of 65 536 squares: rounding of
+    # about 256 (√65 536) × 1e-16 × 10 of it (2.6e-13; 1e-11 allowed). Samples at 10⁶ carry 1e-10 of absolute
+    # rounding each, so their RMS holds to 1e-9: those pieces are centred first, since a sum of squares about
+    # zero would have lost 10¹² × 2e-16 = 2e-4 of the variance to cancellation
+    signals = _record() + offset
     assert signals.shape[1] % CHUNK_SAMPLES and signals.shape[1] > 3 * CHUNK_SAMPLES
     prepared = prepare(signals, 100.0)
     centred = signals - signals.mean(axis=1, keepdims=True)
     rms = np.sqrt(np.mean(centred**2, axis=1))
     assert np.allclose(prepared.mean, signals.mean(axis=1), rtol=1e-14)
-    assert np.allclose(prepared.scale, rms, rtol=1e-9)
+    assert np.allclose(prepared.scale, rms, rtol=rtol)
 
 
 def test_channel_is_the_centred_and_scaled_samples():
