@@ -168,9 +168,9 @@ def choose_references(signals: np.ndarray, n_references: int, probe_lags: int = 
                       probe_samples: int = 1 << 14, mean=None) -> tuple[int, ...]:
     """The channels that best span the outputs' correlations, for projection.
 
-    Each channel (less its ``mean``, when given) is scaled to unit RMS; the correlations of every channel with every other
-    over a few lags (from the first ``probe_samples`` samples, one matrix product in single
-    precision) form the columns of one matrix, and a column-pivoted QR picks the
+    Each channel (less its ``mean``, when given) is scaled to unit RMS; the correlations of every
+    channel with every other over a few lags (from the first ``probe_samples`` samples, one matrix
+    product in single precision) form the columns of one matrix, and a column-pivoted QR picks the
     ``n_references`` channels that are the most independent and carry the most correlated
     (not white) signal: white measurement noise only enters lag 0, which is left out. The
     choice needs only the rough correlations that 2¹⁴ samples give (each within a few percent);
