@@ -140,7 +140,10 @@ def channel_statistics(signals: np.ndarray, src: str, names=()) -> tuple[np.ndar
     The record is read from memory once, :data:`CHUNK_SAMPLES` of a channel at a time: each piece's sum and
     sum of squares (in double precision, the piece still in cache for the second), their difference the sum of
     squares about the piece's mean, unless a large offset would cancel digits there (:func:`_moments`); the
-    pieces' means and sums of squares are then pooled exactly (Chan, Golub & LeVeque).
+    pieces' means and sums of squares are then pooled exactly (Chan, Golub & LeVeque). A record whose channels'
+    samples are not contiguous in memory (an array of shape (n_samples, n_channels) transposed) is read a stretch
+    of samples of every channel at a time instead (:func:`_moments_by_samples`): channel by channel, each read
+    would touch the whole record.
 
     Returns
     -------
@@ -151,13 +154,20 @@ def channel_statistics(signals: np.ndarray, src: str, names=()) -> tuple[np.ndar
     n_channels, n = signals.shape
     mean = np.empty(n_channels)
     rms = np.empty(n_channels)
-    buffer = np.empty(min(n, CHUNK_SAMPLES))
+    if signals.strides[1] != signals.itemsize:  # e.g. (n_samples, n_channels).T: read a stretch of samples at a time
+        mean, squares, finite = _moments_by_samples(signals)
+        if not finite.all():
+            _refuse_non_finite(signals, int(np.flatnonzero(~finite)[0]), src, names)
+    else:
+        squares = np.empty(n_channels)
+        buffer = np.empty(min(n, CHUNK_SAMPLES))
+        for ch, row in enumerate(signals):
+            moments = _moments(row, buffer)
+            if moments is None:
+                _refuse_non_finite(signals, ch, src, names)
+            mean[ch], squares[ch] = moments
     for ch, row in enumerate(signals):
-        moments = _moments(row, buffer)
-        if moments is None:
-            _refuse_non_finite(signals, ch, src, names)
-        mean[ch], squares = moments
-        rms[ch] = np.sqrt(squares / n)
+        rms[ch] = np.sqrt(squares[ch] / n)
         if not np.isfinite(rms[ch]):
             raise ParameterError(f"{src}: channel {ch + 1}{_name(names, ch)}: samples up to {np.abs(row).max():g}; "
                                  "expected values whose squares fit double precision (rescale the record)")
@@ -201,6 +211,36 @@ def _moments(row: np.ndarray, buffer: np.ndarray):
         pooled_mean += delta * m / total
         count = total
     return pooled_mean, pooled_squares
+
+
+@np.errstate(over="ignore", invalid="ignore")
+def _moments_by_samples(signals: np.ndarray):
+    """(means, sums of squares about them, finite) of every channel, as :func:`_moments` but a stretch of samples
+    of every channel at a time (:data:`CHUNK_SAMPLES` samples in all), copied into a double-precision buffer."""
+    n_channels, n = signals.shape
+    width = max(CHUNK_SAMPLES // n_channels, 1)
+    buffer = np.empty((n_channels, min(n, width)))
+    pooled_mean, pooled_squares, count = np.zeros(n_channels), np.zeros(n_channels), 0
+    finite = np.ones(n_channels, bool)
+    for start in range(0, n, width):
+        piece = buffer[:, :min(width, n - start)]
+        piece[...] = signals[:, start:start + width]
+        m = piece.shape[1]
+        total_sum = piece.sum(axis=1)
+        piece_mean = total_sum / m
+        finite &= np.isfinite(piece_mean)
+        squares = np.einsum("ij,ij->i", piece, piece)
+        about_mean = squares - total_sum * piece_mean
+        cancelled = ~(about_mean > CANCELLATION * squares)
+        if cancelled.any():
+            centred = piece[cancelled] - piece_mean[cancelled, None]
+            about_mean[cancelled] = np.einsum("ij,ij->i", centred, centred)
+        total = count + m
+        delta = piece_mean - pooled_mean
+        pooled_squares += about_mean + delta * delta * count * m / total
+        pooled_mean += delta * m / total
+        count = total
+    return pooled_mean, pooled_squares, finite
 
 
 def _check_shape(signals: np.ndarray, src: str) -> None:

@@ -110,3 +110,20 @@ def test_samples_whose_squares_overflow_are_refused():
     signals[2] *= 1e160
     with pytest.raises(ParameterError, match="channel 3: samples up to .*e\\+16.; expected values whose squares fit"):
         prepare(signals, 100.0)
+
+
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+def test_transposed_record_gives_the_same_statistics(dtype):
+    # an array of shape (n_samples, n_channels) transposed: its channels' samples lie apart in memory, and it is
+    # read a stretch of samples of every channel at a time; the same means and RMS to double-precision rounding
+    # of sums of 200 000 samples, the same first bad sample named
+    signals = _record().astype(dtype)
+    signals[5] += 1e6  # one channel's pieces centred before their squares are summed
+    transposed = np.ascontiguousarray(signals.T).T
+    assert transposed.strides[1] != transposed.itemsize
+    a, b = prepare(signals, 100.0), prepare(transposed, 100.0)
+    assert np.allclose(b.mean, a.mean, rtol=1e-13) and np.allclose(b.scale, a.scale, rtol=1e-9)
+    transposed[3, 70_000] = np.nan
+    transposed[6, 5] = np.inf
+    with pytest.raises(ParameterError, match=r"channel 4, sample 70000: nan; expected finite samples \(2 are not\)"):
+        prepare(transposed, 100.0)
