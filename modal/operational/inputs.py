@@ -24,16 +24,16 @@ CONSTANT_CHANNEL = 1e-12
 CANCELLATION = 1e-3
 #: the record must hold at least this many times the longest correlation lag
 MIN_LAGS_IN_RECORD = 40
-#: the input check reads each channel this many samples at a time: each piece is centred in a double-precision
-#: buffer (512 kB) that stays in cache while it is squared and summed
+#: the input check reads each channel this many samples at a time: each piece is summed and squared while it
+#: stays in cache (and copied to double precision or centred first, where needed, in a 512 kB buffer)
 CHUNK_SAMPLES = 1 << 16
 
 
 @dataclass(frozen=True)
 class Prepared:
     """A record checked and brought to the band, with each channel's mean and RMS; the samples themselves are
-    neither centred nor scaled (a centred, scaled copy of a 10⁶ × 64 record would cost a pass over 256 MB
-    written and read again): the correlations centre them as they read them and scale the correlation matrices
+    neither centred nor scaled (a centred, scaled single-precision copy of a 10⁶ × 64 record would take 256 MB):
+    the correlations centre them as they read them and scale the correlation matrices
     (:func:`modal.operational.correlations.correlations`), and :meth:`channel` gives one channel centred and
     scaled where a method needs samples.
 
