@@ -210,7 +210,7 @@ def tone_calls(n_records: int) -> str:
                 continue
             channel = int(np.argmax(np.abs(m.mode_shape) / prepared.scale))  # as the test chooses it
             width = max(4 * m.damping_ratio * m.natural_frequency_hz, MIN_BANDWIDTH_TIME / prepared.duration_s)
-            k = band_kurtosis(np.fft.rfft(prepared.signals[channel]), prepared.signals.shape[1],
+            k = band_kurtosis(np.fft.rfft(prepared.channel(channel)), prepared.n_samples,
                               prepared.sample_rate_hz, m.natural_frequency_hz, width)
             if k < lowest[0]:
                 lowest = (k, f"{m.natural_frequency_hz:.2f} Hz, seed {7000 + r}, {noise:.0%} noise, {duration:g} s")

@@ -60,6 +60,8 @@ class Correlations:
         """The blocks merged into ``n_groups`` contiguous groups: (correlations, weights)."""
         n = self.blocks.shape[0]
         n_groups = int(min(max(n_groups, 1), n))
+        if n_groups == n:  # (a 10⁶ × 64 record's 50 blocks are 9 MB)
+            return self.blocks, self.weights
         edges = np.linspace(0, n, n_groups + 1).round().astype(int)
         weights = np.add.reduceat(self.weights, edges[:-1])
         sums = np.add.reduceat(self.blocks * self.weights[:, None, None, None], edges[:-1], axis=0)
@@ -92,13 +94,13 @@ def _segment_length(max_lag: int, n_samples: int) -> int:
 
 
 def correlations(signals: np.ndarray, sample_rate_hz: float, references, max_lag: int,
-                 max_blocks: int = MAX_BLOCKS) -> Correlations:
+                 max_blocks: int = MAX_BLOCKS, mean=None, scale=None) -> Correlations:
     """Correlations ``R_k``, k = 0…``max_lag``, of every output with the references, per block.
 
     Parameters
     ----------
     signals : ndarray, shape (n_outputs, n_samples)
-        Zero-mean signals.
+        The signals (zero-mean unless ``mean`` is given), single or double precision.
     sample_rate_hz : float
     references : sequence of int
         Reference channels (indices into the outputs).
@@ -106,10 +108,17 @@ def correlations(signals: np.ndarray, sample_rate_hz: float, references, max_lag
         Longest lag, samples.
     max_blocks : int
         At most this many blocks (each of whole segments).
+    mean : ndarray, shape (n_outputs,), optional
+        Each signal's mean: removed as the samples are read, one block at a time, in double precision before
+        they are rounded to single (so that an offset large against the signal costs no precision).
+    scale : ndarray, shape (n_outputs,), optional
+        Each signal's RMS: the correlations are those of the signals divided by it (``R_k`` divided by
+        ``scale[o] scale[r]``), the samples themselves left as they are.
 
     Returns
     -------
     Correlations
+        In units² of the signals, or of the signals divided by ``scale``.
     """
     from scipy import fft as sfft
 
@@ -123,13 +132,23 @@ def correlations(signals: np.ndarray, sample_rate_hz: float, references, max_lag
     n_blocks = int(min(max_blocks, n_segments))
     edges = np.linspace(0, n_segments, n_blocks + 1).round().astype(int)
     # float32 FFTs: their rounding (1e-7 relative) lies far below the estimates' scatter (1/√samples)
-    data = np.ascontiguousarray(signals, dtype=np.float32)
-    windows = np.lib.stride_tricks.sliding_window_view(data, n_seg + max_lag, axis=1)
+    if mean is None:
+        record = np.ascontiguousarray(signals, dtype=np.float32)
+    else:  # each block's samples centred into one buffer, reused
+        shift = np.asarray(mean, float)[:, None]
+        buffer = np.empty((n_out, int(np.diff(edges).max()) * n_seg + max_lag), np.float32)
     spectra = np.empty((n_blocks, n_fft // 2 + 1, n_out, refs.size), np.complex64)
     for b in range(n_blocks):
+        first, stop = edges[b] * n_seg, edges[b + 1] * n_seg + max_lag
+        if mean is None:
+            data = record[:, first:stop]
+        else:
+            data = buffer[:, :stop - first]
+            np.subtract(signals[:, first:stop], shift, out=data)
         # (samples, n_out, segs): transformed along the first axis, the spectra come out line by line, each
         # line's (outputs × segments) matrix contiguous for the product below
-        ext = windows[:, edges[b] * n_seg:(edges[b + 1] - 1) * n_seg + 1:n_seg].transpose(2, 0, 1)
+        windows = np.lib.stride_tricks.sliding_window_view(data, n_seg + max_lag, axis=1)
+        ext = windows[:, ::n_seg].transpose(2, 0, 1)
         future = sfft.rfft(ext, n=n_fft, axis=0)  # every output, extended by the longest lag
         past = sfft.rfft(ext[:n_seg, refs], n=n_fft, axis=0)  # the references' segments, zero-padded
         # Σ over the block's segments of Y_o(f) conj(X_r(f)): one (outputs × segments)(segments × refs)
@@ -138,17 +157,20 @@ def correlations(signals: np.ndarray, sample_rate_hz: float, references, max_lag
     lagged = sfft.irfft(spectra, n=n_fft, axis=1)[:, :max_lag + 1]  # (blocks, lags, n_out, refs)
     lagged = lagged.astype(float)
     weights = (np.diff(edges) * n_seg).astype(float)
-    return Correlations(lagged / weights[:, None, None, None], weights, float(sample_rate_hz),
-                        tuple(int(r) for r in refs))
+    lagged /= weights[:, None, None, None]
+    if scale is not None:
+        scale = np.asarray(scale, float)
+        lagged /= scale[:, None] * scale[refs][None, :]
+    return Correlations(lagged, weights, float(sample_rate_hz), tuple(int(r) for r in refs))
 
 
 def choose_references(signals: np.ndarray, n_references: int, probe_lags: int = 8,
-                      probe_samples: int = 1 << 14) -> tuple[int, ...]:
+                      probe_samples: int = 1 << 14, mean=None) -> tuple[int, ...]:
     """The channels that best span the outputs' correlations, for projection.
 
-    Each channel is scaled to unit RMS; the correlations of every channel with every other
-    over a few lags (from the first ``probe_samples`` samples, one matrix product in single
-    precision) form the columns of one matrix, and a column-pivoted QR picks the
+    Each channel (less its ``mean``, when given) is scaled to unit RMS; the correlations of every
+    channel with every other over a few lags (from the first ``probe_samples`` samples, one matrix
+    product in single precision) form the columns of one matrix, and a column-pivoted QR picks the
     ``n_references`` channels that are the most independent and carry the most correlated
     (not white) signal: white measurement noise only enters lag 0, which is left out. The
     choice needs only the rough correlations that 2¹⁴ samples give (each within a few percent);
@@ -159,7 +181,8 @@ def choose_references(signals: np.ndarray, n_references: int, probe_lags: int = 
     n_out, n = signals.shape
     if n_references >= n_out:
         return tuple(range(n_out))
-    piece = np.array(signals[:, : min(n, probe_samples + probe_lags)], dtype=np.float32)
+    piece = signals[:, : min(n, probe_samples + probe_lags)]
+    piece = np.array(piece if mean is None else piece - np.asarray(mean, float)[:, None], dtype=np.float32)
     piece /= np.sqrt(np.mean(piece**2, axis=1, keepdims=True))
     m = piece.shape[1] - probe_lags
     # one column per candidate reference, the rows (channel, lag) for lags 1…probe_lags: one product per lag,

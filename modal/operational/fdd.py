@@ -40,11 +40,12 @@ def singular_values(prepared: Prepared, refs):
     low, high = prepared.band_hz
     f_low = max(low, high / 10)
     n_lags = int(np.ceil(-np.log(0.01) / (WINDOW_DAMPING * 2 * np.pi * f_low) * fs))
-    n_lags = min(n_lags, prepared.signals.shape[1] // MIN_LAGS_IN_RECORD)
+    n_lags = min(n_lags, prepared.n_samples // MIN_LAGS_IN_RECORD)
     if n_lags < 16:
         raise ParameterError(f"{prepared.source}: the record lasts {prepared.duration_s:.4g} s; too short for a "
                              f"spectral decomposition down to {f_low:.4g} Hz")
-    corr = correlations(prepared.signals, fs, refs, n_lags - 1, max_blocks=1)
+    corr = correlations(prepared.signals, fs, refs, n_lags - 1, max_blocks=1, mean=prepared.mean,
+                        scale=prepared.scale)
     spacing = fs / (4 * n_lags)
     lines = spacing * np.arange(max(int(np.ceil(low / spacing)), 1), int(np.floor(high / spacing)) + 1)
     S, beta = half_spectra(corr.mean, fs, lines)

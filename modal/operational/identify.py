@@ -41,7 +41,7 @@ HANKEL_ASPECT = 2
 def _references(prepared: Prepared, reference_channels) -> tuple[int, ...]:
     n = prepared.n_channels
     if reference_channels is None:
-        return choose_references(prepared.signals, min(n, MAX_AUTO_REFERENCES))
+        return choose_references(prepared.signals, min(n, MAX_AUTO_REFERENCES), mean=prepared.mean)
     refs = np.atleast_1d(np.asarray(reference_channels))
     if refs.dtype.kind not in "iu" or refs.size == 0 or np.any(refs < 0) or np.any(refs >= n) \
             or np.unique(refs).size != refs.size:
@@ -72,7 +72,7 @@ def _sweep_size(prepared: Prepared, n_refs: int, max_order, block_rows):
     if block_rows is None and n_out > n_refs:
         rows = min(cols, max(int(np.ceil(max_order / n_out)) + 1, int(np.ceil(HANKEL_ASPECT * n_refs * cols / n_out)),
                              2))
-    n_samples = prepared.signals.shape[1]
+    n_samples = prepared.n_samples
     if n_samples < MIN_LAGS_IN_RECORD * 2 * cols:
         need = MIN_LAGS_IN_RECORD * 2 * cols / fs
         raise ParameterError(f"{prepared.source}: the record lasts {n_samples / fs:.4g} s; the band from "
@@ -86,7 +86,8 @@ def _ssi(prepared: Prepared, refs, max_order, block_rows):
     from .ssi import Perturbation, poles_at, subspace_model
 
     max_order, rows, cols = _sweep_size(prepared, len(refs), max_order, block_rows)
-    corr = correlations(prepared.signals, prepared.sample_rate_hz, refs, rows + cols)
+    corr = correlations(prepared.signals, prepared.sample_rate_hz, refs, rows + cols, mean=prepared.mean,
+                        scale=prepared.scale)
     model = subspace_model(corr.mean, rows, max_order, prepared.sample_rate_hz, cols)
     orders = list(range(2, model.max_order + 1, 2))
     sets = [poles_at(model, n) for n in orders]

@@ -14,28 +14,40 @@ from ..errors import ParameterError
 from .correlations import decimate, decimation_factor
 from .screen import check_units, screen_samples
 
-__all__ = ["Prepared", "prepare", "check_band", "check_channels"]
+__all__ = ["Prepared", "prepare", "check_band", "channel_statistics"]
 
 #: a channel whose standard deviation is below this fraction of the largest channel's is constant
 CONSTANT_CHANNEL = 1e-12
+#: a piece of a channel whose sum of squares about its mean is below this fraction of its sum of squares about
+#: zero (a mean above about 30 RMS) is centred before its squares are summed: their difference would keep fewer
+#: than 13 of double precision's 16 digits
+CANCELLATION = 1e-3
 #: the record must hold at least this many times the longest correlation lag
 MIN_LAGS_IN_RECORD = 40
-#: the input check centres each channel this many samples at a time, in a double-precision buffer (512 kB)
-#: that stays in cache while the piece is centred, squared and stored
+#: the input check reads each channel this many samples at a time: each piece is summed and squared while it
+#: stays in cache (and copied to double precision or centred first, where needed, in a 512 kB buffer)
 CHUNK_SAMPLES = 1 << 16
 
 
 @dataclass(frozen=True)
 class Prepared:
-    """A record ready for correlation: zero-mean channels of unit RMS, decimated to the band.
+    """A record checked and brought to the band, with each channel's mean and RMS; the samples themselves are
+    neither centred nor scaled (a centred, scaled single-precision copy of a 10⁶ × 64 record would take 256 MB):
+    the correlations centre them as they read them and scale the correlation matrices
+    (:func:`modal.operational.correlations.correlations`), and :meth:`channel` gives one channel centred and
+    scaled where a method needs samples.
 
     Attributes
     ----------
-    signals : ndarray, shape (n_channels, n_samples), float32
+    signals : ndarray, shape (n_channels, n_samples)
+        The samples as recorded (single or double precision, not copied), or decimated to the band (double
+        precision, centred before the filter).
     sample_rate_hz : float
         After decimation.
+    mean : ndarray, shape (n_channels,)
+        Each channel's mean in the units of ``signals`` (double precision).
     scale : ndarray, shape (n_channels,)
-        Each channel's RMS in the input's units (shapes are scaled back by it).
+        Each channel's RMS about its mean in the input's units (shapes are scaled back by it).
     band_hz : (float, float)
     decimation : int
     original_rate_hz : float
@@ -46,6 +58,7 @@ class Prepared:
 
     signals: np.ndarray
     sample_rate_hz: float
+    mean: np.ndarray
     scale: np.ndarray
     band_hz: tuple[float, float]
     decimation: int
@@ -59,8 +72,18 @@ class Prepared:
         return self.signals.shape[0]
 
     @property
+    def n_samples(self) -> int:
+        return self.signals.shape[1]
+
+    @property
     def duration_s(self) -> float:
         return self.signals.shape[1] / self.sample_rate_hz
+
+    def channel(self, ch: int) -> np.ndarray:
+        """Channel ``ch`` less its mean (in double precision) and divided by its RMS, stored in single precision."""
+        centred = np.asarray(self.signals[ch], dtype=np.float64) - self.mean[ch]
+        centred /= self.scale[ch]
+        return centred.astype(np.float32)
 
 
 def _record(data, sample_rate_hz):
@@ -110,42 +133,114 @@ def check_band(band_hz, nyquist_hz: float, src: str) -> tuple[float, float]:
     return low, high
 
 
-def check_channels(signals: np.ndarray, src: str, names=(), dtype=float,
-                   unit_rms: bool = False) -> tuple[np.ndarray, np.ndarray]:
-    """Two or more channels of finite samples, none constant.
+def channel_statistics(signals: np.ndarray, src: str, names=()) -> tuple[np.ndarray, np.ndarray]:
+    """Each channel's mean and RMS about it, checking that there are two or more channels of finite samples,
+    none constant.
 
-    Each channel is read from memory twice: once for its mean, once more :data:`CHUNK_SAMPLES` at a time,
-    each piece centred in double precision in a buffer that stays in cache, its squares summed and the piece
-    stored in ``dtype``; with ``unit_rms`` the stored channel, still in cache, is then divided by its RMS.
+    The record is read from memory once, :data:`CHUNK_SAMPLES` of a channel at a time: each piece's sum and
+    sum of squares (in double precision, the piece still in cache for the second), their difference the sum of
+    squares about the piece's mean, unless a large offset would cancel digits there (:func:`_moments`); the
+    pieces' means and sums of squares are then pooled exactly (Chan, Golub & LeVeque). A record whose channels'
+    samples are not contiguous in memory (an array of shape (n_samples, n_channels) transposed) is read a stretch
+    of samples of every channel at a time instead (:func:`_moments_by_samples`): channel by channel, each read
+    would touch the whole record.
 
     Returns
     -------
-    (centred, rms) : ndarray (n_channels, n_samples) of ``dtype``, ndarray (n_channels,)
-        The channels with their means removed (a new array; each divided by its RMS with ``unit_rms``) and
-        their RMS about the mean.
+    (mean, rms) : ndarray (n_channels,), ndarray (n_channels,)
+        Double precision, in the units of ``signals``.
     """
     _check_shape(signals, src)
-    centred = np.empty(signals.shape, dtype)
-    rms = np.empty(signals.shape[0])
-    n = signals.shape[1]
-    buffer = np.empty(min(n, CHUNK_SAMPLES))
-    for ch, row in enumerate(signals):  # channel by channel: no temporary as large as the record
-        mean = _finite_mean(signals, ch, src, names)
-        squares = 0.0
-        for start in range(0, n, CHUNK_SAMPLES):
-            piece = buffer[:min(CHUNK_SAMPLES, n - start)]
-            np.subtract(row[start:start + CHUNK_SAMPLES], mean, out=piece)
-            squares += np.dot(piece, piece)
-            centred[ch, start:start + CHUNK_SAMPLES] = piece
-        rms[ch] = np.sqrt(squares / n)
-        if unit_rms and rms[ch] > 0:  # (a constant channel is refused below)
-            centred[ch] /= centred.dtype.type(rms[ch])
+    n_channels, n = signals.shape
+    mean = np.empty(n_channels)
+    rms = np.empty(n_channels)
+    if signals.strides[1] != signals.itemsize:  # e.g. (n_samples, n_channels).T: read a stretch of samples at a time
+        mean, squares, finite = _moments_by_samples(signals)
+        if not finite.all():
+            _refuse_non_finite(signals, int(np.flatnonzero(~finite)[0]), src, names)
+    else:
+        squares = np.empty(n_channels)
+        buffer = np.empty(min(n, CHUNK_SAMPLES))
+        for ch, row in enumerate(signals):
+            moments = _moments(row, buffer)
+            if moments is None:
+                _refuse_non_finite(signals, ch, src, names)
+            mean[ch], squares[ch] = moments
+    for ch, row in enumerate(signals):
+        rms[ch] = np.sqrt(squares[ch] / n)
+        if not np.isfinite(rms[ch]):
+            raise ParameterError(f"{src}: channel {ch + 1}{_name(names, ch)}: samples up to {np.abs(row).max():g}; "
+                                 "expected values whose squares fit double precision (rescale the record)")
     constant = np.flatnonzero(~(rms > CONSTANT_CHANNEL * rms.max()))
     if constant.size:
         listing = ", ".join(f"{k + 1}{_name(names, k)}" for k in constant)
         raise ParameterError(f"{src}: channel(s) {listing} constant; expected a varying response on every channel "
                              "(drop dead channels)")
-    return centred, rms
+    return mean, rms
+
+
+@np.errstate(over="ignore", invalid="ignore")  # (squares that overflow are refused by the caller)
+def _moments(row: np.ndarray, buffer: np.ndarray):
+    """(mean, sum of squares about it) of one channel, piece by piece (see :func:`channel_statistics`), in
+    double precision; None when a piece's mean is not finite.
+
+    Each piece's sum and sum of squares come from one read of it; where its mean is large against its spread
+    (the sum of squares about the mean below :data:`CANCELLATION` of the sum of squares about zero), the
+    difference would lose digits, and the piece is centred (in ``buffer``, which also holds a single-precision
+    piece converted to double) and its squares summed again."""
+    pooled_mean, pooled_squares, count = 0.0, 0.0, 0
+    for start in range(0, row.size, CHUNK_SAMPLES):
+        piece = row[start:start + CHUNK_SAMPLES]
+        m = piece.size
+        if piece.dtype != np.float64:  # summed in double precision
+            buffer[:m] = piece
+            piece = buffer[:m]
+        total_sum = float(piece.sum())
+        piece_mean = total_sum / m
+        if not np.isfinite(piece_mean):
+            return None
+        squares = float(np.dot(piece, piece))
+        about_mean = squares - total_sum * piece_mean
+        if not about_mean > CANCELLATION * squares:
+            centred = buffer[:m]
+            np.subtract(piece, piece_mean, out=centred)
+            about_mean = float(np.dot(centred, centred))
+        total = count + m
+        delta = piece_mean - pooled_mean
+        pooled_squares += about_mean + delta * delta * count * m / total
+        pooled_mean += delta * m / total
+        count = total
+    return pooled_mean, pooled_squares
+
+
+@np.errstate(over="ignore", invalid="ignore")
+def _moments_by_samples(signals: np.ndarray):
+    """(means, sums of squares about them, finite) of every channel, as :func:`_moments` but a stretch of samples
+    of every channel at a time (:data:`CHUNK_SAMPLES` samples in all), copied into a double-precision buffer."""
+    n_channels, n = signals.shape
+    width = max(CHUNK_SAMPLES // n_channels, 1)
+    buffer = np.empty((n_channels, min(n, width)))
+    pooled_mean, pooled_squares, count = np.zeros(n_channels), np.zeros(n_channels), 0
+    finite = np.ones(n_channels, bool)
+    for start in range(0, n, width):
+        piece = buffer[:, :min(width, n - start)]
+        piece[...] = signals[:, start:start + width]
+        m = piece.shape[1]
+        total_sum = piece.sum(axis=1)
+        piece_mean = total_sum / m
+        finite &= np.isfinite(piece_mean)
+        squares = np.einsum("ij,ij->i", piece, piece)
+        about_mean = squares - total_sum * piece_mean
+        cancelled = ~(about_mean > CANCELLATION * squares)
+        if cancelled.any():
+            centred = piece[cancelled] - piece_mean[cancelled, None]
+            about_mean[cancelled] = np.einsum("ij,ij->i", centred, centred)
+        total = count + m
+        delta = piece_mean - pooled_mean
+        pooled_squares += about_mean + delta * delta * count * m / total
+        pooled_mean += delta * m / total
+        count = total
+    return pooled_mean, pooled_squares, finite
 
 
 def _check_shape(signals: np.ndarray, src: str) -> None:
@@ -157,20 +252,24 @@ def _check_shape(signals: np.ndarray, src: str) -> None:
 
 
 def _finite_mean(signals: np.ndarray, ch: int, src: str, names) -> float:
-    """Channel ``ch``'s mean in double precision, whatever it is stored in; refused, naming the first NaN or
-    infinite sample of the record, when it is not finite (or naming the channel when its finite samples' sum
-    overflows)."""
-    row = signals[ch]
-    mean = row.mean(dtype=np.float64)
+    """Channel ``ch``'s mean in double precision, whatever it is stored in; refused (:func:`_refuse_non_finite`)
+    when it is not finite."""
+    mean = signals[ch].mean(dtype=np.float64)
     if not np.isfinite(mean):
-        bad = ~np.isfinite(signals)
-        if bad.any():
-            ch, i = (int(v) for v in np.argwhere(bad)[0])
-            raise ParameterError(f"{src}: channel {ch + 1}{_name(names, ch)}, sample {i}: {signals[ch, i]}; "
-                                 f"expected finite samples ({int(bad.sum())} are not)")
-        raise ParameterError(f"{src}: channel {ch + 1}{_name(names, ch)}: samples up to {np.abs(row).max():g}; "
-                             "expected values whose sum fits double precision (rescale the record)")
+        _refuse_non_finite(signals, ch, src, names)
     return mean
+
+
+def _refuse_non_finite(signals: np.ndarray, ch: int, src: str, names) -> None:
+    """Refuse a record whose channel ``ch`` sums to a non-finite number: naming the first NaN or infinite sample
+    of the record, or the channel when its finite samples' sum overflows."""
+    bad = ~np.isfinite(signals)
+    if bad.any():
+        ch, i = (int(v) for v in np.argwhere(bad)[0])
+        raise ParameterError(f"{src}: channel {ch + 1}{_name(names, ch)}, sample {i}: {signals[ch, i]}; "
+                             f"expected finite samples ({int(bad.sum())} are not)")
+    raise ParameterError(f"{src}: channel {ch + 1}{_name(names, ch)}: samples up to {np.abs(signals[ch]).max():g}; "
+                         "expected values whose sum fits double precision (rescale the record)")
 
 
 def _centred_decimated(signals: np.ndarray, factor: int, src: str, names) -> np.ndarray:
@@ -192,7 +291,7 @@ def _name(names, ch) -> str:
 
 
 def prepare(data, sample_rate_hz=None, band_hz=None, quantity: str | None = None, screen: bool = True) -> Prepared:
-    """Check a record and bring it to zero mean, unit RMS per channel and a rate suited to the band.
+    """Check a record, bring it to a rate suited to the band and find each channel's mean and RMS.
 
     Parameters
     ----------
@@ -213,8 +312,8 @@ def prepare(data, sample_rate_hz=None, band_hz=None, quantity: str | None = None
         raise ParameterError(f"{src}: 'sample_rate_hz' is {rate!r}; expected a positive number of samples per second")
     low, high = check_band(band_hz, rate / 2, src)
     factor = decimation_factor(rate, high)
-    # single precision from here on (the correlations' FFTs are single precision anyway: their rounding, 1e-7,
-    # lies far below the estimates' scatter); a record to be decimated is filtered in double first
+    # a record to be decimated is centred (an offset would ring in the filter) and filtered in double precision,
+    # channel by channel; any other is used as it is stored (see Prepared)
     if factor > 1:
         work = _centred_decimated(signals, factor, src, names)
         if work.shape[1] < 2:
@@ -222,7 +321,8 @@ def prepare(data, sample_rate_hz=None, band_hz=None, quantity: str | None = None
                                  f"{high:g} Hz")
     else:
         work = signals
-    work, scale = check_channels(work, src, names, dtype=np.float32, unit_rms=True)
+    mean, scale = channel_statistics(work, src, names)
     if screen:  # on the samples as recorded, known finite by now
         screen_samples(signals, rate, names, src)
-    return Prepared(work, rate / factor, scale, (low, high), factor, rate, quantity or file_quantity, names, src)
+    return Prepared(work, rate / factor, mean, scale, (low, high), factor, rate, quantity or file_quantity, names,
+                    src)

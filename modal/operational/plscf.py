@@ -125,13 +125,13 @@ def plscf(prepared: Prepared, refs, max_order=None):
     m = len(refs)
     top = int(min(MAX_POLY_ORDER, max(16, np.ceil(2 * (max_order or 80) / m))))
     n_lags = int(max(np.ceil(PERIODS * fs / max(low, high / 10)), 4 * top))
-    n_samples = prepared.signals.shape[1]
+    n_samples = prepared.n_samples
     if n_samples < MIN_LAGS_IN_RECORD * n_lags:
         from ..errors import ParameterError
 
         raise ParameterError(f"{prepared.source}: the record lasts {n_samples / fs:.4g} s; the half-spectra over "
                              f"{n_lags} lags need at least {MIN_LAGS_IN_RECORD * n_lags / fs:.4g} s")
-    corr = correlations(prepared.signals, fs, refs, n_lags - 1)
+    corr = correlations(prepared.signals, fs, refs, n_lags - 1, mean=prepared.mean, scale=prepared.scale)
     spacing = fs / (2 * n_lags)
     lines = np.arange(max(low, spacing), high + spacing / 2, spacing)
     omega = 2 * np.pi * lines
@@ -162,7 +162,9 @@ def plscf(prepared: Prepared, refs, max_order=None):
                 return {"pole": d_windowed[:, match], "shape": None}
 
             perturb = perturb_poles
-    estimates, chosen, kept = estimates_from_clusters(flat, clusters, perturb, len(orders), prepared.scale,
+    # the poles' participation vectors, their shapes until the residue fit below, lie on the references
+    estimates, chosen, kept = estimates_from_clusters(flat, clusters, perturb, len(orders),
+                                                      prepared.scale[np.asarray(refs, int)],
                                                       representative="upper_half")
     estimates = _with_shapes(estimates, S, omega, beta, 1.0 / fs, blocks_dS, prepared.scale)
     settings = {"orders": [orders[0], orders[-1]], "lags": n_lags, "window_decay_per_s": float(beta)}

@@ -119,9 +119,9 @@ def _band_is_peaky(estimate: PoleEstimate, prepared: Prepared, spectra: dict, re
     f = estimate.natural_frequency_hz
     channel = int(np.argmax(np.abs(estimate.shape) / prepared.scale))  # where it is strongest against the rest
     width = max(4 * max(zeta, 0.0) * f, MIN_BANDWIDTH_TIME / prepared.duration_s)
-    n = prepared.signals.shape[1]
+    n = prepared.n_samples
     if channel not in spectra:
-        spectra[channel] = rfft(prepared.signals[channel])
+        spectra[channel] = rfft(prepared.channel(channel))
     centre = f
     if (nearly_undamped(estimate) or not estimate.damping_known) and resolution_hz:
         centre = strongest_line_hz(spectra[channel], n, prepared.sample_rate_hz, f - resolution_hz / 2,

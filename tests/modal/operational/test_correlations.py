@@ -25,6 +25,41 @@ def test_correlations_equal_the_direct_sums_per_block():
     assert w.sum() == c.weights.sum() and np.allclose(np.average(merged, axis=0, weights=w), c.mean)
 
 
+def _direct(y, refs, lo, hi, k):
+    return y[:, lo + k:hi + k] @ y[refs, lo:hi].T / (hi - lo)
+
+
+@pytest.mark.parametrize("offset, dtype", [(1e4, np.float64), (3.0, np.float32)])
+def test_correlations_of_the_raw_record_are_those_of_the_centred_scaled_one(offset, dtype):
+    # the record as recorded (an offset, channels of different RMS), its mean removed as each block is read (in
+    # double precision, before the samples are rounded to single) and its scale taken out of the correlation
+    # matrices: the correlations of the explicitly centred, unit-RMS record. The FFTs and the sums over a
+    # block's segments run in single precision: each block's correlation of unit-RMS signals then holds to
+    # about (segments per block + log2 FFT length) single-precision epsilons (4e-6; 1e-7 is seen). Rounding the
+    # raw record to single precision first, as removing the mean after the FFT would, costs about
+    # eps × offset / RMS instead (4e-5 with the first offset here)
+    rng = np.random.default_rng(4)
+    unit = rng.standard_normal((3, 30_000))
+    unit[1] += 0.5 * np.roll(unit[0], 3)
+    unit /= np.sqrt(np.mean(unit**2, axis=1, keepdims=True))
+    rms = np.array([0.5, 2.0, 30.0])
+    raw = (unit * rms[:, None] + offset).astype(dtype)
+    mean = raw.mean(axis=1, dtype=float)
+    scale = np.sqrt(np.mean((raw - mean[:, None]) ** 2, axis=1))
+    exact = (raw - mean[:, None]) / scale[:, None]
+    refs = [0, 2]
+    c = correlations(raw, 50.0, refs, 12, max_blocks=5, mean=mean, scale=scale)
+    edges = np.concatenate([[0], np.cumsum(c.weights)]).astype(int)
+    n_fft = 256  # the segments' FFT length for the longest lag 12
+    tolerance = (c.weights.max() / (n_fft - 12) + np.log2(n_fft)) * np.finfo(np.float32).eps
+    for b in range(5):
+        for k in range(13):
+            assert np.allclose(c.blocks[b, k], _direct(exact, refs, edges[b], edges[b + 1], k), rtol=0,
+                               atol=tolerance)
+    explicit = correlations(exact, 50.0, refs, 12, max_blocks=5)
+    assert np.allclose(c.blocks, explicit.blocks, rtol=0, atol=tolerance)
+
+
 def test_too_short_a_record_is_refused():
     with pytest.raises(ParameterError, match="no segment"):
         correlations(np.ones((2, 30)), 1.0, [0], 40)
