@@ -57,6 +57,25 @@ from support.paths import REAL, ROOT, SYNTHETIC  # noqa: E402,F401
 SUITE_MARKERS = {"fuzz": "fuzz", "calibration": "calibration"}
 
 
+@pytest.hookimpl(tryfirst=True)
+def pytest_cmdline_main(config):
+    """``pytest -n N`` of the default run (``-m "not stress"``) hands its workers whole files
+    (:mod:`support.workergroups`); an explicit ``--dist`` is kept, and the stress run keeps ``load``."""
+    if (getattr(config.option, "numprocesses", None) and config.option.dist == "no"
+            and "not stress" in (config.option.markexpr or "")):
+        config.option.dist = "loadfile"
+
+
+@pytest.hookimpl(tryfirst=True, optionalhook=True)
+def pytest_xdist_make_scheduler(config, log):
+    """``--dist loadfile``: whole files to a worker, and the files sharing a session fixture together."""
+    if config.getvalue("dist") != "loadfile":
+        return None
+    from support.workergroups import FileGroupScheduling
+
+    return FileGroupScheduling(config, log)
+
+
 def pytest_collection_modifyitems(config, items):
     """Mark every test of a special suite's folder with that suite's marker (``-m fuzz`` etc.)."""
     tests = Path(__file__).resolve().parent

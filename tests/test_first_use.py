@@ -109,8 +109,9 @@ def test_method_all_draws_every_method():
 # ---- every archive the toolkit writes (items 1, 2, 4) ---------------------------------------------------------
 
 @pytest.fixture(scope="module")
-def archives(tmp_path_factory):
-    """Run every command that writes an archive, once, as a user would (subprocesses)."""
+def archives(tmp_path_factory, dask_cluster):
+    """Run every command that writes an archive, once, as a user would (subprocesses); the batch on the
+    session's Dask cluster (tests/modal/batch/test_cluster.py and test_formats.py run the embedded one)."""
     out = tmp_path_factory.mktemp("archives")
     beam = [*REAL, "--frequency-step", "1", "--kind", "accelerance"]
     # a hammer record (the shipped real time file has no force channel: it cannot give an FRF)
@@ -126,7 +127,8 @@ def archives(tmp_path_factory):
                        "--archive", out / "fit_all.h5"),
         "fit_global.h5": ("modal", "fit", *beam, "--method", "global", "--archive", out / "fit_global.h5"),
         # one group per file, copied from per-file parts (issue 18)
-        "batch.h5": ("modal", "batch", *beam, "--method", "all", "--workers", "1", "--out", out / "batch.h5"),
+        "batch.h5": ("modal", "batch", *beam, "--method", "all", "--scheduler", dask_cluster[0],
+                     "--out", out / "batch.h5"),
         "estimate.h5": ("modal", "frf", uff, "--impact", "--out", out / "estimate.h5"),
         "demo.h5": ("balancer", "run", ROOT / "data" / "synthetic" / "demo_scene.toml", "--out", out / "demo.h5",
                     "--plots", out / "demo_plots"),

@@ -23,7 +23,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import linprog
 
 from modal.errors import ParameterError, QualityWarning, warn
 
@@ -259,6 +258,10 @@ def _minmax_scaled(a: np.ndarray, b: np.ndarray, bound: float, rtol: float, max_
         if math.isfinite(bound):
             for j in range(p):
                 add_bound_cut(j, phi)
+    # scipy.optimize where the min-max correction runs, not at import: it was most of the import time of
+    # every `balancer influence` run, which by default solves least squares
+    from scipy.optimize import linprog
+
     cost = np.zeros(2 * p + 1)
     cost[-1] = 1.0
     u = np.zeros(p, dtype=complex)

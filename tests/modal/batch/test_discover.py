@@ -78,9 +78,9 @@ def test_glob_matches_that_lead_out_are_not_taken(planted):
         assert names(find_files(str(data / "*.uff"))) == ["a.uff", "b_link.uff"]
 
 
-def test_batch_does_not_read_a_file_outside_through_a_link(planted, tmp_path):
+def test_batch_does_not_read_a_file_outside_through_a_link(planted, tmp_path, dask_cluster):
     data, _ = planted
-    done = run_cli(data, "--out", tmp_path / "r.h5", "--workers", "1", "--json")
+    done = run_cli(data, "--out", tmp_path / "r.h5", "--scheduler", dask_cluster[0], "--json")
     assert done.returncode == 0, done.stderr
     assert "warning: 3 symbolic link(s) lead outside the folders given" in done.stderr
     table = (tmp_path / "r.csv").read_text()
@@ -99,11 +99,11 @@ def test_a_missing_path_is_one_line(tmp_path):
     assert not (tmp_path / "r.h5").exists()
 
 
-def test_a_failure_line_names_the_file_once(tmp_path):
+def test_a_failure_line_names_the_file_once(tmp_path, dask_cluster):
     write_frf(mobility(), tmp_path / "a.uff")
     broken = tmp_path / "broken.csv"
     broken.write_text("not,an\nfrf,file\n")
-    done = run_cli(tmp_path, "--out", tmp_path / "r.h5", "--workers", "1")
+    done = run_cli(tmp_path, "--out", tmp_path / "r.h5", "--scheduler", dask_cluster[0])
     assert done.returncode == 1
     line, = [ln for ln in done.stderr.splitlines() if ln.startswith("failed:")]
     assert line.startswith(f"failed: {broken}: ") and line.count(str(broken)) == 1, line
