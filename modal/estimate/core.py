@@ -381,8 +381,13 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
         if starts.size == 0:
             where = [f"{r['take_name']} " if "take" in r else "" for r in rejected]
             reasons = "; ".join(f"{at}hit {r['hit']} at {r['time_s']:.3f} s: {r['reason']}"
-                                for at, r in zip(where, rejected))
-            raise ParameterError(f"{source}: every hit was rejected ({reasons})")
+                                + (f" ({r['detail']})" if r.get("detail") else "") for at, r in zip(where, rejected))
+            advice = ""
+            if any(r["reason"] == "response not decayed within the record" for r in rejected) and decay is None:
+                advice = ("; the responses still ring at the end of the hit records: an exponential window makes them "
+                          "decay within them (window='exponential' with exponential_decay_s; modal fit --window "
+                          "exponential --exponential-decay-s S), its damping taken back out of the modes")
+            raise ParameterError(f"{source}: every hit was rejected ({reasons}){advice}")
         in_w = np.ones(length)
         if window in ("force", "exponential"):
             in_w = force_window(length, pre_samples, width=max(8, 3 * hits.pulse_samples))
