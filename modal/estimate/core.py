@@ -235,6 +235,25 @@ def _noise_model(sums, output_correlation, input_window, output_window, sample_r
                       overlapping if influence is not None else 0, withheld)
 
 
+def _refuse_swapped_channels(force, response, sample_rate_hz, labels, source) -> None:
+    """An impact record whose excitation is no train of hammer pulses while a response channel is one: the
+    force and a response were swapped (at the recorder or in the file's labels). Hit detection would read the
+    ringing response as a force and reject every "hit" as a double hit, or pass a response over a force as an
+    FRF; refused instead, naming both channels."""
+    own = pulse_train(force, sample_rate_hz)
+    if own.impulsive:
+        return
+    for o in range(response.shape[0]):
+        other = pulse_train(np.asarray(response[o], dtype=float), sample_rate_hz)
+        if other.impulsive:
+            raise ParameterError(
+                f"{source}: {labels[0]} is no train of hammer pulses ({own.count} pulse(s) filling "
+                f"{100 * own.duty:.1f} % of the record) but {labels[len(labels) - response.shape[0] + o]} is "
+                f"({other.count} pulse(s), {100 * other.duty:.2f} %): the force and response channels look swapped "
+                "(the cables at the recorder or the file's channel labels); expected the hammer's force as the "
+                "excitation")
+
+
 def _default_segment_length(n_samples: int) -> int:
     """Largest power of two giving at least 16 half-overlapping segments (at least 16 samples)."""
     return 1 << max(4, int(np.floor(np.log2(max(n_samples / 8.5, 16)))))
@@ -356,6 +375,7 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
         if x.shape[0] != 1:
             raise ParameterError(f"{source}: impact=True takes one force channel, got {x.shape[0]}")
         force = np.asarray(x[0], dtype=float)
+        _refuse_swapped_channels(force, y, fs, labels, source)
         pre = None if pretrigger_s is None else pretrigger_s
 
         def find(force, response, rate, **options):

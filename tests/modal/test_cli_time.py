@@ -318,3 +318,17 @@ def test_hammer_takes_cut_short_while_ringing_are_refused_with_the_window_that_f
     first = min(json.loads(fixed.stdout)["modes"], key=lambda row: abs(row["natural_frequency_hz"] - 40.0))
     # the mass within 4 of its standard errors (1/kg constant of mode 1 is 1.0)
     assert abs(first["mass_kg"] - 1.0) <= 4 * first["std"]["mass_kg"]
+
+
+def test_a_hammer_file_with_force_and_response_swapped_says_so(tmp_path):
+    # the shipped hammer record with its two columns' data exchanged (cables swapped at the recorder): the error
+    # was "every hit was rejected (hit 1 ... double hit; ...)" for all eight hits
+    lines = (ROOT / "data" / "synthetic" / "hammer.csv").read_text().splitlines()
+    swapped = tmp_path / "swapped.csv"
+    rows = [line.split(",") for line in lines[1:]]
+    swapped.write_text("\n".join([lines[0]] + [",".join([t, a, f]) for t, f, a in rows]) + "\n")
+    out = run("fit", swapped, "--impact")
+    assert out.returncode == 1 and out.stderr.count("error: ") == 1 and out.stdout == ""
+    error = out.stderr.splitlines()[-1]
+    assert error.startswith(f"error: {swapped}: force 1+Z is no train of hammer pulses") and "look swapped" in error
+    assert "double hit" not in error
