@@ -28,6 +28,7 @@ from . import spectra
 from .error_correlation import LEAKAGE_LAGS, MIN_RECORDS, measured_line_correlation
 from .record_influence import MAX_INFLUENCE_VALUES, overlapping_records, record_influence
 from .hits import find_hits, pulse_train
+from .levels import level_dependence
 from .overload import find_overloads
 from .quiet import quiet_noise
 from .takes import find_hits_in_takes, segment_starts, take_bounds
@@ -254,6 +255,20 @@ def _refuse_swapped_channels(force, response, sample_rate_hz, labels, source) ->
                 "excitation")
 
 
+def _warn_level_dependence(force, response, starts, length, input_window, output_window, sample_rate_hz, labels,
+                           source) -> None:
+    """Warn where the hits' FRFs change with their force level beyond the noise (:mod:`.levels`)."""
+    test = level_dependence(force, response, starts, length, input_window, output_window, sample_rate_hz)
+    if test is None or not test.level_dependent:
+        return
+    low, high = test.force_range
+    warn(f"{source}: the FRF changes with the force of the hit beyond its noise (nonlinearity: {test.n_hits} hits "
+         f"from {low:.3g} to {high:.3g} in the force's unit; {labels[len(labels) - response.shape[0] + test.output]} "
+         f"at {test.frequency_hz:.4g} Hz, F-test p = {test.p_value:.2g} against {test.limit:.2g} over "
+         f"{test.n_lines} lines): the average mixes the structure's states; estimate hits of one force level "
+         "together, or hit alike", QualityWarning)
+
+
 def _default_segment_length(n_samples: int) -> int:
     """Largest power of two giving at least 16 half-overlapping segments (at least 16 samples)."""
     return 1 << max(4, int(np.floor(np.log2(max(n_samples / 8.5, 16)))))
@@ -446,6 +461,8 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
             warn(f"{source}: {item.describe(labels[item.channel])}: the spectra are distorted where it clipped; "
                  "lower the gain or the excitation level", QualityWarning)
 
+    if impact:
+        _warn_level_dependence(x[0], y, starts, length, in_w, out_w, fs, labels, source)
     output_correlation = window_line_correlation(out_w)
     window_lags = lags_carried(output_correlation, length // 2 + 1)
     # continuous records, enough of them: the errors' correlation is also measured over the records
