@@ -28,7 +28,7 @@ from . import spectra
 from .error_correlation import LEAKAGE_LAGS, MIN_RECORDS, measured_line_correlation
 from .record_influence import MAX_INFLUENCE_VALUES, overlapping_records, record_influence
 from .hits import find_hits, pulse_train
-from .levels import level_dependence
+from .levels import level_dependence, take_dependence
 from .overload import find_overloads
 from .quiet import quiet_noise
 from .takes import find_hits_in_takes, segment_starts, take_bounds
@@ -269,6 +269,20 @@ def _warn_level_dependence(force, response, starts, length, input_window, output
          "together, or hit alike", QualityWarning)
 
 
+def _warn_take_dependence(force, response, starts, take_of_hit, length, input_window, output_window,
+                          sample_rate_hz, labels, take_names, source) -> None:
+    """Warn where the takes' hits do not share one FRF beyond the noise (:func:`.levels.take_dependence`)."""
+    test = take_dependence(force, response, starts, take_of_hit, length, input_window, output_window, sample_rate_hz)
+    if test is None or not test.takes_differ:
+        return
+    names = ", ".join(take_names[t] for t in sorted(set(int(t) for t in take_of_hit)))
+    warn(f"{source}: the takes' FRFs differ beyond their noise ({names}: "
+         f"{labels[len(labels) - response.shape[0] + test.output]} at {test.frequency_hz:.4g} Hz, F-test p = "
+         f"{test.p_value:.2g} against {test.limit:.2g} over {test.n_lines} lines): they do not measure one FRF "
+         "(a hit point labelled twice, a sensor moved or the structure changed between them); estimate them apart",
+         QualityWarning)
+
+
 def _default_segment_length(n_samples: int) -> int:
     """Largest power of two giving at least 16 half-overlapping segments (at least 16 samples)."""
     return 1 << max(4, int(np.floor(np.log2(max(n_samples / 8.5, 16)))))
@@ -463,6 +477,9 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
 
     if impact:
         _warn_level_dependence(x[0], y, starts, length, in_w, out_w, fs, labels, source)
+        if bounds.size > 2:  # several takes: do they measure one FRF?
+            _warn_take_dependence(x[0], y, starts, np.searchsorted(bounds, starts, side="right") - 1, length, in_w,
+                                  out_w, fs, labels, names_of_takes, source)
     output_correlation = window_line_correlation(out_w)
     window_lags = lags_carried(output_correlation, length // 2 + 1)
     # continuous records, enough of them: the errors' correlation is also measured over the records

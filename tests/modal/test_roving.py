@@ -196,3 +196,16 @@ def test_estimates_on_other_axes_or_windows_are_refused():
     cut = first.cropped(0.0, 200.0)
     with pytest.raises(FormatError, match="p2.csv: .* lines up to 200 Hz where p1.csv has .*expected one frequency"):
         join_estimates([first, cut], [("1+Z", ["p1.csv"]), ("2+Z", ["p2.csv"])])
+
+
+def test_a_point_labelled_twice_is_averaged_as_takes_and_the_disagreement_said(roving, tmp_path):
+    # p3.csv saved with its force channel named 2+Z by mistake: it becomes a take of point 2, whose two files then
+    # hold two FRFs; the command says so instead of printing their average as point 2's shape entry
+    text = roving[2].read_text().splitlines()
+    mislabelled = tmp_path / "p3.csv"
+    mislabelled.write_text("\n".join([text[0].replace("3+Z [N]", "2+Z [N]")] + text[1:]) + "\n")
+    out = run("fit", roving[0], roving[1], mislabelled, "--impact")
+    assert out.returncode == 0, out.stderr
+    assert f"{roving[1]}, {mislabelled}: all hit at 2+Z: averaged as takes of that point" in out.stderr
+    warning = [ln for ln in out.stderr.splitlines() if "the takes' FRFs differ beyond their noise" in ln]
+    assert len(warning) == 1 and f"({roving[1]}, {mislabelled}:" in warning[0]
