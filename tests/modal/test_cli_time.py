@@ -382,3 +382,12 @@ def test_the_global_method_takes_the_exponential_window_damping_out_too(tmp_path
             # within 4 of its standard errors, and the window's share said
             assert abs(row["damping_ratio"] - zeta) <= 4 * row["std"]["damping_ratio"], (method, row)
             assert row["window_damping_ratio"] == pytest.approx(1 / (2 * np.pi * fn * 0.1), rel=0.01)
+
+
+def test_an_exponential_window_that_flattens_every_peak_is_named_as_the_cause(tmp_path):
+    # τ = 0.01 s adds ζ = 1/(2π f τ) = 40 % at 40 Hz: no peak stands, and the error only asked for bands
+    out = run("fit", *_ringing_takes(tmp_path), "--impact", "--window", "exponential", "--exponential-decay-s", "0.01")
+    assert out.returncode == 1 and out.stderr.count("error: ") == 1
+    error = out.stderr.splitlines()[-1]
+    assert "no resonance peak found" in error and "the exponential window (tau = 0.01 s)" in error
+    assert "10 % or more below 159.2 Hz" in error  # 1/(0.2 π τ)
