@@ -28,7 +28,7 @@ from .flags import COMPLEX_PHASE_DEG, FLAG_TEXT, INFORMATIONAL, OVERLAP_LIMIT, R
 from .results import ModeResult, ModeStd, correlation_of, physical_covariance, physical_parameters
 from .units import TWO_PI
 from .validate import channel_mask
-from .window_damping import remove_window_damping
+from .window_damping import remove_window_damping, window_constant_factor
 
 __all__ = ["ModeEstimate", "assemble_modes", "driving_points"]
 
@@ -148,7 +148,7 @@ def physical_with_flags(wn, zeta, const, cov, driving, flags: set[str], referenc
 
 def assemble_modes(estimates: Sequence[ModeEstimate], *, method: str, source: str, single: bool,
                    driving: np.ndarray | None, driving_known: bool = True, window_decay_s: float | None = None,
-                   phase_check: bool = True) -> tuple[ModeResult, ...]:
+                   phase_check: bool = True, window_power: int = 0) -> tuple[ModeResult, ...]:
     """The :class:`~modal.results.ModeResult` of every mode, with the flags every method shares, and a
     warning per flagged mode.
 
@@ -170,6 +170,10 @@ def assemble_modes(estimates: Sequence[ModeEstimate], *, method: str, source: st
         (flag ``driving_point_unknown``).
     window_decay_s : float, optional
         τ of an exponential window whose damping is taken out of every pole.
+    window_power : int
+        The power of iω of the FRF's kind (1 mobility, 2 accelerance), taken as what the windowed records
+        measured: the window turned the modal constants by (p/p')^power, taken back out
+        (:func:`modal.window_damping.window_constant_factor`).
     phase_check : bool
         Raise ``complex_mode`` from a driving point's phase (see :func:`physical_with_flags`).
 
@@ -211,6 +215,14 @@ def assemble_modes(estimates: Sequence[ModeEstimate], *, method: str, source: st
                 reference = (reference[0] + wn - wn_measured, reference[1] + zeta - zeta_measured, *reference[2:])
             if not valid:
                 flags.add("window_damping_dominates")
+            elif window_power:  # the windowed record was a velocity or an acceleration: its constants turned
+                factor = window_constant_factor(wn_measured, zeta_measured, wn, zeta, window_power)
+                const = const * factor
+                turn = np.eye(4)
+                turn[2:, 2:] = [[factor.real, -factor.imag], [factor.imag, factor.real]]
+                cov = turn @ cov @ turn.T
+                if reference is not None:
+                    reference = (*reference[:2], np.asarray(reference[2]) * factor, *reference[3:])
         if driving is None:  # output-only: nothing scales the shapes to k, c, m
             k = c = m = sk = sc = sm = np.full(const.shape, np.nan)
             cov_kcm, inputs = None, np.zeros(const.shape, bool)

@@ -71,7 +71,9 @@ def build_parser(prog: str = "python -m modal") -> argparse.ArgumentParser:
                          description="Identify natural frequency, damping, modal constant and k, c, m of every mode.")
     fit.add_argument("path", nargs="+", help="FRF file(s) (UFF 58/58b, CSV, MAT, HDF5); several files on one "
                      "frequency axis become one multi-channel FRF; several time files are takes of one test "
-                     "(the same channels, e.g. one file per hammer hit), averaged as one")
+                     "(the same channels, e.g. one file per hammer hit), averaged as one; time files of a roving "
+                     "hammer (the force channel names the hit point, the responses stay) are estimated point by "
+                     "point and fitted together")
     add_fit_options(fit)
     fit.add_argument("--stabilisation-plot", dest="stabilisation_plot", metavar="OUT.png",
                      help="global: write the stabilisation diagram over the summed FRF")
@@ -89,7 +91,8 @@ def build_parser(prog: str = "python -m modal") -> argparse.ArgumentParser:
                          description="Estimate FRFs with coherence and noise per line from a time file "
                                      "(UFF 58/58b function type 1, CSV with a time column, MAT, HDF5).")
     frf.add_argument("path", nargs="+", help="time file(s); several are takes of one test (the same channels, "
-                     "e.g. one file per hammer hit), averaged as one")
+                     "e.g. one file per hammer hit), averaged as one; files of a roving hammer (the force channel "
+                     "names the hit point) give one FRF per point")
     frf.add_argument("--out", required=True, metavar="FRF.h5",
                      help="output: .h5 keeps coherence, noise and settings; .uff/.csv/.mat the FRF only")
     frf.add_argument("--kind", choices=FRF_KINDS, help="FRF kind (default: from what the responses measured)")

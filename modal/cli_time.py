@@ -45,7 +45,7 @@ def save_time_plots(target, estimate: EstimatedFRF, record, inputs, outputs, hit
 
     target = Path(target)
     figures = [(target, plot_estimate(estimate))]
-    if estimate.hit_times_s or estimate.rejected:
+    if record is not None and (estimate.hit_times_s or estimate.rejected):
         hits_path = Path(hits_target) if hits_target else target.with_name(f"{target.stem}_hits{target.suffix}")
         figures.append((hits_path,
                         plot_hits(record.signals[inputs[0]], record.signals[outputs], record.sample_rate_hz, estimate)))

@@ -184,7 +184,9 @@ def fit_path(path: str | os.PathLike | Sequence[str | os.PathLike], options: Fit
     ----------
     path : path-like or sequence of path-likes
         One file, or several FRF files on one frequency axis (one multi-channel FRF), or several
-        time files: takes of one test (the same channels), estimated as one.
+        time files: takes of one test (the same channels), estimated as one, or a roving-hammer test
+        (one hit point per file), each point estimated and the FRFs joined (``settings["roving_hammer"]``
+        says what their errors share).
     options : FitOptions
     report_estimate : callable, optional
         Called with the estimate when the file held time data (the command line prints a line).
@@ -234,6 +236,11 @@ def fit_path(path: str | os.PathLike | Sequence[str | os.PathLike], options: Fit
                              **(global_options if method == "global" else {}),
                              **budget)
                     for method in methods)
+    from .roving import RovingEstimate
+
+    if isinstance(frf, RovingEstimate):  # what the hit points' estimates shared, and what they could not
+        results = tuple(dataclasses.replace(r, settings={**r.settings, "roving_hammer": frf.join_note})
+                        for r in results)
     return FitOutput(frf=frf, results=results, time_data=time_data)
 
 

@@ -409,9 +409,15 @@ def find_modes(frf: FRF, min_prominence_db: float = 6.0, noise_factor: float = 1
         strongest = np.argsort(ind[idx])[::-1][:max_modes]
         idx = np.sort(idx[strongest])
     if idx.size == 0:
+        window = ""
+        if frf.exponential_decay_s:  # the window adds ζ = 1/(ωτ): 10 % or more below 1/(0.2 π τ) Hz
+            below_hz = 1.0 / (0.2 * np.pi * frf.exponential_decay_s)
+            window = (f"; the exponential window (tau = {frf.exponential_decay_s:g} s) adds a damping ratio of "
+                      f"1/(2 pi f tau), 10 % or more below {below_hz:.4g} Hz, which flattens the peaks there: a longer "
+                      "tau")
         raise IdentificationError(
             f"{frf.source}: no resonance peak found ({min_prominence_db} dB prominence, "
-            f"{noise_factor}x above noise); give the bands explicitly"
+            f"{noise_factor}x above noise); give the bands explicitly{window}"
         )
     out = []
     df_min = np.min(np.diff(freq))

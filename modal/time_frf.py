@@ -18,7 +18,7 @@ from .estimate import estimate_frf
 from .frf import DEFAULT_UNITS, FRF_KINDS
 
 __all__ = ["TIME_OPTIONS", "wants_time", "frf_from_time", "TimePlan", "plan_time_frf", "estimate_time_frf",
-           "point_ids"]
+           "estimate_roving", "point_ids"]
 
 #: the attribute names the time options set (None when not given)
 TIME_OPTIONS = ("excitation", "response", "impact", "estimator", "window", "exponential_decay_s", "segment_length",
@@ -43,7 +43,9 @@ def frf_from_time(path, args, report: Callable[[str], None] | None = None):
     ----------
     path : path-like or sequence of path-likes
         One file, or several takes of one test (the same channels at one rate, such as one file
-        per hammer hit): estimated as one, no segment or hit record straddling two files.
+        per hammer hit): estimated as one, no segment or hit record straddling two files; or the
+        files of a roving-hammer test (the force channel's name changes, the responses stay):
+        each hit point estimated from its own file(s), joined (:mod:`modal.roving`).
     args : object
         The time options as attributes (:data:`TIME_OPTIONS`, and ``kind``): an ``argparse``
         namespace or :meth:`modal.fitting.FitOptions.namespace`.
@@ -53,7 +55,8 @@ def frf_from_time(path, args, report: Callable[[str], None] | None = None):
     Returns
     -------
     (EstimatedFRF, TimeRecord, list of int, list of int)
-        The estimate, the record, and the excitation and response channel indices.
+        The estimate, the record, and the excitation and response channel indices (of the first file);
+        for a roving-hammer test a :class:`~modal.roving.RovingEstimate` and no record (None).
     """
     from .io._common import refuse_copies
     from .io.timedata import read_time
@@ -61,7 +64,16 @@ def frf_from_time(path, args, report: Callable[[str], None] | None = None):
 
     paths = [path] if isinstance(path, (str, os.PathLike)) else list(path)
     refuse_copies(paths, "takes", "a take given twice is averaged with itself: its noise looks smaller than it is")
-    record = join_takes([read_time(p) for p in paths])
+    records = [read_time(p) for p in paths]
+    if len(records) > 1 and len({r.names for r in records}) > 1:  # a roving hammer, or files that are not one test
+        from .roving import roving_points
+
+        plans = [plan_time_frf(r, args) for r in records]
+        points = roving_points(records, plans)
+        if points is not None:
+            estimate = estimate_roving(records, plans, points, args, report)
+            return estimate, None, list(plans[0].inputs), list(plans[0].outputs)
+    record = join_takes(records)
     plan = plan_time_frf(record, args, report)
     return estimate_time_frf(record, plan, args), record, list(plan.inputs), list(plan.outputs)
 
@@ -205,3 +217,51 @@ def _ratio_units(record, plan: TimePlan) -> str | None:
         record.units[plan.outputs[0]] or "unit not given")
     bottom = "N" if force else (record.units[plan.inputs[0]] or "unit not given")
     return f"{top}/{bottom}" if "/" not in bottom and " " not in bottom else f"{top}/({bottom})"
+
+
+def estimate_roving(records, plans, points, args, report: Callable[[str], None] | None = None):
+    """Each hit point's FRFs from its own file(s), joined (:func:`modal.roving.join_estimates`).
+
+    Parameters
+    ----------
+    records, plans
+        Each file's record and channels (:func:`modal.roving.roving_points`).
+    points : list of (str, list of int)
+        What :func:`modal.roving.roving_points` returned.
+    args : object
+        The time options (:data:`modal.time_frf.TIME_OPTIONS` and ``kind``), for every point alike; without a
+        ``segment_length``, points whose hits give records of other lengths are estimated again with the
+        shortest (one frequency axis).
+    report : callable, optional
+        Called with a one-line note (files averaged as takes of one point, a length imposed).
+
+    Returns
+    -------
+    modal.roving.RovingEstimate
+    """
+    from types import SimpleNamespace
+
+    from .io.timejoin import join_takes
+    from .roving import join_estimates
+
+    groups = []
+    for point, members in points:
+        sources = tuple(records[k].source for k in members)
+        if len(members) > 1 and report is not None:
+            report(f"{', '.join(sources)}: all hit at {point}: averaged as takes of that point")
+        groups.append((join_takes([records[k] for k in members]), plans[members[0]], sources))
+    estimates = [estimate_time_frf(record, plan, args) for record, plan, _ in groups]
+    notes = []
+    lengths = [e.segment_length for e in estimates]
+    if args.segment_length is None and len(set(lengths)) > 1:
+        shortest = min(lengths)
+        alike = SimpleNamespace(**{**vars(args), "segment_length": shortest})
+        estimates = [e if e.segment_length == shortest else estimate_time_frf(record, plan, alike)
+                     for e, (record, plan, _) in zip(estimates, groups)]
+        notes.append(f"every point's hit records cut to {shortest} samples (the shortest default of the points, "
+                     "for one frequency axis)")
+        if report is not None:
+            report(f"roving hammer: hit records of {shortest} samples at every point (the points' defaults differ: "
+                   f"{', '.join(str(n) for n in lengths)}); give --segment-length to choose")
+    return join_estimates(estimates, [(point, sources) for (point, _), (_, _, sources) in zip(points, groups)],
+                          notes)

@@ -7,8 +7,13 @@ the residues stay. So the true pole is the identified one moved right by 1/τ
 
     σ = ζ_m ωn_m − 1/τ,   ωd = ωn_m √(1 − ζ_m²),   ωn = √(ωd² + σ²),   ζ = σ/ωn.
 
-The modal constants are unchanged (so is m = 1/|A|); k and c follow from the
-corrected ωn and ζ. Covariances go through the Jacobian of the map.
+The window multiplies the signal the sensor recorded: for a receptance from displacements the
+residues stay; an accelerometer's record windowed gives (s + 1/τ)² X(s + 1/τ), which near the
+moved pole p' = p − 1/τ reads as s² R (p/p')² / (s − p'): the modal constant fitted to it is
+the true one times (p/p')^q, q the power of iω of the kind (2 for accelerance, 1 for mobility),
+a phase of about −q/(ωτ) and a magnitude of 1 + ... (1/(ωτ))²; :func:`window_constant_factor` gives
+the factor that takes it back out. k and c follow from the corrected ωn and ζ. Covariances go
+through the Jacobian of the map.
 
 The correction acts on identified poles and their covariances, so it lives with
 identification (:func:`modal.assemble.assemble_modes` applies it); the FRF only
@@ -18,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["remove_window_damping"]
+__all__ = ["remove_window_damping", "window_constant_factor"]
 
 
 def remove_window_damping(omega_n: float, damping_ratio: float, cov: np.ndarray, std_omega_n: float,
@@ -59,3 +64,14 @@ def remove_window_damping(omega_n: float, damping_ratio: float, cov: np.ndarray,
     reported = jac[:2, :2] @ np.diag([std_omega_n**2, std_damping_ratio**2]) @ jac[:2, :2].T
     return (wn, zeta, cov, float(np.sqrt(reported[0, 0])), float(np.sqrt(reported[1, 1])),
             float(damping_ratio - zeta), True)
+
+
+def window_constant_factor(omega_n_measured: float, damping_ratio_measured: float, omega_n: float,
+                           damping_ratio: float, power: int) -> complex:
+    """(p'/p)^power: what a modal constant fitted to an exponentially windowed FRF is multiplied by to be the
+    structure's, p' the measured (windowed) pole and p the corrected one (rad/s, dimensionless ratios), for an
+    FRF whose kind's power of iω is ``power``, recorded as that quantity (see the module)."""
+    def pole(wn, zeta):
+        return complex(-zeta * wn, wn * np.sqrt(max(1.0 - zeta**2, 0.0)))
+
+    return complex((pole(omega_n_measured, damping_ratio_measured) / pole(omega_n, damping_ratio)) ** int(power))

@@ -28,6 +28,7 @@ from . import spectra
 from .error_correlation import LEAKAGE_LAGS, MIN_RECORDS, measured_line_correlation
 from .record_influence import MAX_INFLUENCE_VALUES, overlapping_records, record_influence
 from .hits import find_hits, pulse_train
+from .levels import level_dependence, take_dependence
 from .overload import find_overloads
 from .quiet import quiet_noise
 from .takes import find_hits_in_takes, segment_starts, take_bounds
@@ -235,6 +236,53 @@ def _noise_model(sums, output_correlation, input_window, output_window, sample_r
                       overlapping if influence is not None else 0, withheld)
 
 
+def _refuse_swapped_channels(force, response, sample_rate_hz, labels, source) -> None:
+    """An impact record whose excitation is no train of hammer pulses while a response channel is one: the
+    force and a response were swapped (at the recorder or in the file's labels). Hit detection would read the
+    ringing response as a force and reject every "hit" as a double hit, or pass a response over a force as an
+    FRF; refused instead, naming both channels."""
+    own = pulse_train(force, sample_rate_hz)
+    if own.impulsive:
+        return
+    for o in range(response.shape[0]):
+        other = pulse_train(np.asarray(response[o], dtype=float), sample_rate_hz)
+        if other.impulsive:
+            raise ParameterError(
+                f"{source}: {labels[0]} is no train of hammer pulses ({own.count} pulse(s) filling "
+                f"{100 * own.duty:.1f} % of the record) but {labels[len(labels) - response.shape[0] + o]} is "
+                f"({other.count} pulse(s), {100 * other.duty:.2f} %): the force and response channels look swapped "
+                "(the cables at the recorder or the file's channel labels); expected the hammer's force as the "
+                "excitation")
+
+
+def _warn_level_dependence(force, response, starts, length, input_window, output_window, sample_rate_hz, labels,
+                           source) -> None:
+    """Warn where the hits' FRFs change with their force level beyond the noise (:mod:`.levels`)."""
+    test = level_dependence(force, response, starts, length, input_window, output_window, sample_rate_hz)
+    if test is None or not test.level_dependent:
+        return
+    low, high = test.force_range
+    warn(f"{source}: the FRF changes with the force of the hit beyond its noise (nonlinearity: {test.n_hits} hits "
+         f"from {low:.3g} to {high:.3g} in the force's unit; {labels[len(labels) - response.shape[0] + test.output]} "
+         f"at {test.frequency_hz:.4g} Hz, F-test p = {test.p_value:.2g} against {test.limit:.2g} over "
+         f"{test.n_lines} lines): the average mixes the structure's states; estimate hits of one force level "
+         "together, or hit alike", QualityWarning)
+
+
+def _warn_take_dependence(force, response, starts, take_of_hit, length, input_window, output_window,
+                          sample_rate_hz, labels, take_names, source) -> None:
+    """Warn where the takes' hits do not share one FRF beyond the noise (:func:`.levels.take_dependence`)."""
+    test = take_dependence(force, response, starts, take_of_hit, length, input_window, output_window, sample_rate_hz)
+    if test is None or not test.takes_differ:
+        return
+    names = ", ".join(take_names[t] for t in sorted(set(int(t) for t in take_of_hit)))
+    warn(f"{source}: the takes' FRFs differ beyond their noise ({names}: "
+         f"{labels[len(labels) - response.shape[0] + test.output]} at {test.frequency_hz:.4g} Hz, F-test p = "
+         f"{test.p_value:.2g} against {test.limit:.2g} over {test.n_lines} lines): they do not measure one FRF "
+         "(a hit point labelled twice, a sensor moved or the structure changed between them); estimate them apart",
+         QualityWarning)
+
+
 def _default_segment_length(n_samples: int) -> int:
     """Largest power of two giving at least 16 half-overlapping segments (at least 16 samples)."""
     return 1 << max(4, int(np.floor(np.log2(max(n_samples / 8.5, 16)))))
@@ -356,6 +404,7 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
         if x.shape[0] != 1:
             raise ParameterError(f"{source}: impact=True takes one force channel, got {x.shape[0]}")
         force = np.asarray(x[0], dtype=float)
+        _refuse_swapped_channels(force, y, fs, labels, source)
         pre = None if pretrigger_s is None else pretrigger_s
 
         def find(force, response, rate, **options):
@@ -381,8 +430,13 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
         if starts.size == 0:
             where = [f"{r['take_name']} " if "take" in r else "" for r in rejected]
             reasons = "; ".join(f"{at}hit {r['hit']} at {r['time_s']:.3f} s: {r['reason']}"
-                                for at, r in zip(where, rejected))
-            raise ParameterError(f"{source}: every hit was rejected ({reasons})")
+                                + (f" ({r['detail']})" if r.get("detail") else "") for at, r in zip(where, rejected))
+            advice = ""
+            if any(r["reason"] == "response not decayed within the record" for r in rejected) and decay is None:
+                advice = ("; the responses still ring at the end of the hit records: an exponential window makes them "
+                          "decay within them (window='exponential' with exponential_decay_s; modal fit --window "
+                          "exponential --exponential-decay-s S), its damping taken back out of the modes")
+            raise ParameterError(f"{source}: every hit was rejected ({reasons}){advice}")
         in_w = np.ones(length)
         if window in ("force", "exponential"):
             in_w = force_window(length, pre_samples, width=max(8, 3 * hits.pulse_samples))
@@ -421,6 +475,11 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
             warn(f"{source}: {item.describe(labels[item.channel])}: the spectra are distorted where it clipped; "
                  "lower the gain or the excitation level", QualityWarning)
 
+    if impact:
+        _warn_level_dependence(x[0], y, starts, length, in_w, out_w, fs, labels, source)
+        if bounds.size > 2:  # several takes: do they measure one FRF?
+            _warn_take_dependence(x[0], y, starts, np.searchsorted(bounds, starts, side="right") - 1, length, in_w,
+                                  out_w, fs, labels, names_of_takes, source)
     output_correlation = window_line_correlation(out_w)
     window_lags = lags_carried(output_correlation, length // 2 + 1)
     # continuous records, enough of them: the errors' correlation is also measured over the records

@@ -38,6 +38,11 @@ __all__ = ["Hits", "find_hits", "PulseTrain", "pulse_train", "trigger_threshold"
 DECAY_LOOK_S = 0.1
 #: a response within this many times its noise floor (RMS of its quietest parts) counts as decayed
 NOISE_FACTOR = 6.0
+#: 64-sample blocks whose RMS is within this factor of the quietest block's hold noise alone: the RMS of 64
+#: samples of white noise scatters by 9 %, so the quietest of thousands of noise blocks lies near 0.7 of the
+#: noise's RMS and every noise block within 1.5 of it but the loudest few; a decaying response above it
+#: is not noise
+QUIET_BLOCK_RATIO = 1.5
 #: a force whose pulses above the trigger threshold fill at most this fraction of the record is a train of
 #: hits: hammer pulses of 1–10 ms, a few per second, fill well under 1 %; a shaker's continuous force has no
 #: sample above 8 robust standard deviations (Gaussian: probability 1e-15), a burst random one fills 10–90 %
@@ -100,13 +105,18 @@ def _pulses(above: np.ndarray, merge_gap: int) -> list[tuple[int, int]]:
 
 
 def _noise_floor(centred: np.ndarray) -> np.ndarray:
-    """Per channel, the RMS of the quiet parts: the 10th percentile of the RMS of 64-sample blocks."""
+    """Per channel, the RMS of the quiet parts: of the 64-sample blocks whose RMS is within
+    :data:`QUIET_BLOCK_RATIO` of the quietest block's, however few they are (a take cut short while
+    it rings is quiet only before its hit: a fixed share of the blocks, such as the quietest tenth,
+    would then be ringing and put the floor near the response's peak)."""
     block = 64
     m = centred.shape[1] // block
     if m < 10:
         return 1.4826 * np.median(np.abs(centred), axis=1)
     blocks = centred[:, :m * block].reshape(centred.shape[0], m, block)
-    return np.percentile(np.sqrt(np.mean(blocks**2, axis=2)), 10, axis=1)
+    power = np.mean(blocks**2, axis=2)
+    quiet = power <= QUIET_BLOCK_RATIO**2 * power.min(axis=1, keepdims=True)
+    return np.sqrt(np.sum(np.where(quiet, power, 0.0), axis=1) / quiet.sum(axis=1))
 
 
 def trigger_threshold(force: np.ndarray) -> float:

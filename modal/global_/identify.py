@@ -676,10 +676,11 @@ def identify_global(frf: FRF, *, modes_hz=None, order: int | None = None, max_or
             quality=pole.n_stable_orders / max(pole.n_orders, 1), mode_shape=shapes[0] if single else shapes,
             participation=np.asarray(pole.participation), mpc=mode_mpc))
     driving, known = driving_points(work, driving_point)
-    # complexity is judged by the shapes' MPC (complex_shape), not by a driving point's phase; the global
-    # fit does not take an exponential window's damping out of the poles
+    # complexity is judged by the shapes' MPC (complex_shape), not by a driving point's phase; an exponential
+    # window's damping comes out of every pole as for the band-wise methods (the shift by 1/τ is exact)
     modes = assemble_modes(estimates, method="global", source=src, single=single, driving=driving,
-                           driving_known=known, phase_check=False)
+                           driving_known=known, phase_check=False, window_decay_s=frf.exponential_decay_s,
+                           window_power=KIND_POWER[frf.kind])
     settings = {"orders": [int(orders[0]), int(orders[-1])], "references": [str(r) for r in references],
                 "transposed_by_reciprocity": bool(transposed),
                 "band_hz": [float(work.frequency_hz[0]), float(work.frequency_hz[-1])],

@@ -99,7 +99,7 @@ def identify_bands(frf, method: str, bands, *, raw_noise: np.ndarray, noise_std=
     driving, known = driving_points(frf, driving_point)
     modes = assemble_modes(estimates, method=method, source=frf.source, single=frf.response.ndim == 1,
                            driving=driving, driving_known=known,
-                           window_decay_s=frf.exponential_decay_s)
+                           window_decay_s=frf.exponential_decay_s, window_power=KIND_POWER[frf.kind])
     return IdentificationResult(modes, method, frf.kind, n_ch, noise_std=estimated_noise, settings=settings)
 
 

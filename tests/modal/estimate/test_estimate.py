@@ -318,3 +318,17 @@ def test_one_record_matches_pyfrf():
     ours = modal.estimate_frf(x, y, 1024.0, window="rect", segment_length=1024)
     # pyFRF's 0 Hz line is NaN (a division by ω there); every other line agrees
     np.testing.assert_allclose(ours.response[1:], theirs[1:], rtol=1e-8)
+
+
+def test_an_impact_record_with_force_and_response_swapped_is_refused_naming_both():
+    # the accelerometer's ringing recorded as the force and the hammer's pulses as the response: hit detection read
+    # every ringing peak as a pulse and refused all hits as double hits, which sends a user after the hammer tip
+    from modal.synthetic import impact_record
+
+    plant = DigitalModes([40.0, 95.0], [0.01, 0.02], [[1.0, 0.5]], FS)
+    record = impact_record(plant, [0.5, 4.5, 8.5], 12.0, seed=2, response_noise=1e-3, force_noise=1e-3).record
+    force, response = record.signals[0], record.signals[1]
+    with pytest.raises(ParameterError, match=r"force is no train of hammer pulses .* but response 1 is .*look swapped"):
+        modal.estimate_frf(response, force, FS, impact=True, window="force", kind="accelerance")
+    est = modal.estimate_frf(force, response, FS, impact=True, window="force", kind="accelerance")
+    assert est.averages == 3  # the right way round: the three hits

@@ -201,3 +201,19 @@ def test_two_equal_peaks_are_not_yet_a_rail():
     assert find_overloads(x) == []  # without repeated_peaks (a continuous record): only flat tops count
     x[[11, 41, 71]] = 0.2  # one pulse repeated exactly (a record without noise): equal flanks, no rail
     assert find_overloads(x, repeated_peaks=3) == []
+
+
+def test_a_take_cut_short_while_it_rings_is_rejected_however_little_of_it_is_quiet():
+    # one hit per 1 s take, 0.1 s after the start, ζ = 0.2 % at 40 Hz (decay time 2 s): the response is still at
+    # a third of its peak when the record ends. Only the 0.1 s before the hit holds noise alone, less than the
+    # quietest tenth of the take's blocks: the noise floor was read on the ringing (near the response's peak),
+    # the hit passed as decayed and its leakage made the mass 1.50 ± 0.03 kg for 1 kg
+    lightly = DigitalModes([40.0, 95.0], [0.002, 0.003], [[1.0, 0.5]], 1024.0)
+    take = impact_record(lightly, [0.1], 1.0, seed=20, response_noise=1e-3, force_noise=1e-3).record
+    hits = find_hits(take.signals[0], take.signals[1:], take.sample_rate_hz)
+    assert [r["reason"] for r in hits.rejected] == ["response not decayed within the record"]
+    with pytest.raises(modal.ParameterError, match="every hit was rejected.*an exponential window makes them decay"):
+        _estimate(take)
+    # the same hit with its ringing decayed within the record (ζ 3 %): the quiet blocks are its noise, kept
+    damped = impact_record(PLANT, [0.1], 1.0, seed=20, response_noise=1e-3, force_noise=1e-3).record
+    assert find_hits(damped.signals[0], damped.signals[1:], damped.sample_rate_hz).rejected == []

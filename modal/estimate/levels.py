@@ -1,0 +1,244 @@
+"""Whether an impact estimate's hits see one linear structure: its FRF tested against the hits' force levels.
+
+A linear structure answers every hit with the same FRF, however hard the hit; a joint that slips,
+a rattling part or a hardening spring changes its frequencies and damping with the force, and the
+average of hits at several levels then mixes its states (a smeared peak: damping too high, a
+frequency between them, errors that only say the hits scatter). Each line is tested on its own:
+the responses of the n hits, Y_k = (a + b u_k) X_k + e_k, with u_k the centred logarithm of hit k's
+peak force, against the linear Y_k = a X_k + e_k (H1's model). With errors independent between
+hits and alike in each (response noise, and force noise through H, both the same for every hit),
+
+    F = (RSS₀ − RSS₁)(n − 2) / RSS₁  ~  F(2, 2(n − 2))
+
+when the structure is linear (complex least squares: one complex parameter more, 2(n − 2) real
+degrees of freedom left). The record's smallest p over its lines and responses is compared with a
+family-wise level spread over them (Bonferroni, which holds however the lines correlate), on the lines
+where the FRF changes by at least :data:`MATERIAL_CHANGE` of itself.
+
+Takes saved in several files are tested the same way against one FRF per take
+(:func:`take_dependence`): F = ((RSS₀ − RSS_T)/(T − 1)) / (RSS_T/(n − T)) ~ F(2(T − 1), 2(n − T)),
+which files of one point that do not measure one FRF fail (a roving point labelled twice, a sensor
+moved or the structure changed between takes).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["LevelTest", "TakeTest", "level_dependence", "take_dependence", "FAMILY_LEVEL", "MIN_LEVEL_RATIO",
+           "MIN_HITS", "MATERIAL_CHANGE", "MAX_SPECTRUM_VALUES"]
+
+#: chance that a linear structure's record is reported level-dependent (over all its lines and responses), as the
+#: F distribution of Gaussian errors gives it; its far tail, with the few degrees of freedom of a handful of hits,
+#: rests on the errors being Gaussian to 1e-7 of their distribution, which real ones need not be (1e-3 warned 1 of
+#: 120 linear records of 5-9 hits): set low, a 0.3 % frequency shift over a factor 8 in force is still found
+FAMILY_LEVEL = 1e-4
+#: the hits' peak forces must span at least this ratio for the test to say anything
+MIN_LEVEL_RATIO = 1.5
+#: a change of the FRF smaller than this fraction of it (over the hits' levels, or between a take and the
+#: others) is not reported, however significant: a hit's record that holds the previous hit's ringing at 1 %
+#: (a lightly damped mode, hits a few seconds apart, little noise) is no nonlinearity worth a warning
+MATERIAL_CHANGE = 0.02
+#: hits needed: two parameters per line and degrees of freedom left for the noise
+MIN_HITS = 4
+#: hits × lines × channels of spectra the test holds at most (64 MiB of complex values); above, it is not run
+MAX_SPECTRUM_VALUES = 1 << 22
+#: lines tested: those where every hit's force spectrum is at least this fraction of its largest (the hammer's
+#: band; above it the force is noise and the FRF undefined)
+FORCE_BAND_FRACTION = 0.1
+
+
+@dataclass(frozen=True)
+class LevelTest:
+    """The smallest p of the line-by-line test and where it was found.
+
+    Attributes
+    ----------
+    p_value : float
+        Smallest p over the lines and responses tested.
+    limit : float
+        :data:`FAMILY_LEVEL` over the number of tests: below it, the FRF changes with the force level.
+    frequency_hz : float
+        The line of the smallest p, Hz.
+    output : int
+        The response (0-based, in the order given) of the smallest p.
+    force_range : tuple of float
+        The smallest and largest peak force of the hits, in the force's unit.
+    n_hits, n_lines : int
+    """
+
+    p_value: float
+    limit: float
+    frequency_hz: float
+    output: int
+    force_range: tuple[float, float]
+    n_hits: int
+    n_lines: int
+
+    @property
+    def level_dependent(self) -> bool:
+        return self.p_value < self.limit
+
+
+def level_dependence(force, response, starts, length: int, input_window, output_window,
+                     sample_rate_hz: float) -> LevelTest | None:
+    """Test the hits' FRFs against their force levels (see the module), or None where the test cannot say.
+
+    Parameters
+    ----------
+    force : ndarray, shape (n_samples,)
+    response : array_like, shape (n_outputs, n_samples)
+    starts : ndarray of int
+        First sample of each accepted hit's record.
+    length : int
+        Samples per record.
+    input_window, output_window : ndarray, shape (length,)
+        The windows the estimate applied.
+    sample_rate_hz : float
+
+    Returns
+    -------
+    LevelTest or None
+        None with fewer than :data:`MIN_HITS` hits, peak forces within :data:`MIN_LEVEL_RATIO` of each other,
+        no line in the force's band, or spectra above :data:`MAX_SPECTRUM_VALUES`.
+    """
+    from scipy.special import fdtrc
+
+    starts = np.asarray(starts, int)
+    n = starts.size
+    n_out = np.shape(response)[0]
+    n_lines = length // 2 + 1
+    if n < MIN_HITS or n * n_lines * (n_out + 1) > MAX_SPECTRUM_VALUES:
+        return None
+    segments = np.stack([np.asarray(force[s:s + length], float) for s in starts])
+    peaks = np.max(np.abs(segments), axis=1)
+    if not (np.all(peaks > 0) and peaks.max() >= MIN_LEVEL_RATIO * peaks.min()):
+        return None
+    X = np.fft.rfft(segments * input_window, axis=1)  # (hits, lines)
+    power = np.abs(X) ** 2
+    band = np.all(power >= FORCE_BAND_FRACTION**2 * power.max(axis=1, keepdims=True), axis=0)
+    band[0] = False  # 0 Hz: the mean, not a vibration
+    if length % 2 == 0:
+        band[-1] = False  # the Nyquist line is real: one degree of freedom per hit, not two
+    lines = np.flatnonzero(band)
+    if lines.size == 0:
+        return None
+    u = np.log(peaks) - np.mean(np.log(peaks))
+    Xb, Pb = X[:, lines], power[:, lines]
+    s_xx, s_ux, s_uu = Pb.sum(axis=0), (u[:, None] * Pb).sum(axis=0), (u[:, None] ** 2 * Pb).sum(axis=0)
+    det = s_xx * s_uu - s_ux**2
+    best = (np.inf, 0.0, 0)
+    for o in range(n_out):
+        rows = np.stack([np.asarray(response[o][s:s + length], float) for s in starts])
+        Y = np.fft.rfft(rows * output_window, axis=1)[:, lines]
+        cross = np.conj(Xb) * Y
+        r0, r1 = cross.sum(axis=0), (u[:, None] * cross).sum(axis=0)
+        s_yy = (np.abs(Y) ** 2).sum(axis=0)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            rss0 = s_yy - np.abs(r0) ** 2 / s_xx
+            # the 2 × 2 solve of [X, uX] per line: r^H G⁻¹ r with G = [[s_xx, s_ux], [s_ux, s_uu]]
+            explained = (s_uu * np.abs(r0) ** 2 - 2 * s_ux * np.real(np.conj(r0) * r1) + s_xx * np.abs(r1) ** 2) / det
+            rss1 = s_yy - explained
+            F = (rss0 - rss1) * (n - 2) / rss1
+            # the FRF's change over the hits' range of levels, relative to it: b (u_max − u_min) / |a|
+            a = (s_uu * r0 - s_ux * r1) / det
+            b = (s_xx * r1 - s_ux * r0) / det
+            change = np.abs(b) * (u.max() - u.min()) / np.abs(a)
+        ok = np.isfinite(F) & (rss1 > 0) & (change >= MATERIAL_CHANGE)
+        if not ok.any():
+            continue
+        p = fdtrc(2.0, 2.0 * (n - 2), np.maximum(F[ok], 0.0))
+        k = int(np.argmin(p))
+        if p[k] < best[0]:
+            best = (float(p[k]), float(lines[np.flatnonzero(ok)[k]] * sample_rate_hz / length), o)
+    if not np.isfinite(best[0]):
+        return None
+    return LevelTest(p_value=best[0], limit=FAMILY_LEVEL / (lines.size * n_out), frequency_hz=best[1],
+                     output=best[2], force_range=(float(peaks.min()), float(peaks.max())), n_hits=n,
+                     n_lines=int(lines.size))
+
+
+@dataclass(frozen=True)
+class TakeTest:
+    """The smallest p of the line-by-line test of one FRF for every take, and where it was found.
+
+    Attributes
+    ----------
+    p_value, limit, frequency_hz, output
+        As :class:`LevelTest`'s.
+    n_takes, n_hits, n_lines : int
+    """
+
+    p_value: float
+    limit: float
+    frequency_hz: float
+    output: int
+    n_takes: int
+    n_hits: int
+    n_lines: int
+
+    @property
+    def takes_differ(self) -> bool:
+        return self.p_value < self.limit
+
+
+def take_dependence(force, response, starts, take_of_hit, length: int, input_window, output_window,
+                    sample_rate_hz: float) -> TakeTest | None:
+    """Test whether the takes' hits share one FRF (see the module), or None where the test cannot say.
+
+    Parameters
+    ----------
+    take_of_hit : ndarray of int
+        The take (0-based) of each accepted hit.
+
+    Other parameters as :func:`level_dependence`. None with fewer than two takes, no take of two hits or more
+    (no noise left once each take has its FRF), no line in the force's band, or spectra too large.
+    """
+    from scipy.special import fdtrc
+
+    starts, takes = np.asarray(starts, int), np.asarray(take_of_hit, int)
+    n = starts.size
+    labels, takes = np.unique(takes, return_inverse=True)
+    n_takes = labels.size
+    n_out = np.shape(response)[0]
+    n_lines = length // 2 + 1
+    if n_takes < 2 or n - n_takes < 2 or n * n_lines * (n_out + 1) > MAX_SPECTRUM_VALUES:
+        return None
+    segments = np.stack([np.asarray(force[s:s + length], float) for s in starts])
+    X = np.fft.rfft(segments * input_window, axis=1)
+    power = np.abs(X) ** 2
+    band = np.all(power >= FORCE_BAND_FRACTION**2 * power.max(axis=1, keepdims=True), axis=0)
+    band[0] = False
+    if length % 2 == 0:
+        band[-1] = False
+    lines = np.flatnonzero(band)
+    if lines.size == 0:
+        return None
+    Xb, Pb = X[:, lines], power[:, lines]
+    member = np.eye(n_takes)[takes]  # (hits, takes)
+    s_xx_t = member.T @ Pb  # (takes, lines)
+    best = (np.inf, 0.0, 0)
+    for o in range(n_out):
+        rows = np.stack([np.asarray(response[o][s:s + length], float) for s in starts])
+        Y = np.fft.rfft(rows * output_window, axis=1)[:, lines]
+        cross = np.conj(Xb) * Y
+        s_yy = (np.abs(Y) ** 2).sum(axis=0)
+        cross_t = member.T @ cross
+        with np.errstate(divide="ignore", invalid="ignore"):
+            rss0 = s_yy - np.abs(cross.sum(axis=0)) ** 2 / Pb.sum(axis=0)
+            rss_t = s_yy - np.sum(np.abs(cross_t) ** 2 / s_xx_t, axis=0)
+            F = ((rss0 - rss_t) / (n_takes - 1)) / (rss_t / (n - n_takes))
+            common = cross.sum(axis=0) / Pb.sum(axis=0)
+            change = np.max(np.abs(cross_t / s_xx_t - common), axis=0) / np.abs(common)
+        ok = np.isfinite(F) & (rss_t > 0) & (change >= MATERIAL_CHANGE)
+        if not ok.any():
+            continue
+        p = fdtrc(2.0 * (n_takes - 1), 2.0 * (n - n_takes), np.maximum(F[ok], 0.0))
+        k = int(np.argmin(p))
+        if p[k] < best[0]:
+            best = (float(p[k]), float(lines[np.flatnonzero(ok)[k]] * sample_rate_hz / length), o)
+    if not np.isfinite(best[0]):
+        return None
+    return TakeTest(p_value=best[0], limit=FAMILY_LEVEL / (lines.size * n_out), frequency_hz=best[1], output=best[2],
+                    n_takes=int(n_takes), n_hits=int(n), n_lines=int(lines.size))

@@ -1,0 +1,99 @@
+"""The hits' FRFs tested against their force levels (modal.estimate.levels): nonlinearity in an impact test."""
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+import modal
+from modal.estimate.levels import FAMILY_LEVEL, level_dependence
+from modal.synthetic import DigitalModes, impact_record
+
+FS = 1024.0
+LEVELS_N = [30.0, 60.0, 120.0, 240.0]
+
+
+def _levelled(shift, seed=0, noise=1e-3):
+    """Two hits at each force level; the structure's frequencies rise by ``shift`` (a fraction) from no force to
+    the strongest hit (a hardening joint), each hit answered by the linear structure of its own level."""
+    force, response = [], []
+    for k, level in enumerate(LEVELS_N):
+        scale = 1 + shift * level / LEVELS_N[-1]
+        plant = DigitalModes([40.0 * scale, 95.0 * scale], [0.01, 0.02], [[1.0, 0.5]], FS)
+        record = impact_record(plant, [0.5, 4.5], 8.0, amplitude_n=level, seed=seed + k, response_noise=noise,
+                               force_noise=noise).record
+        force.append(record.signals[0])
+        response.append(record.signals[1:])
+    return np.concatenate(force), np.concatenate(response, axis=1), [record.n_samples] * len(LEVELS_N)
+
+
+def _estimate(force, response, takes, window="force", **options):
+    return modal.estimate_frf(force, response, FS, impact=True, window=window, kind="accelerance",
+                              take_lengths=takes, **options)
+
+
+def test_hits_of_a_structure_that_stiffens_with_the_force_are_warned_of():
+    # frequencies 1 % higher at 240 N than at 0 N: averaged, the 30-240 N hits gave 40.349 ± 0.008 Hz (no flag)
+    # where the structure is at 40.05-40.4 Hz
+    force, response, takes = _levelled(0.01)
+    with pytest.warns(modal.QualityWarning) as caught:
+        _estimate(force, response, takes)
+    said = [str(w.message) for w in caught]
+    assert any("changes with the force of the hit beyond its noise (nonlinearity: 8 hits from 30 to 240" in m
+               for m in said)
+    # each take at its own level: the takes differ too, and are said to
+    assert any("the takes' FRFs differ beyond their noise (take 1, take 2, take 3, take 4" in m for m in said)
+
+
+def test_a_linear_structure_hit_at_many_levels_raises_no_warning():
+    # the same hits on the linear structure: the test's family-wise false alarm is FAMILY_LEVEL per record; hits
+    # whose force and pulse width scatter widely (a factor 8 in force), with or without an exponential window
+    assert FAMILY_LEVEL <= 1e-4
+    for seed in range(6):
+        force, response, takes = _levelled(0.0, seed=10 * seed)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", modal.QualityWarning)
+            _estimate(force, response, takes)
+            _estimate(force, response, takes, window="exponential", exponential_decay_s=0.5)
+    plant = DigitalModes([40.0, 95.0], [0.01, 0.02], [[1.0, 0.5], [0.6, -0.8]], FS)
+    record = impact_record(plant, [0.5 + 4 * k for k in range(8)], 33.0, seed=3, amplitude_variation=0.6,
+                           width_variation=0.3, response_noise=1e-4, force_noise=1e-4).record
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", modal.QualityWarning)
+        modal.estimate_frf(record.signals[0], record.signals[1:], FS, impact=True, window="force", kind="accelerance")
+
+
+def test_the_test_says_nothing_where_it_cannot():
+    force, response, takes = _levelled(0.01)
+    starts = np.array([512 - 8, 4608 - 8])
+    window = np.ones(2048)
+    # two hits: no degrees of freedom for the noise once the level's slope is fitted
+    assert level_dependence(force, response, starts, 2048, window, window, FS) is None
+    # hits of one force level: no spread to test against
+    plant = DigitalModes([40.0, 95.0], [0.01, 0.02], [[1.0, 0.5]], FS)
+    same = impact_record(plant, [0.5 + 4 * k for k in range(6)], 25.0, seed=1, response_noise=1e-3).record
+    starts = np.array([int(0.5 * FS) + 4096 * k - 8 for k in range(6)])
+    assert level_dependence(same.signals[0], same.signals[1:], starts, 2048, window, window, FS) is None
+
+
+def test_takes_that_do_not_measure_one_frf_are_warned_of():
+    # two takes of three hits each, the second with the hammer at another point of the structure: averaged as
+    # takes of one test they mixed two FRFs, and nothing said so
+    first = impact_record(DigitalModes([40.0, 95.0], [0.01, 0.02], [[1.0, 0.5]], FS), [0.5, 4.5, 8.5], 12.0,
+                          seed=1, response_noise=1e-3, force_noise=1e-3).record
+    other = impact_record(DigitalModes([40.0, 95.0], [0.01, 0.02], [[0.6, -0.8]], FS), [0.5, 4.5, 8.5], 12.0,
+                          seed=2, response_noise=1e-3, force_noise=1e-3).record
+    force = np.concatenate([first.signals[0], other.signals[0]])
+    response = np.concatenate([first.signals[1:], other.signals[1:]], axis=1)
+    with pytest.warns(modal.QualityWarning, match=r"the takes' FRFs differ beyond their noise \(a.csv, b.csv"):
+        modal.estimate_frf(force, response, FS, impact=True, window="force", kind="accelerance",
+                           take_lengths=[first.n_samples, other.n_samples], take_names=["a.csv", "b.csv"])
+    # the same point in both takes: one FRF, no warning
+    again = impact_record(DigitalModes([40.0, 95.0], [0.01, 0.02], [[1.0, 0.5]], FS), [0.5, 4.5, 8.5], 12.0,
+                          seed=2, response_noise=1e-3, force_noise=1e-3).record
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", modal.QualityWarning)
+        modal.estimate_frf(np.concatenate([first.signals[0], again.signals[0]]),
+                           np.concatenate([first.signals[1:], again.signals[1:]], axis=1), FS, impact=True,
+                           window="force", kind="accelerance", take_lengths=[first.n_samples, again.n_samples])
