@@ -71,7 +71,7 @@ def take_setup(time_data) -> str:
     continuous excitation)."""
     from ..estimate.hits import pulse_train
 
-    if time_data is None:
+    if time_data is None or time_data[0] is None:  # an FRF file, or a roving test's joined estimates
         return ""
     record, inputs, _ = time_data
     if len(inputs) != 1 or len(record.take_lengths or ()) > 1:
