@@ -4,7 +4,7 @@ The fit service (:mod:`modal.fitting`) and the command line (:mod:`modal.cli`,
 whose options :mod:`modal.cli_time` declares) both call :func:`frf_from_time`, so a
 time file gives the same FRFs either way; a scene's ``[frf]`` table takes the same options
 under the same names and calls :func:`plan_time_frf` (when the scene is checked) and
-:func:`estimate_time_frf` (when its stage runs).
+:func:`estimate_time_frf` (when its stage runs), or :func:`estimate_roving` for a roving hammer's files.
 """
 from __future__ import annotations
 

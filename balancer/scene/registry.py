@@ -316,7 +316,9 @@ STAGES = tuple(REGISTRY)
 
 def result_modules(scene, stages) -> tuple[str, ...]:
     """Modules a plotting process needs beyond the ``plot_modules`` of ``stages`` to read what this scene's figures
-    are handed: an FRF estimated from a time record (``modal.estimate``'s EstimatedFRF) where a figure reads the
-    frf; nothing for an FRF file or a synthetic FRF."""
+    are handed: an FRF estimated from a time record (``modal.estimate``'s EstimatedFRF, or ``modal.roving``'s
+    RovingEstimate for a roving hammer's files) where a figure reads the frf; nothing for an FRF file or a
+    synthetic FRF."""
     timed = scene.inputs.get("frf") is not None
-    return ("modal.estimate",) if timed and any("frf" in REGISTRY[s].plot_inputs for s in stages) else ()
+    wanted = timed and any("frf" in REGISTRY[s].plot_inputs for s in stages)
+    return ("modal.estimate", "modal.roving") if wanted else ()

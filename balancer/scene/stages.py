@@ -27,7 +27,7 @@ __all__ = [
     "RotorStage", "StabilityStage", "DriveStage", "CompressorStage", "MountsStage",
     "stage_frf", "stage_identify", "stage_drive", "stage_rotor", "stage_adb_stability", "stage_adb_response",
     "stage_compressor", "stage_mounts", "resolve", "BalanceStage", "stage_balance", "check_frf", "read_balance_job",
-    "stage_oma", "check_oma", "check_compressor", "check_mounts",
+    "stage_oma", "check_oma", "check_compressor", "check_mounts", "RovingFiles",
 ]
 
 
@@ -212,7 +212,10 @@ def check_frf(scene: Scene):
 
     A time record (a hammer or shaker test) is read here, its channels chosen and their roles
     checked before any work: returns ``(record, plan)`` (:func:`modal.time_frf.plan_time_frf`)
-    for the stage to estimate from; None for an FRF file or a synthetic FRF.
+    for the stage to estimate from, several files being takes of one test; :class:`RovingFiles`
+    for the files of a roving-hammer test (the force channel's name changes from file to file, the
+    responses stay), refused as ``modal fit`` refuses them when they are not one; None for an FRF
+    file or a synthetic FRF.
     """
     cfg = scene.section("frf")
     if "file" in cfg and "synthetic" in cfg:
@@ -237,13 +240,46 @@ def check_frf(scene: Scene):
                          f"time record; expected its time options ({', '.join(TIME_FRF_OPTIONS)}, kind)")
     from modal.io.timedata import read_time
     from modal.io.timejoin import join_takes
-    from modal.time_frf import plan_time_frf
 
     try:
-        record = join_takes([read_time(path) for path in paths])  # several files: takes of one test
+        records = [read_time(path) for path in paths]
     except ModalError as exc:
         raise SceneError(f"{scene.source}: key 'frf.file' = {cfg['file']!r}: {exc}") from None
-    # each named channel is looked up under its own key, so that an error names it
+    if len(records) > 1 and len({r.names for r in records}) > 1:  # a roving hammer, or files that are not one test
+        from modal.roving import roving_points
+
+        plans = [_plan_record(scene, record) for record in records]  # as `modal fit` plans each file
+        try:
+            points = roving_points(records, plans)
+        except ModalError as exc:
+            raise SceneError(f"{scene.source}: key 'frf.file' = {cfg['file']!r}: {exc}") from None
+        if points is not None:
+            return RovingFiles(tuple(records), tuple(plans), tuple(points))
+    try:
+        record = join_takes(records)  # several files: takes of one test
+    except ModalError as exc:
+        raise SceneError(f"{scene.source}: key 'frf.file' = {cfg['file']!r}: {exc}") from None
+    return record, _plan_record(scene, record)
+
+
+@dataclass(frozen=True)
+class RovingFiles:
+    """The files of a roving-hammer test in [frf] file, as the scene's check read them
+    (:func:`modal.roving.roving_points`): each file's record and channels, and the hit points with the
+    indices of the files hit at each."""
+
+    records: tuple
+    plans: tuple
+    points: tuple
+
+
+def _plan_record(scene: Scene, record):
+    """A record's channels as [frf] names them (:func:`modal.time_frf.plan_time_frf`), each named channel
+    looked up under its own key, so that an error names it."""
+    from modal.errors import ModalError
+    from modal.time_frf import plan_time_frf
+
+    cfg = scene.section("frf")
     for key, spec in [("excitation", cfg.get("excitation"))] + [
             (f"response[{i}]", r) for i, r in enumerate(cfg.get("response", []))]:
         if spec is None:
@@ -253,14 +289,13 @@ def check_frf(scene: Scene):
         except ModalError as exc:
             raise SceneError(f"{scene.source}: key 'frf.{key}' = {spec!r}: {exc}") from None
     try:
-        plan = plan_time_frf(record, _time_options(cfg), option=lambda name: f"frf.{name}")
+        return plan_time_frf(record, _time_options(cfg), option=lambda name: f"frf.{name}")
     except ModalError as exc:
         raise SceneError(f"{scene.source}: key 'frf': {exc}") from None
-    return record, plan
 
 
 def _frf_paths(scene: Scene) -> list:
-    """The files [frf] file names: one, or several (FRFs on one axis, or takes of one test)."""
+    """The files [frf] file names: one, or several (FRFs on one axis, takes of one test, or a roving hammer's)."""
     names = scene.section("frf")["file"]
     return [scene.folder / name for name in (names if isinstance(names, list) else [names])]
 
@@ -323,6 +358,10 @@ def stage_frf(scene: Scene) -> modal.FRF:
     make the synthetic FRF."""
     cfg = scene.section("frf")
     timed = scene.inputs["frf"]
+    if isinstance(timed, RovingFiles):  # each hit point estimated from its own file(s), joined as `modal fit` does
+        from modal.time_frf import estimate_roving
+
+        return estimate_roving(timed.records, timed.plans, list(timed.points), _time_options(cfg))
     if timed is not None:  # a time record, read and checked with the scene
         from modal.time_frf import estimate_time_frf
 
@@ -363,8 +402,15 @@ def stage_identify(scene: Scene, frf: modal.FRF) -> modal.IdentificationResult:
                                        where=f"{scene.source}: ")
         except ModalError as exc:
             raise SceneError(str(exc)) from None
-    return modal.identify(frf, cfg.get("method", "nls"), bands_hz=bands, driving_point=driving,
-                          min_prominence_db=cfg.get("min_prominence_db", 6.0), max_modes=cfg.get("max_modes"))
+    result = modal.identify(frf, cfg.get("method", "nls"), bands_hz=bands, driving_point=driving,
+                            min_prominence_db=cfg.get("min_prominence_db", 6.0), max_modes=cfg.get("max_modes"))
+    from modal.roving import RovingEstimate
+
+    if isinstance(frf, RovingEstimate):  # what the hit points' estimates shared, as `modal fit` says it
+        from dataclasses import replace
+
+        result = replace(result, settings={**result.settings, "roving_hammer": frf.join_note})
+    return result
 
 
 def stage_oma(scene: Scene) -> modal.IdentificationResult:

@@ -13,40 +13,18 @@ import pytest
 
 from modal.errors import FormatError
 from modal.fitting import FitOptions, fit_path
-from modal.io.timewrite import write_time
 from modal.roving import RovingEstimate, join_estimates
-from modal.synthetic_time import DigitalModes, impact_record, random_record
+from modal.synthetic_time import random_record
 from modal.time_frf import frf_from_time
 from support.paths import ROOT
 
-FS = 1024.0
-# three masses in a chain (kg, N/m) with Rayleigh damping: modes at 31.7, 65.5 and 85.8 Hz, ζ 1.5-2.9 %
-MASS = np.diag([1.0, 1.5, 1.2])
-STIFFNESS = np.array([[2e5, -1e5, 0], [-1e5, 2.5e5, -1.2e5], [0, -1.2e5, 1.6e5]])
-DAMPING = 1e-4 * STIFFNESS + 2.0 * MASS
-HITS_S = [0.5, 6.5, 12.5]
-
-
-def _plant(point: int, rate: float = FS) -> DigitalModes:
-    """Force at ``point`` (0-based), the accelerometer at point 0."""
-    return DigitalModes.from_matrices(MASS, DAMPING, STIFFNESS, rate, response_dofs=[0], reference_dof=point)
-
-
-def _hits(point, seed, hits=HITS_S, duration=18.0, rate=FS, response="1+Z", **options):
-    return impact_record(_plant(point, rate), hits, duration, seed=seed, names=[f"{point + 1}+Z", response],
-                         response_noise=3e-3, force_noise=1e-3, **options).record
-
-
-def _write(path, record):
-    write_time(replace(record, source=path.name), path)
-    return path
+from support.roving import hits as _hits, plant as _plant, roving_files, write as _write
 
 
 @pytest.fixture(scope="module")
 def roving(tmp_path_factory):
     """A roving-hammer test: the hammer at points 1, 2 and 3, the accelerometer at point 1, one file per point."""
-    folder = tmp_path_factory.mktemp("roving")
-    return [_write(folder / f"p{j + 1}.csv", _hits(j, seed=10 + j)) for j in range(3)]
+    return roving_files(tmp_path_factory.mktemp("roving"))
 
 
 def _options(**given):

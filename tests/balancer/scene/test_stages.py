@@ -207,6 +207,84 @@ def test_a_scene_takes_a_hammer_test_saved_one_file_per_part(tmp_path):
                     source="s.toml")
 
 
+def _roving_scene(tmp_path, files, **identify):
+    """A scene over roving-hammer files in ``tmp_path``, the rotor's M, k, c from the driving point's mode 1."""
+    from balancer.scene import parse_scene
+    from support.scenes import ROTOR
+
+    config = scene(frf={"file": [f.name for f in files], "impact": True}, identify={"method": "nls", **identify},
+                   rotor={**ROTOR, "mass_includes_balls": False}, adb=ADB, outputs={"tables": ["rotor"]})
+    return parse_scene(config, source=str(tmp_path / "s.toml"), folder=tmp_path)
+
+
+def test_a_scene_takes_a_roving_hammer_test_as_modal_fit_does(tmp_path):
+    """[frf] file = [p1, p2, p3], one file per hit point (the accelerometer at point 1): each point estimated from
+    its own file and the FRFs joined, as `modal fit p1 p2 p3 --impact` does; k, c, M come from the driving point
+    (hammer and accelerometer both at point 1), the one channel that has them."""
+    import numpy as np
+    import scipy.linalg
+
+    from modal.errors import SceneError
+    from modal.fitting import FitOptions
+    from modal.roving import RovingEstimate
+    from modal.time_frf import frf_from_time
+    from support.roving import DAMPING, MASS, STIFFNESS, roving_files
+
+    files = roving_files(tmp_path)
+    run = run_scene(_roving_scene(tmp_path, files))
+    frf = run.results["frf"]
+    expected, *_ = frf_from_time(files, FitOptions(impact=True).namespace())
+    assert isinstance(frf, RovingEstimate) and frf.reference_points == ("1+Z", "2+Z", "3+Z")
+    np.testing.assert_array_equal(frf.response, expected.response)
+    np.testing.assert_array_equal(frf.noise_std, expected.noise_std)
+    identified = run.results["identify"]
+    assert identified.settings["roving_hammer"] == expected.join_note
+    assert list(identified[0].driving_point) == [True, False, False]
+    # the truth at point 1: mode 1's mass-normalised shape φ gives m = 1/φ₁², k = ω² m, c = φᵀCφ m
+    eigenvalues, shapes = scipy.linalg.eigh(STIFFNESS, MASS)
+    shape = shapes[:, 0]
+    mass = 1.0 / shape[0] ** 2
+    truth = {"M": mass, "k": eigenvalues[0] * mass, "c": shape @ DAMPING @ shape * mass}
+    rotor = run.results["rotor"]
+    for name, true in truth.items():
+        value, std = getattr(rotor.params, name), getattr(rotor.std, name)
+        # the fit's one-sigma errors: 4 of them leave a chance of 6e-5 per value
+        assert 0 < std < 0.05 * true and abs(value - true) <= 4 * std, (name, value, true, std)
+    # the other channels (the hammer at points 2 and 3) give no k, c, M: [identify] channel picks one
+    with pytest.raises(SceneError, match=r"key 'rotor\.M' = 'identified:mode1\.mass' is not defined for that "
+                                         r"channel"):
+        run_scene(_roving_scene(tmp_path, files, channel=2))
+
+
+def test_a_scene_refuses_files_that_are_not_one_roving_hammer_test(tmp_path):
+    """Files whose hammer moved but whose accelerometer moved too (or whose rate differs) are no roving-hammer
+    test: refused when the scene is read, in one line naming the scene file, the key and the file, as
+    `modal fit` refuses them."""
+    import subprocess
+    import sys
+
+    from balancer.scene import parse_scene
+    from modal.errors import SceneError
+    from support.roving import hits, roving_files, write
+
+    first = roving_files(tmp_path)[0]
+    moved = write(tmp_path / "moved.csv", hits(1, seed=3, response="2+Z"))
+    (tmp_path / "s.toml").write_text(f"""[frf]\nfile = ["{first.name}", "{moved.name}"]\nimpact = true\n"""
+                                     """[outputs]\ntables = ["identify"]\n""")
+    out = subprocess.run([sys.executable, "-m", "balancer", "run", str(tmp_path / "s.toml"), "--out",
+                          str(tmp_path / "o.h5")], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 1 and out.stderr.count("\n") == 1, out.stderr
+    assert out.stderr.startswith(f"error: {tmp_path / 's.toml'}: key 'frf.file' = ['p1.csv', 'moved.csv']: "
+                                 f"{moved}: response channel 2 (names) is '2+Z' where {first} has '1+Z'; expected "
+                                 "the same accelerometers"), out.stderr
+    assert not (tmp_path / "o.h5").exists()
+    faster = write(tmp_path / "fast.csv", hits(1, seed=3, rate=2048.0))
+    with pytest.raises(SceneError, match=r"^s\.toml: key 'frf\.file' = .*fast\.csv: sample rate 2048 Hz where "
+                                         r".*p1\.csv has 1024 Hz; expected one rate"):
+        parse_scene(scene(frf={"file": [first.name, faster.name], "impact": True}, outputs={"tables": ["frf"]}),
+                    source="s.toml", folder=tmp_path)
+
+
 def test_a_scene_reads_frf_files_on_one_axis_as_one_frf(tmp_path):
     """[frf] file = [...] of FRF files: their channels on one frequency axis, as `modal fit a b` reads them."""
     import numpy as np
