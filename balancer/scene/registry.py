@@ -133,6 +133,9 @@ class Stage:
         ``"module:function"``: ``function(scene) -> value`` called when the scene is checked
         (when it has the ``needs`` sections): checks beyond the rules, and reads what only
         reading can check (the balancing readings), once; the value is ``scene.inputs[name]``.
+    archive_whole : bool
+        Whether the result read back from an archive is all a later stage computes from. When not (an FRF's noise
+        model and record influences are not archived), the stage runs again whenever a stage that takes it does.
     figures : str or None
         ``"module:function"``: ``function(results) -> [(name, Figure), ...]``.
     plot_inputs : tuple of str
@@ -155,6 +158,7 @@ class Stage:
     depends_when: tuple[tuple[str, tuple[str, ...]], ...] = ()
     files: tuple[str, ...] = ()
     prepare: str | None = None
+    archive_whole: bool = True
     figures: str | None = None
     plot_inputs: tuple[str, ...] = ()
     plot_modules: tuple[str, ...] = ()
@@ -176,6 +180,7 @@ _SUMMARY = "balancer.scene.summary"
 REGISTRY: dict[str, Stage] = {stage.name: stage for stage in (
     Stage(
         "frf", run=f"{_STAGES}:stage_frf", needs=("frf",), files=("frf.file",), prepare=f"{_STAGES}:check_frf",
+        archive_whole=False,  # the archive holds the FRF and its noise, not its noise model or record influences
         config={"frf": {
             "file": FILES, "kind": _KINDS,
             # the read options of `python -m modal fit`, under the same names

@@ -114,6 +114,11 @@ def plan(scene: Scene, earlier: h5py.File | None = None) -> tuple[dict[str, str]
     for stage in needed:
         same = earlier is not None and stage in earlier and earlier[stage].attrs.get("inputs_hash") == hashes[stage]
         status[stage] = "reused" if same else "ran"
+    for stage in reversed(list(needed)):  # a stage's inputs come before it: dependents first
+        if status[stage] == "ran":
+            for dep in needed[stage]:
+                if status[dep] == "reused" and not REGISTRY[dep].archive_whole:
+                    status[dep] = "ran"  # what the archive holds of it is not all this stage computes from
     return status, hashes
 
 
