@@ -64,6 +64,9 @@ LOW_RATE_HZ = 20.0
 #: longer than this at the rate a file states are no hits at that rate, the rate is off by its unit (a rate in
 #: kHz written as Hz makes a 2 ms hit last 2 s), s
 MAX_HIT_DURATION_S = 0.1
+#: force pulses shorter than this (s) at the rate a time column in ms or µs gives are no hammer hits either (a steel
+#: tip's 0.1 ms, with a margin of 5): the column holds seconds (a 1 ms hit read from 'time [ms]' lasts 1 µs)
+MIN_HIT_DURATION_S = 2e-5
 
 
 @dataclass(frozen=True)
@@ -231,18 +234,20 @@ def _check_samples(values: np.ndarray, src: str, where: str) -> None:
         raise FormatError(f"{src}: {where}, {at}: {what}; expected finite samples (|value| < {LARGEST_SAMPLE:g})")
 
 
-def _check(signals: np.ndarray, rate: float, src: str, quantities=(), field: str = "sample rate") -> None:
+def _check(signals: np.ndarray, rate: float, src: str, quantities=(), field: str = "sample rate",
+           time_unit: str = "") -> None:
     """Shape, rate and samples; and the rate against the hammer hits of the channels that say they measured force
-    (``field`` names where the rate came from)."""
+    (``field`` names where the rate came from; ``time_unit`` the unit a time column's name gave)."""
     if signals.ndim != 2 or signals.shape[1] < 2:
         raise FormatError(f"{src}: field 'signals' has shape {signals.shape}; expected (channels, samples >= 2)")
     if not (np.isfinite(rate) and rate > 0):
         raise FormatError(f"{src}: sample rate {rate!r}; expected a positive number of samples per second")
     _check_samples(signals, src, "field 'signals'")
-    _check_hit_durations(signals, rate, src, quantities, field)
+    _check_hit_durations(signals, rate, src, quantities, field, time_unit)
 
 
-def _check_hit_durations(signals: np.ndarray, rate: float, src: str, quantities, field: str) -> None:
+def _check_hit_durations(signals: np.ndarray, rate: float, src: str, quantities, field: str,
+                         time_unit: str = "") -> None:
     """Refuse a rate at which a force channel's hits (short pulses holding its energy) last longer than any hammer
     hit does (:data:`MAX_HIT_DURATION_S`): the rate, or the time axis it came from, is in the wrong unit."""
     timed = field.startswith("column") or field == "field 'time'"
@@ -260,6 +265,10 @@ def _check_hit_durations(signals: np.ndarray, rate: float, src: str, quantities,
             raise FormatError(f"{src}: {field} gives {rate:.6g} samples/s, at which the {train.count} hit(s) of force "
                               f"channel {k + 1} last {duration:.3g} s each; expected a rate in Hz at which hammer "
                               f"hits last at most {MAX_HIT_DURATION_S:g} s ({hint})")
+        if _TIME_FACTOR.get(time_unit.lower(), 1.0) < 1.0 and duration < MIN_HIT_DURATION_S:
+            raise FormatError(f"{src}: {field} gives {rate:.6g} samples/s, at which the {train.count} hit(s) of force "
+                              f"channel {k + 1} last {duration:.3g} s each; expected hammer hits of at least "
+                              f"{MIN_HIT_DURATION_S:g} s (does the time column hold seconds? name it 'time [s]')")
 
 
 def _time_column(header: str) -> str | None:
@@ -483,7 +492,7 @@ def _read_csv(path, src: str) -> TimeRecord:
         level = None if scale is None else scale[j - 1]
         scales.append(None if level is None else level * _SI_FACTOR.get(_normalise_unit(unit) or "", 1.0))
     signals = np.array(signals)
-    _check(signals, rate, src, quantities, f"column {header[0]!r}")
+    _check(signals, rate, src, quantities, f"column {header[0]!r}", time_unit or "")
     if not time_unit:
         _warn_low_rate(rate, src, header[0], time_axis=True)
     declared = tuple(scales) if any(v is not None for v in scales) else None

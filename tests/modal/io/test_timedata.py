@@ -389,6 +389,28 @@ def test_a_rate_in_khz_is_refused_where_the_hammer_hits_contradict_it(tmp_path, 
             assert read_time(path).sample_rate_hz == pytest.approx(FS, rel=1e-9)
 
 
+def test_a_time_column_named_in_ms_that_holds_seconds_is_refused(tmp_path):
+    # the shipped hammer record with its header edited to 'time [ms]' (the column holds seconds): read at
+    # 1.024 MHz, its 2 ms hits lasted 2 µs and every one was rejected as a "double hit"; no hammer hit is shorter
+    # than a steel tip's 0.1 ms, so the column's unit is refused, with the way out
+    from support.paths import SYNTHETIC
+
+    lines = (SYNTHETIC / "hammer.csv").read_text().splitlines()
+    path = tmp_path / "ms.csv"
+    path.write_text("\n".join([lines[0].replace("time [s]", "time [ms]"), *lines[1:]]) + "\n")
+    message = assert_refused(path, "column 'time [ms]' gives 1.024e+06 samples/s", "8 hit(s) of force channel 1",
+                             "expected hammer hits of at least 2e-05 s", "name it 'time [s]'")
+    assert float(message.split(" last ")[1].split(" s ")[0]) < 1e-5, message
+    # the column named as it is reads without a word; a column in ms that holds ms, too
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert read_time(SYNTHETIC / "hammer.csv").sample_rate_hz == pytest.approx(1024.0)
+        rows = [line.split(",") for line in lines[1:]]
+        path.write_text("\n".join([lines[0].replace("time [s]", "time [ms]")]
+                                   + [",".join([repr(1000 * float(t)), *rest]) for t, *rest in rows]) + "\n")
+        assert read_time(path).sample_rate_hz == pytest.approx(1024.0)
+
+
 def test_a_mat_rate_and_time_vector_that_disagree_are_refused(tmp_path):
     from scipy.io import savemat
 
