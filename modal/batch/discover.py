@@ -11,6 +11,7 @@ from __future__ import annotations
 import glob
 import hashlib
 import os
+import re
 import warnings
 from collections.abc import Iterable, Sequence
 from pathlib import Path
@@ -64,6 +65,23 @@ def _walk(folder: Path, follow: bool, links_out: list[str], roots: Sequence[Path
                 yield path
 
 
+#: UFF extensions, and the opening of a dataset 58 or 58b (a function: FRFs and time records alike)
+_UFF_EXTENSIONS = (".uff", ".unv", ".58")
+_DATASET_58 = re.compile(rb"(?:^|\n)    -1\r?\n[ \t]*58b?[ \t\r\n]")
+
+
+def _holds_no_measurement(path: Path) -> bool:
+    """A UFF file found in a folder that opens no dataset 58 (geometry, trace lines, results beside the
+    measurements): nothing to fit. An unreadable file is taken (the batch reports why it fails)."""
+    if path.suffix.lower() not in _UFF_EXTENSIONS:
+        return False
+    try:
+        data = path.read_bytes()
+    except OSError:
+        return False
+    return b"    -1" in data and _DATASET_58.search(data) is None
+
+
 def _glob_root(pattern: str) -> Path:
     """The folder of a glob pattern: its components before the first one with a wildcard."""
     parts = Path(pattern).parts
@@ -113,10 +131,13 @@ def find_files(inputs: str | os.PathLike | Sequence[str | os.PathLike],
     roots = [f.resolve() for f in folders] + [_glob_root(p).resolve() for p in patterns]
     found: dict[Path, str] = {}
     links_out: list[str] = []
+    no_measurement: list[str] = []
     for item in items:
         path = Path(item)
         if path.is_dir():
             candidates = list(_walk(path, follow_symlinks, links_out, roots))
+            no_measurement += [os.fspath(c) for c in candidates if _holds_no_measurement(c)]
+            candidates = [c for c in candidates if os.fspath(c) not in no_measurement]
         elif path.is_file():
             candidates = [path]  # named on its own: taken as named
         elif os.fspath(item) in patterns:
@@ -136,6 +157,11 @@ def find_files(inputs: str | os.PathLike | Sequence[str | os.PathLike],
             if any(real == s or s in real.parents for s in skip):
                 continue
             found.setdefault(real, os.fspath(candidate))
+    if no_measurement:
+        shown = ", ".join(sorted(no_measurement)[:3]) + (f" and {len(no_measurement) - 3} more"
+                                                          if len(no_measurement) > 3 else "")
+        warnings.warn(f"{len(no_measurement)} UFF file(s) in the folders hold no dataset 58 (no FRF or time record: "
+                      f"geometry or results) and were left out: {shown}", ModalWarning, stacklevel=2)
     if links_out:
         shown = ", ".join(sorted(links_out)[:3]) + (f" and {len(links_out) - 3} more" if len(links_out) > 3 else "")
         warnings.warn(f"{len(links_out)} symbolic link(s) lead outside the folders given and were not followed: "

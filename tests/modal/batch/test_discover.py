@@ -108,3 +108,25 @@ def test_a_failure_line_names_the_file_once(tmp_path, dask_cluster):
     line, = [ln for ln in done.stderr.splitlines() if ln.startswith("failed:")]
     assert line.startswith(f"failed: {broken}: ") and line.count(str(broken)) == 1, line
     assert os.path.basename(broken) in line
+
+
+def test_a_geometry_uff_beside_the_measurements_is_left_out_with_a_word(tmp_path):
+    """data/synthetic holds the plate's FRFs and its geometry (datasets 15 and 82) side by side, as a lab folder
+    does: `modal batch` on the folder failed on the geometry file ("no dataset 58") and exited 1. A UFF file found
+    in a folder that opens no dataset 58 is left out, named in one warning; a file named on its own is taken as
+    named (and fails, saying why); a damaged UFF that opens one is taken."""
+    import shutil
+    import warnings
+
+    from support.paths import SYNTHETIC
+
+    for name in ("plate_frf.uff", "plate_geometry.uff"):
+        shutil.copy(SYNTHETIC / name, tmp_path / name)
+    (tmp_path / "cut.uff").write_bytes((SYNTHETIC / "plate_frf.uff").read_bytes()[:5000])
+    with pytest.warns(ModalWarning, match=r"1 UFF file\(s\) in the folders hold no dataset 58 .* left out: "
+                                          r".*plate_geometry\.uff$"):
+        found = find_files(tmp_path)
+    assert names(found) == ["cut.uff", "plate_frf.uff"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert names(find_files(tmp_path / "plate_geometry.uff")) == ["plate_geometry.uff"]
