@@ -70,16 +70,25 @@ _UFF_EXTENSIONS = (".uff", ".unv", ".58")
 _DATASET_58 = re.compile(rb"(?:^|\n)    -1\r?\n[ \t]*58b?[ \t\r\n]")
 
 
-def _holds_no_measurement(path: Path) -> bool:
+def _holds_no_measurement(path: Path, chunk: int = 1 << 20) -> bool:
     """A UFF file found in a folder that opens no dataset 58 (geometry, trace lines, results beside the
-    measurements): nothing to fit. An unreadable file is taken (the batch reports why it fails)."""
+    measurements): nothing to fit. An unreadable file is taken (the batch reports why it fails). Read in pieces
+    up to the first dataset 58: a measurement file opens one near its start, and only files without one are
+    read whole."""
     if path.suffix.lower() not in _UFF_EXTENSIONS:
         return False
+    tail, delimited = b"", False
     try:
-        data = path.read_bytes()
+        with open(path, "rb") as fh:
+            while block := fh.read(chunk):
+                data = tail + block
+                if _DATASET_58.search(data):
+                    return False
+                delimited = delimited or b"    -1" in data
+                tail = data[-16:]  # a dataset's opening split between two pieces
     except OSError:
         return False
-    return b"    -1" in data and _DATASET_58.search(data) is None
+    return delimited
 
 
 def _glob_root(pattern: str) -> Path:

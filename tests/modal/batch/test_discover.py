@@ -127,6 +127,11 @@ def test_a_geometry_uff_beside_the_measurements_is_left_out_with_a_word(tmp_path
                                           r".*plate_geometry\.uff$"):
         found = find_files(tmp_path)
     assert names(found) == ["cut.uff", "plate_frf.uff"]
+    # the files are read in pieces up to their first dataset 58: an opening split between two pieces still counts
+    from modal.batch.discover import _holds_no_measurement
+
+    assert [_holds_no_measurement(tmp_path / n, chunk=7) for n in ("plate_frf.uff", "plate_geometry.uff")] == \
+        [False, True]
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         assert names(find_files(tmp_path / "plate_geometry.uff")) == ["plate_geometry.uff"]
