@@ -82,7 +82,7 @@ class CorrectionSpread:
 
 
 def correction_spread(initial, trial_runs, trial_unbalance_kg_m, radius_m, reading_noise: float, weights=None,
-                      si_units: str = "m", seed: int = 0) -> CorrectionSpread:
+                      si_units: str = "m", seed: int = 0, draws=None) -> CorrectionSpread:
     """The correction's scatter and the vibration it leaves under ``reading_noise`` (module notes).
 
     Parameters
@@ -95,10 +95,14 @@ def correction_spread(initial, trial_runs, trial_unbalance_kg_m, radius_m, readi
         Relative standard deviation of a reading.
     weights : array_like, optional
         Per-reading weights of the least-squares correction.
+    draws : tuple, optional
+        :func:`redrawn_jobs` of the same job, noise and seed, when already made.
     """
     v0 = np.asarray(initial, dtype=complex)
     alpha = (np.asarray(trial_runs, dtype=complex) - v0).T / np.asarray(trial_unbalance_kg_m, dtype=complex)
-    _, _, u_b, _ = redrawn_jobs(v0, trial_runs, trial_unbalance_kg_m, reading_noise, weights, seed)
+    if draws is None:
+        draws = redrawn_jobs(v0, trial_runs, trial_unbalance_kg_m, reading_noise, weights, seed)
+    u_b = draws[2]
     centre = np.mean(u_b, axis=0)
     angle = np.rad2deg(np.angle(u_b / np.where(centre != 0, centre, 1.0)))
     left = np.max(np.abs(v0[None, :] + u_b @ alpha.T), axis=1)  # on the machine the readings describe

@@ -36,6 +36,8 @@ check run (the correction itself taken as one more trial: a rank-one, Broyden, u
 """
 from __future__ import annotations
 
+import copy
+
 from dataclasses import dataclass
 
 import numpy as np
@@ -148,15 +150,19 @@ def check_reading_noise(reading_noise) -> float:
 
 
 def discrepancy_limit(initial, trial_runs, trial_unbalance_kg_m, reading_noise: float, weights=None,
-                      seed: int = 0) -> float:
+                      seed: int = 0, draws=None) -> float:
     """The 99th percentile of the check run's discrepancy with the correction mounted as computed (module notes).
 
     Least-squares corrections are drawn whatever the job's method (min-max's differ from them by far less than
-    the reading errors move either).
+    the reading errors move either). ``draws``: :func:`~balancer.influence.bootstrap.redrawn_jobs` of the same job,
+    noise and seed, when already made (its generator is copied, not advanced).
     """
     v0 = np.asarray(initial, dtype=complex)
     alpha = (np.asarray(trial_runs, dtype=complex) - v0).T / np.asarray(trial_unbalance_kg_m, dtype=complex)
-    v0_b, alpha_b, u_b, rng = redrawn_jobs(v0, trial_runs, trial_unbalance_kg_m, reading_noise, weights, seed)
+    if draws is None:
+        draws = redrawn_jobs(v0, trial_runs, trial_unbalance_kg_m, reading_noise, weights, seed)
+    v0_b, alpha_b, u_b, rng = draws
+    rng = copy.deepcopy(rng)
     predicted_b = v0_b + np.einsum("bij,bj->bi", alpha_b, u_b)
     after_b = redraw(v0 + np.einsum("ij,bj->bi", alpha, u_b), reading_noise, rng, per_draw=True)
     change = np.linalg.norm(predicted_b - v0_b, axis=1)
@@ -178,7 +184,7 @@ def _causes(initial: np.ndarray, trial_runs: np.ndarray, trials: np.ndarray, alp
 
 def check_run(alpha, initial, trial_runs, trial_unbalance_kg_m, correction_kg_m, after, *, method: str = "least_squares",
               weights=None, reading_noise: float = DEFAULT_READING_NOISE, si_units: str = "m",
-              field: str = "after") -> CheckRun:
+              field: str = "after", draws=None) -> CheckRun:
     """Set a check run against the prediction, name a mounting mistake that explains it, and give the trim.
 
     Parameters
@@ -200,6 +206,9 @@ def check_run(alpha, initial, trial_runs, trial_unbalance_kg_m, correction_kg_m,
         The readings' SI unit, for the archive.
     field : str
         Name used in messages.
+    draws : tuple, optional
+        :func:`~balancer.influence.bootstrap.redrawn_jobs` of this job at ``reading_noise`` (seed 0), when the
+        caller has them (:func:`~balancer.influence.balance` shares them with the correction's spread).
 
     Returns
     -------
@@ -222,7 +231,7 @@ def check_run(alpha, initial, trial_runs, trial_unbalance_kg_m, correction_kg_m,
     predicted = v0 + a @ u
     scale = float(np.linalg.norm(predicted - v0))
     discrepancy = float(np.linalg.norm(measured - predicted)) / scale if scale > 0 else 0.0
-    limit = discrepancy_limit(v0, runs, trials, float(reading_noise), weights)
+    limit = discrepancy_limit(v0, runs, trials, float(reading_noise), weights, draws=draws)
     agrees = discrepancy <= limit
     cause, plane, others = "", 0, ()
     if not agrees:

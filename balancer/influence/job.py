@@ -39,7 +39,7 @@ import numpy as np
 
 from modal.errors import FormatError, ParameterError
 
-from .bootstrap import CorrectionSpread, correction_spread
+from .bootstrap import CorrectionSpread, correction_spread, redrawn_jobs
 from .checkrun import DEFAULT_READING_NOISE, CheckRun, check_reading_noise, check_run
 from .coefficients import correction, influence_matrix
 from .iso import IsoCheck, iso_check
@@ -378,12 +378,14 @@ def balance(job: BalanceJob, method: str = "least_squares", *, weights=None, max
         split = np.array([float(f"{v:.12g}") for v in (np.round(split / step) * step).ravel()]).reshape(split.shape)
     left = job.after if job.after.size else result.residual
     check = None
+    # one bootstrap of the readings serves the correction's spread and the check run's limit
+    draws = redrawn_jobs(job.initial, job.trial_runs, job.trial_unbalance_kg_m, noise, weights)
     if job.after.size:
         check = check_run(alpha, job.initial, job.trial_runs, job.trial_unbalance_kg_m, result.unbalance_kg_m,
                           job.after, method=method, weights=weights, si_units=reading_unit(job.units).si_unit,
-                          reading_noise=noise)
+                          reading_noise=noise, draws=draws)
     spread = correction_spread(job.initial, job.trial_runs, job.trial_unbalance_kg_m, job.radius_m, noise,
-                               weights=weights, si_units=reading_unit(job.units).si_unit)
+                               weights=weights, si_units=reading_unit(job.units).si_unit, draws=draws)
     sensitivity = np.max(np.abs(alpha), axis=0)
     residual_unbalance = np.max(np.abs(left)) / sensitivity
     iso = None
