@@ -24,7 +24,7 @@ from typing import Sequence
 import numpy as np
 
 from .errors import IdentificationError, QualityWarning, ResolutionWarning, warn_caller
-from .flags import COMPLEX_PHASE_DEG, FLAG_TEXT, INFORMATIONAL, OVERLAP_LIMIT, REL_STD_LIMIT, RESOLUTION_FLAGS, overlap
+from .flags import COMPLEX_PHASE_DEG, FLAG_TEXT, OVERLAP_LIMIT, REL_STD_LIMIT, RESOLUTION_FLAGS, overlap, serious_flags
 from .results import ModeResult, ModeStd, correlation_of, physical_covariance, physical_parameters
 from .units import TWO_PI
 from .validate import channel_mask
@@ -242,7 +242,7 @@ def assemble_modes(estimates: Sequence[ModeEstimate], *, method: str, source: st
             quality=estimate.quality, window_damping_ratio=window_zeta,
             mode_shape=estimate.mode_shape, participation=estimate.participation, mpc=estimate.mpc,
             kcm_correlation=None if cov_kcm is None else correlation_of(cov_kcm[0] if single else cov_kcm)))
-        serious = set(flags_t) - INFORMATIONAL
+        serious = serious_flags(flags_t)
         if serious:
             category = ResolutionWarning if serious & RESOLUTION_FLAGS else QualityWarning
             reasons = "; ".join(f"{f}: {FLAG_TEXT[f]}{estimate.details.get(f, '')}" for f in sorted(serious))

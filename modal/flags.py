@@ -13,7 +13,7 @@ from .frf import line_spacing
 __all__ = ["FLAG_TEXT", "FLAG_ACTION", "CHI2_LIMIT", "RELATIVE_MISFIT", "REL_STD_LIMIT", "OVERLAP_LIMIT", "BIAS_LIMIT",
            "COMPLEX_PHASE_DEG", "MPC_LIMIT", "WEAK_FRACTION", "RIGID_BODY_RATIO", "HARMONIC_TOLERANCE",
            "HARMONIC_SIGMAS", "MIN_SHIFT_SIGMAS", "MAX_SCALE_ERROR", "GRID_FLAGS", "RESOLUTION_FLAGS", "RULE_FLAGS",
-           "INFORMATIONAL", "DRIVING_POINT_ONLY", "TRANSFER_ONLY", "lines_near_mode", "model_inadequate", "overlap",
+           "INFORMATIONAL", "serious_flags", "DRIVING_POINT_ONLY", "TRANSFER_ONLY", "lines_near_mode", "model_inadequate", "overlap",
            "channel_flags", "contradictions", "flags_markdown"]
 
 #: chi-square (residual variance over the noise variance) above which a model may be flagged model_inadequate
@@ -194,6 +194,14 @@ RULE_FLAGS = frozenset({"high_uncertainty", "close_modes", "driving_point_unknow
 #: is no longer raised (k, c, m only where the driving point is known or declared) but archives written
 #: before still carry it, and read back their modes as they were judged then.
 INFORMATIONAL = frozenset({"driving_point_unknown", "not_driving_point", "driving_point_assumed"})
+
+
+def serious_flags(flags) -> set[str]:
+    """The flags that say something is wrong: all but the :data:`INFORMATIONAL` ones (``flags`` an iterable of
+    names, or a table cell of names separated by spaces)."""
+    return set(flags.split() if isinstance(flags, str) else flags) - INFORMATIONAL
+
+
 #: Flags about a driving-point channel's constant (never on a transfer channel).
 DRIVING_POINT_ONLY = frozenset({"complex_mode", "non_positive_constant", "units_unknown"})
 #: Flags about a transfer channel (never on a driving-point channel).

@@ -83,9 +83,9 @@ def _as_results(result) -> list[IdentificationResult]:
 
 def _serious(mode) -> bool:
     """Whether a mode carries a flag a user should act on (not only driving-point bookkeeping)."""
-    from .flags import INFORMATIONAL
+    from .flags import serious_flags
 
-    return bool(set(mode.flags) - INFORMATIONAL)
+    return bool(serious_flags(mode.flags))
 
 
 def _model_name(result: IdentificationResult) -> str:

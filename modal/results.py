@@ -11,7 +11,7 @@ from typing import Any, Iterator
 
 import numpy as np
 
-from .flags import INFORMATIONAL, channel_flags
+from .flags import channel_flags, serious_flags
 from .units import TWO_PI
 
 __all__ = ["ModeStd", "ModeResult", "IdentificationResult", "physical_parameters", "physical_covariance", "correlation_of"]
@@ -144,7 +144,7 @@ class ModeResult:
     @property
     def ok(self) -> bool:
         """True when the estimate carries no flag other than informational ones."""
-        return not (set(self.flags) - INFORMATIONAL)
+        return not serious_flags(self.flags)
 
 
 @dataclass(frozen=True)

@@ -91,9 +91,9 @@ TIME_FRF_OPTIONS = ("excitation", "response", "impact", "estimator", "window", "
 
 # ---------------------------------------------------------------- references
 def _serious_flags(mode) -> list[str]:
-    from modal.flags import INFORMATIONAL
+    from modal.flags import serious_flags
 
-    return sorted(set(mode.flags) - INFORMATIONAL)
+    return sorted(serious_flags(mode.flags))
 
 
 def _test_section(scene: Scene) -> str:

@@ -12,7 +12,7 @@ from typing import Any
 
 from ..errors import ParameterError
 from ..fitting import FitOptions
-from ..flags import INFORMATIONAL
+from ..flags import serious_flags
 from .discover import file_sha256, find_files
 from .fitproc import DEFAULT_FILE_TIMEOUT_S
 from .lock import RunLock, lock_path
@@ -72,7 +72,7 @@ class BatchResult:
         out = []
         for o in self.outcomes:
             flagged = {(row["method"], row["mode"]) for row in o.rows
-                       if set(row["flags"].split()) - INFORMATIONAL}
+                       if serious_flags(row["flags"])}
             if o.status != "failed" and (o.warnings or flagged):
                 out.append({"file": o.file, "warnings": list(o.warnings), "flagged_modes": len(flagged)})
         return out

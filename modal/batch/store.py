@@ -81,12 +81,12 @@ def _file_cells(source: str, rows: list[list[str]], warnings: Sequence[str]) -> 
     """Each stored row (cells of :func:`table_text`) with the file's ``warnings`` (without the file's name, which
     the row's first column gives) and ``flagged_modes`` cells: the modes of the row's method with a flag that
     is not informational (on any of their channels)."""
-    from ..flags import INFORMATIONAL
+    from ..flags import serious_flags
 
     method, mode, flags = (_STORED.index(name) for name in ("method", "mode", "flags"))
     flagged: dict[str, set[str]] = {}
     for cells in rows:
-        if set(cells[flags].split()) - INFORMATIONAL:
+        if serious_flags(cells[flags]):
             flagged.setdefault(cells[method], set()).add(cells[mode])
     text = WARNING_SEPARATOR.join(w.removeprefix(f"{source}: ") for w in warnings)
     return [[*cells, text, str(len(flagged.get(cells[method], ())))] for cells in rows]

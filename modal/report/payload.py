@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..estimate.core import EstimatedFRF
-from ..flags import INFORMATIONAL
+from ..flags import serious_flags
 from ..frf import FRF
 from ..geometry import Geometry
 from ..shapes import ModeShapes, mean_phase_deviation_deg, mpc, normalise
@@ -165,7 +165,7 @@ def stabilisation_payload(frf: FRF | None, result) -> dict | None:
     out = {"method": result.method, "f": np.asarray(diagram.frequency_hz, float),
            "order": np.asarray(diagram.order, float), "cls": code.astype(float), "classes": list(STABILITY_CLASSES),
            "modes": [float(m.natural_frequency_hz) for m in result.modes],
-           "flagged": [bool(set(getattr(m, "flags", ())) - INFORMATIONAL)
+           "flagged": [bool(serious_flags(getattr(m, "flags", ())))
                        for m in result.modes]}
     if frf is not None:
         rms = np.sqrt(np.mean(np.abs(frf.channels) ** 2, axis=0))
