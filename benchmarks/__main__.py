@@ -10,7 +10,8 @@ against numpy's eigenvalues, the demo scene against the import floor, a 100 000-
 noisy FRF against a minute), identification against the Cramér–Rao bound over damping, noise
 and resolution (``bench_identify``), 1 and 1000 channels, the calibration of every
 method's standard errors (``bench_calibration``) and of the whole chain from time
-records (``bench_chain``), file reading
+records (``bench_chain``), FRF estimation from time records and side by side with pyFRF
+(``bench_estimate``, ``bench_pyfrf``), file reading
 (``bench_io``), the counterweight optimiser against brute-force grids
 (``bench_crank``), the ball-balancer stability map and simulations against plain
 ``solve_ivp`` (``bench_adb``), batches of files on Dask against one process
@@ -532,6 +533,9 @@ def main(argv: list[str] | None = None) -> int:
     if "estimate" in wanted and (HERE / "bench_estimate.py").is_file():
         sections.append(("FRFs from time data: estimate time and identification on estimates",
                          run_module("bench_estimate", ["--quick"] if args.quick else [])))
+    if "estimate" in wanted:
+        sections.append(("FRF estimation side by side with pyFRF: run time, error, lab mistakes",
+                         run_module("bench_pyfrf", ["--rounds", str(runs)])))
     if "influence" in wanted and (HERE / "bench_influence.py").is_file():
         sections.append(("Field balancing: influence-coefficient corrections", run_module("bench_influence", [])))
     if "io" in wanted:

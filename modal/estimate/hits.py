@@ -122,7 +122,16 @@ def _noise_floor(centred: np.ndarray) -> np.ndarray:
 def trigger_threshold(force: np.ndarray) -> float:
     """The default trigger level of a force record, in its unit: the larger of 5 % of the largest |force| and
     8 robust standard deviations of its noise (median absolute deviation / 0.6745)."""
-    noise = float(np.median(np.abs(force - np.median(force)))) / 0.6745
+    return _threshold(force, _centre_and_noise(force)[1])
+
+
+def _centre_and_noise(force: np.ndarray) -> tuple[float, float]:
+    """The force's median and its noise's robust standard deviation (median absolute deviation / 0.6745)."""
+    centre = float(np.median(force))
+    return centre, float(np.median(np.abs(force - centre))) / 0.6745
+
+
+def _threshold(force: np.ndarray, noise: float) -> float:
     return max(0.05 * float(np.max(np.abs(force))), 8.0 * noise)
 
 
@@ -155,13 +164,14 @@ def pulse_train(force, sample_rate_hz: float) -> PulseTrain:
     force = np.asarray(force, dtype=float)
     if force.size == 0 or not np.any(force):
         return PulseTrain(0, 0.0, 0.0)
-    above = np.abs(force) > trigger_threshold(force)
+    centre, noise = _centre_and_noise(force)
+    above = np.abs(force) > _threshold(force, noise)
     pulses = _pulses(above, max(2, int(round(0.0005 * float(sample_rate_hz)))))
     inside = np.zeros(force.size, bool)
     for first, last in pulses:
         inside[first:last + 1] = True
-    centred = force - np.median(force)
-    noise_variance = (float(np.median(np.abs(centred))) / 0.6745) ** 2
+    centred = force - centre
+    noise_variance = noise**2
     # energies above the noise's (the noise's expected energy taken off both), so that a noisy force
     # channel still shows its hits
     energy = float(np.sum(centred**2)) - noise_variance * force.size

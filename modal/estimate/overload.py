@@ -93,6 +93,8 @@ def _rail(x: np.ndarray, extreme: float, repeated_peaks: int | None = None) -> n
     """Samples on the rail at ``extreme`` when the channel shows a flat top there (or, with ``repeated_peaks``,
     reaches it in that many separate samples), else None."""
     on = x == extreme
+    if np.count_nonzero(on) < 2 and (repeated_peaks is None or repeated_peaks > 1):
+        return None  # one sample at the extreme: neither a flat top nor repeated peaks (most records end here)
     starts, stops = _runs(on)
     long = (stops - starts) >= 2
     # separate peaks on the rail, each counted (a run of one sample at a hit's peak), when there are enough
