@@ -521,6 +521,8 @@ def stage_rotor(scene: Scene, identify=None, drive=None, oma=None) -> RotorStage
     M = values["M"]
     if isinstance(rotor["M"], Reference) and rotor.get("mass_includes_balls", True):
         M -= adb["n"] * adb["m"]
+        sources[0] += (f"; M = {values['M']:.6g} kg identified less the {adb['n']} balls ({adb['n']} x {adb['m']:g} kg:"
+                       " mass_includes_balls)")
         if M <= 0:
             raise SceneError(f"{scene.source}: key 'rotor.M': identified mass {values['M']:.6g} kg minus the balls "
                              f"({adb['n']} x {adb['m']} kg) is not positive")

@@ -53,6 +53,10 @@ def test_reuse_and_exact_downstream_rerun(tmp_path):
     mode = first.results["identify"][0]
     assert (rotor.params.k, rotor.params.c) == (mode.stiffness_n_per_m, mode.damping_n_s_per_m)
     assert rotor.params.M == mode.mass_kg - 2 * 0.02
+    # the summary says the balls were taken off the identified mass (its value differs from the mode's m)
+    assert f"M = {mode.mass_kg:.6g} kg identified less the 2 balls" in rotor.sources[0]
+    config_without = {**config, "rotor": {**config["rotor"], "mass_includes_balls": False}}
+    assert "balls" not in run_scene(config_without, out=tmp_path / "w.h5").results["rotor"].sources[0]
     assert (rotor.params.m, rotor.params.n, rotor.params.R, rotor.params.D, rotor.params.e) == (0.02, 2, 0.05, 0.001, 5e-4)
     # the stage's stable interval is exactly what a direct call with those parameters gives
     direct = stable_speed_intervals(rotor.params, 3.0 * rotor.params.natural_frequency_rad_s, grid_points=400)
