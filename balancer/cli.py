@@ -80,7 +80,8 @@ def _main(argv: list[str] | None) -> int:
         return 1
     if args.json:
         doc = {"scene": args.scene, "stages": run.stages, "archive": run.archive_path, "plots": list(run.plot_paths),
-               "timings_s": run.timings_s, "results": {s: digest(s, r) for s, r in run.results.items()}}
+               "timings_s": run.timings_s, "warnings": {s: list(w) for s, w in run.warnings.items()},
+               "results": {s: digest(s, r) for s, r in run.results.items()}}
         json.dump(jsonable(doc), sys.stdout, indent=1, allow_nan=False)
         sys.stdout.write("\n")
     else:

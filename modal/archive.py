@@ -23,7 +23,7 @@ import importlib
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Sequence
 
 import h5py
 import numpy as np
@@ -32,7 +32,7 @@ from .errors import ArchiveError
 from .io.hdf5 import SCHEMA, SCHEMA_VERSION, check_schema, read_frf_group, write_frf_group, write_root_attrs
 
 __all__ = ["SCHEMA", "SCHEMA_VERSION", "Archive", "write_archive", "read_archive", "write_node", "read_node",
-           "units_of"]
+           "read_warnings", "units_of"]
 
 _ALLOWED_MODULES = ("modal.", "balancer.")
 _COMPRESS_BYTES = 16384  # gzip+shuffle only where it pays: arrays above 16 kB
@@ -277,7 +277,8 @@ def read_node(node) -> Any:
 
 
 def write_archive(path: str | os.PathLike, items: dict[str, Any], scene_text: str | None = None,
-                  inputs_hash: dict[str, str] | None = None, created: str | None = None) -> Path:
+                  inputs_hash: dict[str, str] | None = None, created: str | None = None,
+                  warnings: dict[str, Sequence[str]] | None = None) -> Path:
     """Write result objects to an HDF5 archive, crash-safely.
 
     Parameters
@@ -292,6 +293,9 @@ def write_archive(path: str | os.PathLike, items: dict[str, Any], scene_text: st
         Stage name → hash of its inputs, stored as ``@inputs_hash``.
     created : str, optional
         ISO 8601 creation time; default now (UTC, ``YYYY-MM-DDTHH:MM:SSZ``).
+    warnings : dict, optional
+        Item name → the warnings given while it was computed, stored as the item's ``@warnings`` (read back by
+        :func:`read_warnings`).
     """
     from .io._atomic import atomic_path
 
@@ -316,7 +320,17 @@ def write_archive(path: str | os.PathLike, items: dict[str, Any], scene_text: st
                 write_node(f, name, obj)
                 if name in hashes:
                     f[name].attrs["inputs_hash"] = hashes[name]
+                if warnings and warnings.get(name):
+                    f[name].attrs["warnings"] = np.array(list(warnings[name]), dtype=h5py.string_dtype())
     return path
+
+
+def read_warnings(node) -> tuple[str, ...]:
+    """The warnings archived with an item by :func:`write_archive` (none for an item written without)."""
+    said = node.attrs.get("warnings")
+    if said is None:
+        return ()
+    return tuple(v.decode() if isinstance(v, bytes) else str(v) for v in np.atleast_1d(said))
 
 
 def read_archive(path: str | os.PathLike) -> Archive:

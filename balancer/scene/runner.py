@@ -6,12 +6,13 @@ import hashlib
 import json
 import os
 import time
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable
 
 import modal
-from modal.errors import ArchiveError, ModalError, PlotError, SceneError
+from modal.errors import ArchiveError, ModalError, ModalWarning, PlotError, SceneError
 
 from .plotter import Plotter, plot_error
 from .registry import REGISTRY, STAGES, load, result_modules
@@ -45,6 +46,9 @@ class SceneRun:
         The readable summary printed by the command line.
     timings_s : dict
         Wall time of each stage that ran, s.
+    warnings : dict
+        Stage name → the warnings it gave (each once, in order; a reused stage's from the earlier archive), for
+        the stages that gave any. They are shown as they come too, and archived with the stage.
     """
 
     stages: dict[str, str]
@@ -54,6 +58,7 @@ class SceneRun:
     plot_paths: tuple[str, ...]
     summary: str
     timings_s: dict[str, float] = field(default_factory=dict)
+    warnings: dict[str, tuple[str, ...]] = field(default_factory=dict)
 
 
 def _canonical(value):
@@ -202,11 +207,14 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, p
         status, hashes = plan(scene, earlier)
         results: dict[str, Any] = {}
         timings: dict[str, float] = {}
+        given: dict[str, tuple[str, ...]] = {}
         for stage in STAGES:
             if status[stage] == "reused":
-                from modal.archive import read_node
+                from modal.archive import read_node, read_warnings
 
                 results[stage] = read_node(earlier[stage])
+                if read_warnings(earlier[stage]):
+                    given[stage] = read_warnings(earlier[stage])
     finally:
         if earlier is not None:
             earlier.close()
@@ -237,7 +245,9 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, p
             say(f"{stage}: running")
             t0 = time.perf_counter()
             kwargs = {dep: results[dep] for dep in scene.graph[stage] if dep in results}
-            results[stage] = load(REGISTRY[stage].run)(scene, **kwargs)
+            results[stage], said = _run_stage(stage, scene, kwargs)
+            if said:
+                given[stage] = said
             timings[stage] = time.perf_counter() - t0
             say(f"{stage}: done in {timings[stage]:.2f} s")
             if plotter is not None and plotter.started and pending:
@@ -248,7 +258,8 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, p
 
             archive_path.parent.mkdir(parents=True, exist_ok=True)  # checked above: exists, or is the default
             write_archive(archive_path, {s: results[s] for s in keep}, scene_text=scene.text or None,
-                          inputs_hash={s: hashes[s] for s in keep})
+                          inputs_hash={s: hashes[s] for s in keep},
+                          warnings={s: given[s] for s in keep if s in given})
         if plotted:
             folder.mkdir(parents=True, exist_ok=True)  # checked above
             mine = {}
@@ -270,9 +281,25 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, p
     from .summary import format_summary
 
     summary = format_summary(name, status, results, outputs.get("tables", []), timings,
-                             str(archive_path) if archive_path else None, plot_paths)
+                             str(archive_path) if archive_path else None, plot_paths, given)
     return SceneRun(status, results, hashes, str(archive_path) if archive_path else None, tuple(map(str, plot_paths)),
-                    summary, timings)
+                    summary, timings, given)
+
+
+def _run_stage(stage: str, scene: Scene, kwargs: dict) -> tuple[Any, tuple[str, ...]]:
+    """Run one stage; its result and the toolkit's warnings it gave (each once).
+
+    Every toolkit warning is kept, whatever the filters in force show; they are then shown as those filters say
+    (an "error" filter raises, after the stage). Other warnings pass through as they would without the runner."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", ModalWarning)
+        result = load(REGISTRY[stage].run)(scene, **kwargs)
+    shown = set()
+    for w in caught:
+        if (w.category, str(w.message)) not in shown:
+            shown.add((w.category, str(w.message)))
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    return result, tuple(dict.fromkeys(str(w.message) for w in caught if issubclass(w.category, ModalWarning)))
 
 
 def _default_plots(scene: Scene, plots_dir, say: Callable[[str], None]) -> list[str]:

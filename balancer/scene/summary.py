@@ -222,15 +222,22 @@ def balance_rows(result, d: dict) -> list[str]:
     return lines
 
 
-def format_summary(name, status, results, tables, timings, archive_path, plot_paths) -> str:
-    """Stage statuses, the requested tables, and where the outputs are."""
+def format_summary(name, status, results, tables, timings, archive_path, plot_paths, warnings=None) -> str:
+    """Stage statuses (with the number of warnings each gave), the requested tables, the warnings, and where the
+    outputs are."""
+    warnings = warnings or {}
     lines = [f"scene: {name}", "", "stages:"]
     for stage in STAGES:
         extra = f" ({timings[stage]:.2f} s)" if stage in timings else ""
+        said = len(warnings.get(stage, ()))
+        extra += f", {said} warning{'s' if said > 1 else ''}" if said else ""
         lines.append(f"  {stage:<14} {status[stage]}{extra}")
     for stage in tables:
         if stage in results:
             lines += ["", f"[{stage}]"] + _table(stage, results[stage])
+    if warnings:
+        # the numbers above stand on data these warnings question: they are repeated here, after the tables
+        lines += ["", "warnings:"] + [f"  [{stage}] {text}" for stage in STAGES for text in warnings.get(stage, ())]
     if archive_path:
         lines += ["", f"archive: {archive_path}"]
     if plot_paths:

@@ -26,6 +26,7 @@ def test_cli_json_and_exit_codes(tmp_path):
     # stdout is a pipe (block-buffered) and `run` leaves by os._exit after flushing: the whole document arrives
     doc = json.loads(out.stdout)
     assert doc["stages"] == {s: ("ran" if s == "compressor" else "skipped") for s in STAGES}
+    assert doc["warnings"] == {}  # the stages' warnings, by stage: this compressor gives none
     # seed 004: 285.5 N at the optimum (crank_drive.md)
     assert abs(doc["results"]["compressor"]["max_force_n"] - 285.5) < 0.05
     path.write_text("[outputs]\ntables = ['compressor']\n")

@@ -7,6 +7,7 @@ import signal
 import time
 
 import numpy as np
+import pytest
 
 from balancer import read_archive, run_scene
 from balancer.adb import stable_speed_intervals
@@ -219,3 +220,39 @@ def test_a_missing_output_folder_is_reported_before_any_work(tmp_path, monkeypat
     run = run_scene({**config, "outputs": {"plots": ["identify"], "archive": True}}, plots_dir=tmp_path / "plots")
     assert (tmp_path / "plots" / "identify_fit.png").exists() and run.archive_path == os.path.join("out", "scene.h5")
     assert (tmp_path / "out" / "scene.h5").is_file()
+
+
+def test_a_stages_warnings_are_kept_in_the_run_the_summary_and_the_archive(tmp_path):
+    """A rotor whose given mass (1.5 kg) with the test's stiffness puts its natural frequency 18 % below the
+    measured mode warns (tests/balancer/scene/test_stages.py). The warning is shown as it comes and kept: in the
+    run's ``warnings`` by stage, counted on the stage's line of the summary and repeated after the tables (the
+    numbers above stand on it), archived with the stage and given back when the stage is reused."""
+    import warnings
+
+    from modal.archive import read_warnings
+    from modal.errors import ModalWarning
+
+    import h5py
+
+    config = scene(frf=SYNTH_FRF, rotor={**ROTOR, "M": 1.5}, adb=ADB, outputs={"tables": ["rotor"], "archive": True})
+    with pytest.warns(ModalWarning, match="key 'rotor.M': the rotor's natural frequency"):
+        first = run_scene(config, out=tmp_path / "a.h5")
+    assert set(first.warnings) == {"rotor"} and len(first.warnings["rotor"]) == 1
+    said = first.warnings["rotor"][0]
+    assert "key 'rotor.M': the rotor's natural frequency" in said
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # what a script that silences warnings shows; the record keeps them
+        assert run_scene(config, out=tmp_path / "quiet.h5").warnings == first.warnings
+    lines = first.summary.splitlines()
+    assert any(line.split()[:2] == ["rotor", "ran"] and line.endswith(", 1 warning") for line in lines)
+    assert lines[lines.index("warnings:") + 1] == f"  [rotor] {said}"
+    with h5py.File(tmp_path / "a.h5", "r") as f:
+        assert read_warnings(f["rotor"]) == (said,) and read_warnings(f["identify"]) == ()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # reused: not computed again, so not warned again
+        second = run_scene(config, out=tmp_path / "b.h5", archive=tmp_path / "a.h5")
+    assert second.stages["rotor"] == "reused" and second.warnings == {"rotor": (said,)}
+    with h5py.File(tmp_path / "b.h5", "r") as f:
+        assert read_warnings(f["rotor"]) == (said,)
+    clean = run_scene(scene(frf=SYNTH_FRF, rotor={**ROTOR, "M": 1.0}, adb=ADB, outputs={"tables": ["rotor"]}))
+    assert clean.warnings == {} and "warnings:" not in clean.summary.splitlines()
