@@ -17,7 +17,7 @@ import numpy as np
 
 from .cli_time import add_time_options, save_time_plots
 from .time_frf import frf_from_time
-from .errors import ModalError
+from .errors import ModalError, kept_warnings
 from .frf import FRF_KINDS
 from .report import jsonable
 
@@ -129,8 +129,9 @@ def _showwarning(message, category, filename, lineno, file=None, line=None):
 def _fit(args) -> int:
     from .fitting import FitOptions, fit_path
 
-    fitted = fit_path(args.path if len(args.path) > 1 else args.path[0], FitOptions.from_args(args),
-                      report_estimate=_report_estimate, report=_note)
+    with kept_warnings() as said:  # shown as they come, and kept for the JSON document and the archive
+        fitted = fit_path(args.path if len(args.path) > 1 else args.path[0], FitOptions.from_args(args),
+                          report_estimate=_report_estimate, report=_note)
     frf, results = fitted.frf, list(fitted.results)
     time_data = None if fitted.time_data is None else (frf, *fitted.time_data)
     more = len(args.path) - 1
@@ -148,7 +149,8 @@ def _fit(args) -> int:
         rows = [dict(row, channel=row["channel"] + 1) for result in results for row in result.rows()]
         doc = {"file": args.path[0] if len(args.path) == 1 else list(args.path), "kind": frf.kind, "n_channels": frf.n_channels,
                "methods": methods, "driving_point": _driving_point_doc(results, args.driving_point),
-               "modal_constant_units": result_units(frf.kind, results[0].settings)["modal_constant"], "modes": rows}
+               "modal_constant_units": result_units(frf.kind, results[0].settings)["modal_constant"],
+               "warnings": said, "modes": rows}
         json.dump(jsonable(doc), sys.stdout, indent=1, allow_nan=False)
         sys.stdout.write("\n")
     else:
@@ -204,7 +206,7 @@ def _fit(args) -> int:
         items = {"frf": frf, **{f"identify_{r.method}": r for r in results}, "source_files": list(args.path)}
         if geometry is not None:
             items["geometry"] = geometry
-        write_archive(args.archive, items)
+        write_archive(args.archive, items, warnings={name: said for name in items if name.startswith("identify_")})
         print(f"archive: {args.archive}", file=sys.stderr)
     return 0
 

@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import sys
 import warnings
+from contextlib import contextmanager
+from typing import Iterator
 
 __all__ = [
     "ModalError",
@@ -23,6 +25,7 @@ __all__ = [
     "QualityWarning",
     "warn",
     "warn_caller",
+    "kept_warnings",
 ]
 
 
@@ -82,3 +85,26 @@ def warn_caller(message: str, category: type[Warning] = ModalWarning) -> None:
     while frame is not None and frame.f_globals.get("__name__", "").partition(".")[0] == "modal":
         frame, level = frame.f_back, level + 1
     warnings.warn(message, category, stacklevel=level)
+
+
+@contextmanager
+def kept_warnings() -> Iterator[list[str]]:
+    """Keep the toolkit's warnings given inside the block: the list yielded holds their texts (each once, in
+    order) when the block ends, whatever the filters in force show.
+
+    The warnings are then shown as those filters say (an "error" filter raises, at the end of the block); other
+    warnings pass through as they would without it. For results that must carry what their data was warned of
+    (archives, JSON documents) as well as show it.
+    """
+    kept: list[str] = []
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", ModalWarning)
+            yield kept
+    finally:  # shown even when the block fails: they may say why
+        kept.extend(dict.fromkeys(str(w.message) for w in caught if issubclass(w.category, ModalWarning)))
+        shown = set()
+        for w in caught:
+            if (w.category, str(w.message)) not in shown:
+                shown.add((w.category, str(w.message)))
+                warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)

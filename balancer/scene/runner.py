@@ -6,13 +6,12 @@ import hashlib
 import json
 import os
 import time
-import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable
 
 import modal
-from modal.errors import ArchiveError, ModalError, ModalWarning, PlotError, SceneError
+from modal.errors import ArchiveError, ModalError, PlotError, SceneError, kept_warnings
 
 from .plotter import Plotter, plot_error
 from .registry import REGISTRY, STAGES, load, result_modules
@@ -287,19 +286,10 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, p
 
 
 def _run_stage(stage: str, scene: Scene, kwargs: dict) -> tuple[Any, tuple[str, ...]]:
-    """Run one stage; its result and the toolkit's warnings it gave (each once).
-
-    Every toolkit warning is kept, whatever the filters in force show; they are then shown as those filters say
-    (an "error" filter raises, after the stage). Other warnings pass through as they would without the runner."""
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always", ModalWarning)
+    """Run one stage; its result and the toolkit's warnings it gave (:func:`modal.errors.kept_warnings`)."""
+    with kept_warnings() as said:
         result = load(REGISTRY[stage].run)(scene, **kwargs)
-    shown = set()
-    for w in caught:
-        if (w.category, str(w.message)) not in shown:
-            shown.add((w.category, str(w.message)))
-            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
-    return result, tuple(dict.fromkeys(str(w.message) for w in caught if issubclass(w.category, ModalWarning)))
+    return result, tuple(said)
 
 
 def _default_plots(scene: Scene, plots_dir, say: Callable[[str], None]) -> list[str]:

@@ -259,11 +259,21 @@ def test_clipping_is_reported_on_the_command_line(tmp_path):
 def test_a_hammer_record_fitted_without_impact_says_so(tmp_path):
     # the shipped hammer record, read as a continuous one (the user forgot --impact): the fit runs, and a
     # warning names the hits and the option that estimates them as such
-    out = run("fit", ROOT / "data" / "synthetic" / "hammer.csv")
+    out = run("fit", ROOT / "data" / "synthetic" / "hammer.csv", "--json", "--archive", tmp_path / "a.h5")
     assert out.returncode == 0, out.stderr
     warning = [ln for ln in out.stderr.splitlines() if ln.startswith("warning: ")]
     assert len(warning) == 1 and "short pulse(s)" in warning[0] and "--impact" in warning[0]
-    assert "warning: " not in run("fit", ROOT / "data" / "synthetic" / "hammer.csv", "--impact").stderr
+    # the warning travels with the results: in the JSON document and in the archive beside the fit
+    import h5py
+
+    from modal.archive import read_warnings
+
+    assert json.loads(out.stdout)["warnings"] == [warning[0].removeprefix("warning: ")]
+    with h5py.File(tmp_path / "a.h5", "r") as f:
+        fits = [name for name in f if name.startswith("identify_")]
+        assert fits and all(read_warnings(f[name]) == (warning[0].removeprefix("warning: "),) for name in fits)
+    clean = run("fit", ROOT / "data" / "synthetic" / "hammer.csv", "--impact", "--json")
+    assert "warning: " not in clean.stderr and json.loads(clean.stdout)["warnings"] == []
 
 
 def test_hammer_hits_saved_in_several_files_are_averaged_as_one_test(tmp_path):
