@@ -82,6 +82,8 @@ class Archive:
     attrs: dict[str, str]
     scene_text: str | None = None
     inputs_hash: dict[str, str] = field(default_factory=dict)
+    #: item name → the warnings given while it was computed (items written with some)
+    warnings: dict[str, tuple[str, ...]] = field(default_factory=dict)
 
     def __getitem__(self, name: str) -> Any:
         return self.items[name]
@@ -354,11 +356,13 @@ def read_archive(path: str | os.PathLike) -> Archive:
         if "scene" in f:
             value = f["scene"][()]
             scene = value.decode() if isinstance(value, bytes) else str(value)
-        items, hashes = {}, {}
+        items, hashes, said = {}, {}, {}
         for name in f.keys():
             if name == "scene":
                 continue
             items[name] = read_node(f[name])
             if "inputs_hash" in f[name].attrs:
                 hashes[name] = str(f[name].attrs["inputs_hash"])
-    return Archive(items=items, attrs=attrs, scene_text=scene, inputs_hash=hashes)
+            if read_warnings(f[name]):
+                said[name] = read_warnings(f[name])
+    return Archive(items=items, attrs=attrs, scene_text=scene, inputs_hash=hashes, warnings=said)

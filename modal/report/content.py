@@ -113,6 +113,12 @@ def _glance(path: str, archive, frf: FRF | None, results, geometry_note: str) ->
         rows.append((f"method {result.method}", f"{len(result.modes)} mode(s)" + (f"; {text}" if text else "")))
         rows.append((f"noise ({result.method})", _noise_text(frf, result)))
     rows.append(("geometry", geometry_note))
+    # the warnings the results were given (each once, with the items that got it): what their numbers stand on
+    said: dict[str, list[str]] = {}
+    for name, texts in archive.warnings.items():
+        for text in texts:
+            said.setdefault(text, []).append(name)
+    rows += [(f"warning ({', '.join(names)})", text) for text, names in said.items()]
     return tuple(rows)
 
 

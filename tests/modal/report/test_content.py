@@ -49,6 +49,13 @@ def test_the_archive_of_a_fit_is_reported(tmp_path, fitted):
     assert glance["file(s)"] == "a.uff" and glance["channels"].startswith("2 (response/reference point: 1+Z/1+Z")
     assert content.shapes[0].points == ("1+Z", "2+Z")
     assert glance["geometry"] == "none: the channels stand on a line in file order"
+    assert not any(label.startswith("warning") for label, _ in content.glance)
+    # the warnings a fit was given are shown with the results they were given to, once each
+    said = ("hits' FRF changes with force level", "takes disagree")
+    write_archive(path, {"frf": frf, "identify_nls": result, "identify_circle": result},
+                  warnings={"identify_nls": said, "identify_circle": said[:1]})
+    rows = [row for row in report_content(path).glance if row[0].startswith("warning")]
+    assert rows == [("warning (identify_nls, identify_circle)", said[0]), ("warning (identify_nls)", said[1])]
 
 
 def test_a_batch_archive_and_an_archive_without_results_are_refused(tmp_path):
