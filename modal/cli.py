@@ -243,7 +243,8 @@ def _report_estimate(frf) -> None:
 def _frf(args) -> int:
     from .io import write_frf
 
-    frf, *record = frf_from_time(args.path[0] if len(args.path) == 1 else args.path, args, _note)
+    with kept_warnings() as said:
+        frf, *record = frf_from_time(args.path[0] if len(args.path) == 1 else args.path, args, _note)
     _report_estimate(frf)
     write_frf(frf, args.out)
     if args.plot:
@@ -252,7 +253,7 @@ def _frf(args) -> int:
     if args.json:
         doc = {"file": args.path[0] if len(args.path) == 1 else list(args.path), "out": args.out, "kind": frf.kind, "n_channels": frf.n_channels,
                "n_lines": frf.n_freq, "averages": frf.averages, "estimator": frf.estimator, "window": frf.window,
-               "exponential_decay_s": frf.exponential_decay_s, "rejected": frf.rejected,
+               "exponential_decay_s": frf.exponential_decay_s, "rejected": frf.rejected, "warnings": said,
                "response_points": list(frf.response_points or []),
                "reference_points": list(frf.reference_points or [])}
         json.dump(jsonable(doc), sys.stdout, indent=1, allow_nan=False)

@@ -251,9 +251,10 @@ def test_clipping_is_reported_on_the_command_line(tmp_path):
     assert shaker.clipped_samples[1] > 0
     path = tmp_path / "shaker.csv"
     write_time(shaker.record, path)
-    out = run("frf", path, "--out", tmp_path / "s.h5")
+    out = run("frf", path, "--out", tmp_path / "s.h5", "--json")
     assert out.returncode == 0, out.stderr
     assert "warning: " in out.stderr and "response a1 clipped at 3 (flat tops" in out.stderr
+    assert any("response a1 clipped at 3 (flat tops" in w for w in json.loads(out.stdout)["warnings"])
 
 
 def test_a_hammer_record_fitted_without_impact_says_so(tmp_path):
