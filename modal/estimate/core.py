@@ -171,7 +171,8 @@ def _noise_model(sums, output_correlation, input_window, output_window, sample_r
     two parts' sum, (a c_out(m) + b c_in(m) H_k H*_{k+m}) g_km / √((a + b|H_k|²)(a + b|H_{k+m}|²)), g_km the
     excitation's term above, and the model's variance per line, (a + b|H_k|²)/S_xx,k, is the noise level's
     shape (``variance_model``). A hammer test's force noise, over the force window's few dozen samples, is
-    nearly the same on every line of a band: at the peaks it is most of the error.
+    nearly the same on every line of a band: at the peaks it is most of the error. Several outputs of one input,
+    more than one record: the variance model is the shape the outputs share (:func:`_shared_variance`).
 
     Continuous records (``sums.error_products`` summed): the correlation measured over the records
     (:func:`~modal.estimate.error_correlation.measured_line_correlation`) replaces the window's model.
