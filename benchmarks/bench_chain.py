@@ -14,7 +14,9 @@ not as z.
 The default cells are the two the chain is held to (random excitation with the
 default settings; a hammer test with an exponential window); ``--cells all`` adds the
 others (rectangular window, burst random, hammer without a window, few and many
-averages, light and heavy damping).
+averages, light and heavy damping, and hammer tests with one force and 2, 3 or 6
+accelerometers in one file, named ``hammer-{exp,force}-{hits}-ch{accelerometers}``,
+``-global`` with the global method).
 """
 from __future__ import annotations
 
@@ -134,13 +136,16 @@ CELLS = {c.name: c for c in [
     Cell("hammer-exp-1", "hammer, 1 hit, exponential window τ = 0.5 s", hammer_cell(1)),
     Cell("hammer-rect-1", "hammer, 1 hit, rectangular window (each hit of a repeated test on its own)",
          hammer_cell(1, "rect", None)),
+    # one force, several accelerometers in one file (modal fit's default is nls for them: one reference, two
+    # peaks); the global method on three of them
     *[Cell(f"hammer-{short}-{hits}-ch{outputs}{suffix}",
            f"hammer, {hits} hits, {long}, {outputs} accelerometers in one file{said}",
            hammer_cell(hits, window, 0.5 if window == "exponential" else None, n_outputs=outputs), options)
-      for suffix, said, options in (("", "", {}), ("-global", ", global method", {"method": "global"}))
+      for suffix, said, options, counts in (("", "", {}, (2, 3, 6)),
+                                            ("-global", ", global method", {"method": "global"}, (3,)))
       for short, window, long in (("exp", "exponential", "exponential window τ = 0.5 s"),
                                   ("force", "force", "force window"))
-      for hits in (3, 6, 12) for outputs in (2, 3, 6)],
+      for hits in (3, 6, 12) for outputs in counts],
 ]}
 
 
