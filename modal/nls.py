@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .channel_covariance import channel_sandwich, sandwich_product, widened
 from .record_variance import misfit_ratio, projected_scores, record_covariance
 from .whitening import LineWhitening
 
@@ -195,39 +196,6 @@ def _pole_covariance(F: np.ndarray) -> np.ndarray:
     return cov / scale
 
 
-def _nan_product(bread: np.ndarray, middle: np.ndarray) -> np.ndarray:
-    """``bread @ middle @ bread`` with the rows and columns of ``bread``'s undetermined parameters (NaN) kept NaN
-    and the others' free of them."""
-    loose = np.isnan(np.diag(bread))
-    clean = np.where(np.isnan(bread), 0.0, bread)
-    out = clean @ middle @ clean
-    out[loose, :] = np.nan
-    out[:, loose] = np.nan
-    return out
-
-
-def _widened(model: np.ndarray, measured: np.ndarray) -> np.ndarray:
-    """The ``model`` covariance with each parameter's variance raised to the ``measured`` one's where that is
-    larger (the correlations kept). The residual's lag covariance (:func:`_lag_covariance`) widens the errors
-    where the lines correlate beyond the noise model, but it is biased low over the few lines near a peak that
-    carry a pole: the fit leaves a residual orthogonal to its derivatives, so the lines' scores sum to zero and
-    their lagged products cancel. Several channels: it only widens (on the multi-channel hammer cells of
-    benchmarks/bench_chain.py it made z of fn spread 1.55 where the model alone gave 1.06)."""
-    raise_by = np.sqrt(np.maximum(np.diag(measured), np.diag(model)) / np.diag(model))
-    return model * np.outer(raise_by, raise_by)
-
-
-def _channel_sandwich(bread: np.ndarray, gram: np.ndarray, Cm: np.ndarray, noise_var: np.ndarray) -> np.ndarray:
-    """Covariance of poles fitted by least squares that weighs every (scaled) channel alike while the channels'
-    noise variances ``noise_var`` differ: B⁻¹ M B⁻¹ with ``bread`` B⁻¹ the inverse of the unweighted information
-    2 Re(Eᴴ E ∘ C̄ Cᵀ) (:func:`_pole_covariance`; ``gram`` Eᴴ E, ``Cm`` C) and M = 2 Re(Eᴴ E ∘ C̄ diag(σ²) Cᵀ) the
-    covariance of that cost's gradient. Equal to the Fisher information's inverse where every σ² is equal; with
-    unequal ones the Fisher inverse is the covariance of a fit weighing the channels by 1/σ², which this one is
-    not (a channel twice as noisy as its scale says counts as much as a quiet one)."""
-    meat = 2 * np.real(gram * ((Cm.conj() * noise_var) @ Cm.T))
-    return _nan_product(bread, meat)
-
-
 #: the residual counts as correlated between lines when its Ljung–Box statistic over the lags exceeds the
 #: chi-square quantile of this tail probability (white residuals pass 99 % of the time)
 WHITENESS_P = 0.01
@@ -388,7 +356,7 @@ def _fill_covariance(mode_cov, dphi, Q, R, Cm, noise_var, correlated_lags=0, res
         # several channels: the fit weighs every scaled channel alike, not by its noise, so its poles' covariance
         # is the sandwich of that unweighted cost (equal to F⁻¹ where the channels' noise is equal)
         bread = _pole_covariance(2 * np.real(gram * (Cm.conj() @ Cm.T))) if several else None
-        cov_theta = _channel_sandwich(bread, gram, Cm, noise_var) if several else _pole_covariance(F)
+        cov_theta = channel_sandwich(bread, gram, Cm, noise_var) if several else _pole_covariance(F)
         measured = None
         if records is not None and np.all(np.isfinite(cov_theta)):
             measured = record_covariance(np.real((E.conj().T @ E) * (Cm.conj() @ Cm.T)),
@@ -404,9 +372,9 @@ def _fill_covariance(mode_cov, dphi, Q, R, Cm, noise_var, correlated_lags=0, res
             dof = n_freq - Q.shape[1] - n_theta / (2 * Cm.shape[1])
             scores = _line_scores(E, Cm, np.ones_like(weights) if several else weights, residual, inverse_scale)
             middle = _lag_covariance(scores, correlated_lags, region) * (n_freq / dof if dof > 0 else np.nan)
-            sandwich = _nan_product(bread, middle) if several else cov_theta @ middle @ cov_theta
+            sandwich = sandwich_product(bread, middle) if several else cov_theta @ middle @ cov_theta
             if several and np.all(np.isfinite(sandwich)) and np.all(np.diag(cov_theta) > 0):
-                cov_theta = _widened(cov_theta, sandwich)
+                cov_theta = widened(cov_theta, sandwich)
             elif np.all(np.isfinite(sandwich)) and np.all(np.diag(sandwich) > 0):
                 cov_theta = sandwich
     elif np.all(noise_var == 0):

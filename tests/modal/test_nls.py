@@ -249,17 +249,3 @@ def test_pole_errors_of_channels_with_unequal_noise_match_their_scatter():
     reported_std = np.sqrt(np.mean(reported, axis=0))
     np.testing.assert_allclose(reported_std / scatter, 1.0, atol=0.15)
 
-
-def test_pole_errors_of_channels_with_equal_noise_are_the_fisher_information_inverse():
-    # channels whose scaled noise is alike: the sandwich is the Fisher information's inverse (to rounding), the
-    # covariance of the efficient fit this one then is
-    from modal.nls import _channel_sandwich, _pole_covariance
-
-    rng = np.random.default_rng(3)
-    E = rng.standard_normal((50, 4)) + 1j * rng.standard_normal((50, 4))
-    C = rng.standard_normal((4, 3)) + 1j * rng.standard_normal((4, 3))
-    gram = E.conj().T @ E
-    noise_var = np.full(3, 0.37)
-    bread = _pole_covariance(2 * np.real(gram * (C.conj() @ C.T)))
-    fisher = 2 * np.real(gram * ((C.conj() / noise_var) @ C.T))
-    np.testing.assert_allclose(_channel_sandwich(bread, gram, C, noise_var), np.linalg.inv(fisher), rtol=1e-10)
