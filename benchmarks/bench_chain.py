@@ -14,7 +14,9 @@ not as z.
 The default cells are the two the chain is held to (random excitation with the
 default settings; a hammer test with an exponential window); ``--cells all`` adds the
 others (rectangular window, burst random, hammer without a window, few and many
-averages, light and heavy damping).
+averages, light and heavy damping, and hammer tests with one force and 2, 3 or 6
+accelerometers in one file, named ``hammer-{exp,force}-{hits}-ch{accelerometers}``,
+``-global`` with the global method).
 """
 from __future__ import annotations
 
@@ -22,7 +24,7 @@ import argparse
 import time
 import warnings
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -45,11 +47,24 @@ class Cell:
     name: str
     description: str
     make: Callable[[int], tuple]  # seed -> (EstimatedFRF, DigitalModes)
+    identify_options: dict = field(default_factory=dict)  # passed to modal.identify (e.g. method)
 
 
-def system(damping_ratio=DAMPING_RATIO) -> DigitalModes:
-    return DigitalModes(np.array(NATURAL_FREQUENCY_HZ), np.asarray(damping_ratio, float),
-                        np.array(MODAL_CONSTANT), SAMPLE_RATE_HZ)
+#: where the accelerometers of the multi-channel cells sit on a pinned-pinned beam (fraction of its length),
+#: the driving point first; its shapes sin(rπx) give each point's constants relative to the driving point's
+ACCELEROMETER_POSITIONS = (0.2, 0.35, 0.8, 0.65, 0.12, 0.9)
+
+
+def system(damping_ratio=DAMPING_RATIO, n_outputs: int = 1) -> DigitalModes:
+    """The two-mode structure; with ``n_outputs`` > 1, seen at the first of :data:`ACCELEROMETER_POSITIONS`
+    (the driving point, constants :data:`MODAL_CONSTANT`) and the next ones."""
+    if n_outputs == 1:
+        constants = np.array(MODAL_CONSTANT)
+    else:
+        x = np.array(ACCELEROMETER_POSITIONS[:n_outputs])
+        shape = np.sin(np.pi * np.outer(x, np.arange(1, len(MODAL_CONSTANT) + 1)))  # (outputs, modes)
+        constants = np.array(MODAL_CONSTANT)[None, :] * shape / shape[0]
+    return DigitalModes(np.array(NATURAL_FREQUENCY_HZ), np.asarray(damping_ratio, float), constants, SAMPLE_RATE_HZ)
 
 
 def random_cell(duration_s: float, window: str = "hann", damping_ratio=DAMPING_RATIO, segment_length=None,
@@ -82,15 +97,19 @@ def burst_cell(n_bursts: int, segment_s: float = 8.0, burst_fraction: float = 0.
 
 
 def hammer_cell(n_hits: int, window: str = "exponential", decay_s: float | None = 0.5, spacing_s: float = 4.0,
-                noise: float = 0.002, damping_ratio=DAMPING_RATIO):
+                noise: float = 0.002, damping_ratio=DAMPING_RATIO, n_outputs: int = 1):
+    """Hammer hits at the driving point, ``n_outputs`` accelerometers (one file: one force, all responses)."""
     def make(seed: int):
-        structure = system(damping_ratio)
+        structure = system(damping_ratio, n_outputs)
         hits = 0.5 + spacing_s * np.arange(n_hits)
         rec = impact_record(structure, hits, hits[-1] + spacing_s, amplitude_variation=0.2, width_variation=0.1,
                             pulse_width_s=0.002, response_noise=noise, force_noise=0.002, seed=seed).record
-        frf = modal.estimate_frf(rec.signals[0], rec.signals[1], rec.sample_rate_hz, impact=True, window=window,
+        points = {} if n_outputs == 1 else {"excitation_points": ["1"],
+                                            "response_points": [f"{k + 1}" for k in range(n_outputs)]}
+        frf = modal.estimate_frf(rec.signals[0], rec.signals[1:] if n_outputs > 1 else rec.signals[1],
+                                 rec.sample_rate_hz, impact=True, window=window,
                                  exponential_decay_s=decay_s if window == "exponential" else None,
-                                 kind="accelerance")
+                                 kind="accelerance", **points)
         return frf, structure
     return make
 
@@ -117,6 +136,16 @@ CELLS = {c.name: c for c in [
     Cell("hammer-exp-1", "hammer, 1 hit, exponential window τ = 0.5 s", hammer_cell(1)),
     Cell("hammer-rect-1", "hammer, 1 hit, rectangular window (each hit of a repeated test on its own)",
          hammer_cell(1, "rect", None)),
+    # one force, several accelerometers in one file (modal fit's default is nls for them: one reference, two
+    # peaks); the global method on three of them
+    *[Cell(f"hammer-{short}-{hits}-ch{outputs}{suffix}",
+           f"hammer, {hits} hits, {long}, {outputs} accelerometers in one file{said}",
+           hammer_cell(hits, window, 0.5 if window == "exponential" else None, n_outputs=outputs), options)
+      for suffix, said, options, counts in (("", "", {}, (2, 3, 6)),
+                                            ("-global", ", global method", {"method": "global"}, (3,)))
+      for short, window, long in (("exp", "exponential", "exponential window τ = 0.5 s"),
+                                  ("force", "force", "force window"))
+      for hits in (3, 6, 12) for outputs in counts],
 ]}
 
 
@@ -129,7 +158,7 @@ def z_scores(cell: Cell, records: int, first_seed: int = 0) -> dict:
         frf, structure = cell.make(seed)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            result = modal.identify(frf)
+            result = modal.identify(frf, **cell.identify_options)
         fn_est = np.array([m.natural_frequency_hz for m in result.modes], float)
         for r in range(n_modes):
             if fn_est.size == 0:

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .channel_covariance import channel_sandwich, sandwich_product, widened
 from .record_variance import misfit_ratio, projected_scores, record_covariance
 from .whitening import LineWhitening
 
@@ -343,14 +344,19 @@ def _fill_covariance(mode_cov, dphi, Q, R, Cm, noise_var, correlated_lags=0, res
     n_modes = n_theta // 2
     from_records = False
     E = dphi - Q @ (Q.conj().T @ dphi)
+    gram = E.conj().T @ E
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         weights = np.where(noise_var > 0, 1.0 / noise_var, np.inf)
         # a channel fitted exactly (residual 0) has infinite weight: F is then not finite and
         # the covariance is zero (below); inf·0 inside the product is expected, not an error
-        F = 2 * np.real((E.conj().T @ E) * ((Cm.conj() * weights) @ Cm.T))
+        F = 2 * np.real(gram * ((Cm.conj() * weights) @ Cm.T))
     cov_theta = np.full((n_theta, n_theta), np.nan)
+    several = Cm.shape[1] > 1
     if np.all(np.isfinite(F)):
-        cov_theta = _pole_covariance(F)
+        # several channels: the fit weighs every scaled channel alike, not by its noise, so its poles' covariance
+        # is the sandwich of that unweighted cost (equal to F⁻¹ where the channels' noise is equal)
+        bread = _pole_covariance(2 * np.real(gram * (Cm.conj() @ Cm.T))) if several else None
+        cov_theta = channel_sandwich(bread, gram, Cm, noise_var) if several else _pole_covariance(F)
         measured = None
         if records is not None and np.all(np.isfinite(cov_theta)):
             measured = record_covariance(np.real((E.conj().T @ E) * (Cm.conj() @ Cm.T)),
@@ -360,14 +366,16 @@ def _fill_covariance(mode_cov, dphi, Q, R, Cm, noise_var, correlated_lags=0, res
             dof = dphi.shape[0] - Q.shape[1] - n_theta / (2 * Cm.shape[1])
             ratio = misfit_ratio(float(noise_var[0]) * dof, off, records[1])
             cov_theta, from_records = measured * max(ratio, 1.0) if np.isfinite(ratio) else measured, True
-        elif correlated_lags > 0 and np.all(np.isfinite(cov_theta)) and _residual_correlated(
-                residual, correlated_lags, region):
+        elif correlated_lags > 0 and np.all(np.isfinite(cov_theta)) and (several or _residual_correlated(
+                residual, correlated_lags, region)):
             n_freq = dphi.shape[0]
             dof = n_freq - Q.shape[1] - n_theta / (2 * Cm.shape[1])
-            scores = _line_scores(E, Cm, weights, residual, inverse_scale)
+            scores = _line_scores(E, Cm, np.ones_like(weights) if several else weights, residual, inverse_scale)
             middle = _lag_covariance(scores, correlated_lags, region) * (n_freq / dof if dof > 0 else np.nan)
-            sandwich = cov_theta @ middle @ cov_theta
-            if np.all(np.isfinite(sandwich)) and np.all(np.diag(sandwich) > 0):
+            sandwich = sandwich_product(bread, middle) if several else cov_theta @ middle @ cov_theta
+            if several and np.all(np.isfinite(sandwich)) and np.all(np.diag(cov_theta) > 0):
+                cov_theta = widened(cov_theta, sandwich)
+            elif np.all(np.isfinite(sandwich)) and np.all(np.diag(sandwich) > 0):
                 cov_theta = sandwich
     elif np.all(noise_var == 0):
         cov_theta = np.zeros((n_theta, n_theta))

@@ -73,7 +73,9 @@ class NoiseModel:
         (:func:`input_noise_split`), in the FRF's unit squared: the shape of ``noise_std²`` without its
         scatter from few averages. NaN on lines where the excitation's noise is not small against the
         excitation (there H1 is biased and the model does not hold); None when not fitted (no excitation
-        noise found, several channels).
+        noise found, several inputs, one record). Several outputs of one input: the part every channel's variance
+        shares, a/S_xx with a the outputs' mean response-noise power (the excitation noise's part, b|H_o|², differs
+        per channel).
     record_influence : ndarray, shape (n_records, n_freq), complex, or None
         Each record's share of the estimate's error at each line, in the FRF's unit
         (:mod:`modal.estimate.record_influence`): identification measures its parameters' variance over

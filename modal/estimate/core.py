@@ -171,7 +171,8 @@ def _noise_model(sums, output_correlation, input_window, output_window, sample_r
     two parts' sum, (a c_out(m) + b c_in(m) H_k H*_{k+m}) g_km / √((a + b|H_k|²)(a + b|H_{k+m}|²)), g_km the
     excitation's term above, and the model's variance per line, (a + b|H_k|²)/S_xx,k, is the noise level's
     shape (``variance_model``). A hammer test's force noise, over the force window's few dozen samples, is
-    nearly the same on every line of a band: at the peaks it is most of the error.
+    nearly the same on every line of a band: at the peaks it is most of the error. Several outputs of one input,
+    more than one record: the variance model is the shape the outputs share (:func:`_shared_variance`).
 
     Continuous records (``sums.error_products`` summed): the correlation measured over the records
     (:func:`~modal.estimate.error_correlation.measured_line_correlation`) replaces the window's model.
@@ -211,6 +212,8 @@ def _noise_model(sums, output_correlation, input_window, output_window, sample_r
             response_part = np.where(holds, np.sqrt(a / np.where(holds, total, 1.0)), 1.0)
             input_part = np.where(holds, np.sqrt(b / np.where(holds, total, 1.0)) * h, 0.0)
             variance = np.where(holds, total / power * overlap_factor, np.nan)
+    elif frf is not None and frf.shape[1] == 1 and frf.shape[0] > 1 and sums.n_records > 1:
+        variance = _shared_variance(sums, frf[:, 0], power) * overlap_factor
     input_correlation = window_line_correlation(input_window)
     for m in range(1, n_lags + 1):
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -234,6 +237,25 @@ def _noise_model(sums, output_correlation, input_window, output_window, sample_r
         influence = record_influence(sums.record_cross, sums.record_power, frf[0, 0], power)
     return NoiseModel(sums.n_records, dof, correlation, lags, interval, variance, influence,
                       overlapping if influence is not None else 0, withheld)
+
+
+def _shared_variance(sums, frf: np.ndarray, power: np.ndarray) -> np.ndarray:
+    """Several outputs of one input: the part of each line's error variance whose shape every channel shares,
+    a/S_xx with a the outputs' mean response-noise power (:func:`~modal.noise_model.input_noise_split` of each
+    output's residual; NaN on lines where an output's excitation-noise part does not hold). The excitation's noise
+    enters output o as H_o times one common error, a different shape in every channel and, over the few samples
+    a force window keeps, nearly one complex gain across a mode's band, which its modal constants take up."""
+    n_out = frf.shape[0]
+    a = np.zeros(n_out)
+    holds = np.ones(power.size, bool)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        for o in range(n_out):
+            residual = (sums.syy[o] - np.abs(sums.syx[o, 0]) ** 2 / power) / (sums.n_records - 1)
+            h2 = np.abs(frf[o]) ** 2
+            _, b = input_noise_split(residual, h2)
+            a[o], b = input_noise_split(residual, h2, b * sums.n_records < INPUT_NOISE_LIMIT * power)
+            holds &= b * sums.n_records < INPUT_NOISE_LIMIT * power
+        return np.where(holds & (power > 0), np.mean(a) / power, np.nan)
 
 
 def _refuse_swapped_channels(force, response, sample_rate_hz, labels, source) -> None:

@@ -149,7 +149,19 @@ def line_weight(frf, bands):
         lines = smoothing_lines(model)
         plain = _smoothed(variance, lines)
         shape = model.variance_model
-        if shape is not None:
+        several = np.ndim(line_noise) > 1 and np.shape(line_noise)[0] > 1
+        if shape is not None and several:
+            # several channels: the shape every channel's noise shares (the response noise over the excitation's
+            # power), at the level of theirs; the excitation noise's part differs per channel and is nearly a
+            # gain across a band, which the modal constants take up: weighing lines down for it would drop the
+            # lines that carry the poles
+            holds = np.isfinite(shape) & (shape > 0) & keep
+            if np.any(holds):
+                level = np.mean(plain[holds]) / np.mean(shape[holds])
+                variance = np.where(np.isfinite(shape) & (shape > 0), shape * level, plain)
+            else:
+                variance = plain
+        elif shape is not None:
             # where the model holds, the variance's own shape (it rises as |H|² at the peaks where the
             # excitation's noise dominates) is kept and only its ratio to it, which scatters from line to
             # line, is averaged (over the neighbours where it holds)
