@@ -17,7 +17,7 @@ covariance of these linear images over the blocks.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -64,6 +64,9 @@ class SubspaceModel:
     max_order: int
     hankel: np.ndarray
     block_cols: int | None = None
+    #: each order's (A, μ, Ψ) once computed (:func:`_system`): the order sweep computes them all, and the error
+    #: bars take those of a few orders again
+    systems: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
 
 def hankel(R: np.ndarray, block_rows: int, block_cols: int | None = None) -> np.ndarray:
@@ -105,11 +108,13 @@ def continuous(mu: np.ndarray, sample_rate_hz: float) -> np.ndarray:
 
 def _system(model: SubspaceModel, order: int):
     """(A, eigenvalues μ, right eigenvectors Ψ) of one order, in the basis of the first ``order`` left singular
-    vectors."""
+    vectors (computed once per model and order)."""
     n = order
-    A = np.linalg.solve(model.R[:n, :n], model.QtU_down[:n, :n])
-    mu, psi = np.linalg.eig(A)
-    return A, mu, psi
+    if n not in model.systems:
+        A = np.linalg.solve(model.R[:n, :n], model.QtU_down[:n, :n])
+        mu, psi = np.linalg.eig(A)
+        model.systems[n] = (A, mu, psi)
+    return model.systems[n]
 
 
 def _normalised(shapes: np.ndarray):
@@ -250,7 +255,7 @@ class Perturbation:
         resid = self.UtU_down[n:, :n] - self.UtU_up[n:, :n] @ A  # (k − n, n): U₂ᵀ (O_down − O_up A)
         rp = resid @ P
         # insideᵀ U₂ᵀ (O_down − O_up A) Ψ_p: (blocks, n, 2p) → (n, blocks, p)
-        in_resid = np.tensordot(inside, np.concatenate([rp.real, rp.imag], axis=1).astype(single), axes=(0, 0))
+        in_resid = np.transpose(inside, (1, 2, 0)) @ np.concatenate([rp.real, rp.imag], axis=1).astype(single)
         in_resid = np.swapaxes(in_resid.astype(float), 0, 1)
         up_resid = in_resid[..., :p] + 1j * in_resid[..., p:] \
             + (e_part(self.EtU_down[:n], P) - e_part(self.EtU_up[:n], AP)) / s1[:, None, None]
@@ -268,8 +273,8 @@ class Perturbation:
             half = x.shape[1] // 2
             return x[:, :half] + 1j * x[:, half:]  # (n, blocks · p)
 
-        inner = unflat(solve_triangular(Rn, flat(up_resid), trans="T")).reshape(n, n_blocks, p)
-        dAP = unflat(solve_triangular(Rn, flat(q_down - q_up + inner)))
+        inner = unflat(solve_triangular(Rn, flat(up_resid), trans="T", check_finite=False)).reshape(n, n_blocks, p)
+        dAP = unflat(solve_triangular(Rn, flat(q_down - q_up + inner), check_finite=False))
         # W = Ψ⁻¹ ΔA Ψ, only its columns of the poles asked for: (blocks, n, picks)
         Wm = np.swapaxes((np.linalg.inv(psi) @ dAP).reshape(n, n_blocks, p), 0, 1)
         picks = np.arange(p)
