@@ -17,7 +17,7 @@ covariance of these linear images over the blocks.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -64,6 +64,9 @@ class SubspaceModel:
     max_order: int
     hankel: np.ndarray
     block_cols: int | None = None
+    #: each order's (A, μ, Ψ) once computed (:func:`_system`): the order sweep computes them all, and the error
+    #: bars take those of a few orders again
+    systems: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
 
 def hankel(R: np.ndarray, block_rows: int, block_cols: int | None = None) -> np.ndarray:
@@ -105,11 +108,13 @@ def continuous(mu: np.ndarray, sample_rate_hz: float) -> np.ndarray:
 
 def _system(model: SubspaceModel, order: int):
     """(A, eigenvalues μ, right eigenvectors Ψ) of one order, in the basis of the first ``order`` left singular
-    vectors."""
+    vectors (computed once per model and order)."""
     n = order
-    A = np.linalg.solve(model.R[:n, :n], model.QtU_down[:n, :n])
-    mu, psi = np.linalg.eig(A)
-    return A, mu, psi
+    if n not in model.systems:
+        A = np.linalg.solve(model.R[:n, :n], model.QtU_down[:n, :n])
+        mu, psi = np.linalg.eig(A)
+        model.systems[n] = (A, mu, psi)
+    return model.systems[n]
 
 
 def _normalised(shapes: np.ndarray):
@@ -160,21 +165,43 @@ class Perturbation:
         d_R = (block_R - np.tensordot(w, block_R, axes=1)[None]).astype(np.float32)
         dH = hankel(d_R, model.block_rows, model.block_cols)
         G = dH @ V[:, :top]  # (blocks, p, top): ΔH V₁ for every order up to top
-        B_right = np.swapaxes(U.T @ G, 1, 2)  # (blocks, top, k): (Uᵀ ΔH V₁)ᵀ
-        self.B_right = B_right  # kept in single precision, as are the products of each order with it
-        E = G - U @ np.swapaxes(B_right, 1, 2)  # the part of ΔH V₁ outside the range of H
-        self.B_left = (np.swapaxes(U[:, :top], 0, 1) @ dH) @ V  # (blocks, top, k): U₁ᵀ ΔH V
-        # E enters every order only through its first l rows and these projections, whose leading n × n
+        # each perturbed singular vector's part outside the signal subspace of order n is ΔU₁ = U₂ X + E/σ₁, with
+        # X (k − n, n) = (U₂ᵀ ΔH V₁ σ₁ + σ₂ (U₁ᵀ ΔH V₂)ᵀ) / (σ₁² − σ₂²) elementwise (the part inside only rotates
+        # the basis, which leaves the eigenvalues and the observed shapes as they are). Entry (i, j) of X, i ≥ n > j,
+        # is the same for every order: X of order n is the block [n:, :n] of one matrix (blocks, k, top), formed
+        # once, in single precision as the deviations, from the gaps in double (close singular values); a gap of
+        # zero (equal singular values) contributes nothing
+        sv = model.singular_values
+        with np.errstate(divide="ignore", invalid="ignore"):
+            inverse_gap = 1.0 / (sv[None, :top] ** 2 - sv[:, None] ** 2)  # (k, top)
+        inverse_gap[~np.isfinite(inverse_gap)] = 0.0
+        UtG = U.T @ G  # (blocks, k, top): Uᵀ ΔH V₁
+        inside = UtG * (sv[None, :top] * inverse_gap).astype(np.float32)
+        inside += (V.T @ (np.swapaxes(dH, 1, 2) @ U[:, :top])) * (sv[:, None] * inverse_gap).astype(np.float32)
+        # every array an order slices is kept as (rows, blocks, columns): an order's rows and columns of all the
+        # blocks are then one matrix ((rows · blocks) × columns, or rows × (blocks · columns)), and each product
+        # with them one call
+        self.inside = _by_rows(inside)
+        # E = (I − U Uᵀ) ΔH V₁, the part of ΔH V₁ outside the range of H, enters every order only through its
+        # first l rows and the projections Qᵀ E_down, Qᵀ E_up, E_upᵀ U_down, E_upᵀ U_up, whose leading n × n
         # blocks are those of order n: formed once for all orders
         l, rows = model.n_outputs, model.n_outputs * model.block_rows
-        Q = model.Q[:, :top].astype(np.float32)
+        Q = model.Q[:, :top]
+        # U₂'s projections of order n (Qₙᵀ U₂ down and up) and U_upᵀ U_down, U_upᵀ U_up, whose blocks [n:, :n]
+        # give U₂ᵀ (O_down − O_up A): slices of these
+        self.QtU_down = Q.T @ model.U[l:]  # (top, k)
+        self.QtU_up = Q.T @ model.U[:rows]
+        self.UtU_down = model.U[:rows].T @ model.U[l:, :top]  # (k, top)
+        self.UtU_up = model.U[:rows].T @ model.U[:rows, :top]
+        Q32 = Q.astype(np.float32)
+        E = G - U @ UtG
         E_up, E_down = E[:, :rows], E[:, l:]
-        self.E_C = E[:, :l].astype(float)  # (blocks, l, top)
-        self.QtE_down = (Q.T @ E_down).astype(float)  # (blocks, top, top): Qᵀ E_down
-        self.QtE_up = (Q.T @ E_up).astype(float)
         E_up_t = np.swapaxes(E_up, 1, 2)
-        self.EtU_down = (E_up_t @ U[l:, :top]).astype(float)  # E_upᵀ U_down
-        self.EtU_up = (E_up_t @ U[:rows, :top]).astype(float)  # E_upᵀ U_up
+        self.E_C = _by_rows(E[:, :l], float)  # (l, blocks, top)
+        self.QtE_down = _by_rows(Q32.T @ E_down, float)  # (top, blocks, top): Qᵀ E_down
+        self.QtE_up = _by_rows(Q32.T @ E_up, float)
+        self.EtU_down = _by_rows(E_up_t @ U[l:, :top], float)  # E_upᵀ U_down
+        self.EtU_up = _by_rows(E_up_t @ U[:rows, :top], float)  # E_upᵀ U_up
 
     def at(self, order: int, indices) -> dict[str, np.ndarray]:
         """Deviations of the poles ``indices`` of :func:`poles_at` (``order``).
@@ -191,52 +218,66 @@ class Perturbation:
         n, l = order, model.n_outputs
         if n > self.top:
             raise IdentificationError(f"perturbations were prepared up to order {self.top}, not {n}")
-        U, sv = model.U, model.singular_values
-        s1, s2 = sv[:n], sv[n:]
-        # U₂ᵀ ΔH V₁ and (U₁ᵀ ΔH V₂)ᵀ, each (blocks, k − n, n)
-        left = np.swapaxes(self.B_right[:, :n, n:], 1, 2)
-        right = np.swapaxes(self.B_left[:, :n, n:], 1, 2)
-        single = np.float32
-        with np.errstate(divide="ignore", invalid="ignore"):
-            # the gaps in double precision (close singular values), the rest in single, as the deviations
-            inverse_gap = (1.0 / (s1[None, :] ** 2 - s2[:, None] ** 2)).astype(single)  # (k − n, n)
-            inside = (left * s1[None, None, :].astype(single) + s2[None, :, None].astype(single) * right) \
-                * inverse_gap
-        inside = np.where(np.isfinite(inside), inside, single(0.0))
-        # each perturbed singular vector's part outside the signal subspace, ΔU₁ = U₂ inside + E/σ₁ (the
-        # part inside only rotates the basis, which leaves the eigenvalues and the observed shapes as they
-        # are). ΔU₁ enters only projected: Qᵀ ΔO_down, Qᵀ ΔO_up, ΔO_upᵀ (O_down − O_up A) and its first l
-        # rows (ΔC), so U₂ is projected once per order rather than ΔU₁ formed per block
-        # (outside = E₁/σ₁, its products taken from the projections formed once for all orders)
+        s1 = model.singular_values[:n]
+        inside = self.inside[n:, :, :n]  # (k − n, blocks, n): ΔU₁ = U₂ inside + E/σ₁
+        n_blocks = inside.shape[1]
+        # ΔU₁ enters only projected: Qᵀ ΔO_down, Qᵀ ΔO_up, ΔO_upᵀ (O_down − O_up A) and its first l rows (ΔC); and
+        # ΔA only through ΔA Ψ_p, Ψ_p the eigenvectors of the poles asked for. So `inside` is multiplied first by
+        # Ψ_p and A Ψ_p (a few columns each) and only then by U₂'s projections (2n + l rows), in single precision
+        # as the deviations
         A, mu, psi = _system(model, order)
-        Rn, Qn = model.R[:n, :n], model.Q[:, :n]
-        rows = l * model.block_rows
-        U1, U2 = U[:, :n], U[:, n:]
-        resid = U1[l:] - U1[:rows] @ A
-        per_column = s1[None, None, :]
-        # the products with `inside` (blocks × (k − n) × n each) in single precision, their sums in double
-        q_down = (Qn.T @ U2[l:]).astype(single) @ inside + self.QtE_down[:, :n, :n] / per_column  # Qᵀ ΔO_down
-        q_up = (Qn.T @ U2[:rows]).astype(single) @ inside + self.QtE_up[:, :n, :n] / per_column  # Qᵀ ΔO_up
-        up_resid = np.swapaxes(inside, 1, 2) @ (U2[:rows].T @ resid).astype(single) \
-            + (self.EtU_down[:, :n, :n] - self.EtU_up[:, :n, :n] @ A) / s1[None, :, None]  # ΔO_upᵀ (O_down − O_up A)
-        d_C = U2[:l].astype(single) @ inside + self.E_C[:, :, :n] / per_column  # (blocks, l, n)
-        # ΔA = R⁻¹ [Qᵀ (ΔO_down − ΔO_up A) + R⁻ᵀ ΔO_upᵀ (O_down − O_up A)], R upper triangular: two
+        P = psi[:, idx]  # (n, p)
+        AP = A @ P
+        p = idx.size
+        single = np.float32
+
+        def spread(x):  # ((k − n) · blocks, m) -> (k − n, blocks · m)
+            return x.reshape(-1, n_blocks * x.shape[-1])
+
+        flat_inside = inside.reshape(-1, n)  # ((k − n) · blocks, n), a view
+        in_P = spread(_real_columns(flat_inside, P, single))  # (k − n, blocks · 2p): inside Ψ_p, real and imaginary
+        in_AP = spread(_real_columns(flat_inside, AP, single))
+        scaled_P, scaled_AP = P / s1[:, None], AP / s1[:, None]  # E/σ₁: the columns of E divided by σ₁
+
+        def rows_of(x, m):  # (m, blocks · 2p) real -> (m, blocks, p) complex
+            x = x.reshape(m, n_blocks, 2 * p).astype(float)
+            return x[..., :p] + 1j * x[..., p:]
+
+        def e_part(E_rows, columns):  # (m, blocks, top) sliced to n columns, times complex columns: (m, blocks, p)
+            m = E_rows.shape[0]
+            x = _real_columns(E_rows[:, :, :n].reshape(-1, n), columns).reshape(m, n_blocks, 2 * p)
+            return x[..., :p] + 1j * x[..., p:]
+
+        # Qᵀ ΔO_down Ψ_p, Qᵀ ΔO_up A Ψ_p, ΔO_upᵀ (O_down − O_up A) Ψ_p, ΔC Ψ_p: (n or l, blocks, p)
+        q_down = rows_of(self.QtU_down[:n, n:].astype(single) @ in_P, n) + e_part(self.QtE_down[:n], scaled_P)
+        q_up = rows_of(self.QtU_up[:n, n:].astype(single) @ in_AP, n) + e_part(self.QtE_up[:n], scaled_AP)
+        d_C = rows_of(model.U[:l, n:].astype(single) @ in_P, l) + e_part(self.E_C, scaled_P)
+        resid = self.UtU_down[n:, :n] - self.UtU_up[n:, :n] @ A  # (k − n, n): U₂ᵀ (O_down − O_up A)
+        rp = resid @ P
+        # insideᵀ U₂ᵀ (O_down − O_up A) Ψ_p: (blocks, n, 2p) → (n, blocks, p)
+        in_resid = np.transpose(inside, (1, 2, 0)) @ np.concatenate([rp.real, rp.imag], axis=1).astype(single)
+        in_resid = np.swapaxes(in_resid.astype(float), 0, 1)
+        up_resid = in_resid[..., :p] + 1j * in_resid[..., p:] \
+            + (e_part(self.EtU_down[:n], P) - e_part(self.EtU_up[:n], AP)) / s1[:, None, None]
+        # ΔA Ψ_p = R⁻¹ [Qᵀ (ΔO_down − ΔO_up A) Ψ_p + R⁻ᵀ ΔO_upᵀ (O_down − O_up A) Ψ_p], R upper triangular: two
         # triangular solves for all blocks at once
         from scipy.linalg import solve_triangular
 
-        n_blocks = inside.shape[0]
+        Rn = model.R[:n, :n]
 
-        def flat(x):  # (blocks, n, m) -> (n, blocks·m)
-            return np.swapaxes(x, 0, 1).reshape(n, -1)
+        def flat(x):  # complex (n, blocks, p) -> real (n, 2·blocks·p)
+            x = x.reshape(n, -1)
+            return np.concatenate([x.real, x.imag], axis=1)
 
         def unflat(x):
-            return np.swapaxes(x.reshape(n, n_blocks, -1), 0, 1)
+            half = x.shape[1] // 2
+            return x[:, :half] + 1j * x[:, half:]  # (n, blocks · p)
 
-        inner = unflat(solve_triangular(Rn, flat(up_resid), trans="T"))
-        dA = unflat(solve_triangular(Rn, flat(q_down - q_up @ A + inner)))
+        inner = unflat(solve_triangular(Rn, flat(up_resid), trans="T", check_finite=False)).reshape(n, n_blocks, p)
+        dAP = unflat(solve_triangular(Rn, flat(q_down - q_up + inner), check_finite=False))
         # W = Ψ⁻¹ ΔA Ψ, only its columns of the poles asked for: (blocks, n, picks)
-        Wm = np.linalg.inv(psi) @ (dA @ psi[:, idx])
-        picks = np.arange(idx.size)
+        Wm = np.swapaxes((np.linalg.inv(psi) @ dAP).reshape(n, n_blocks, p), 0, 1)
+        picks = np.arange(p)
         d_mu = Wm[:, idx, picks]
         d_lam = d_mu / mu[idx][None, :] * model.sample_rate_hz
         # eigenvectors: Δψ_i = Σ_{k≠i} ψ_k W_ki / (μ_i − μ_k)
@@ -244,9 +285,20 @@ class Perturbation:
             coupling = Wm / (mu[idx][None, None, :] - mu[None, :, None])  # (blocks, n, picks)
         coupling[:, idx, picks] = 0.0
         coupling = np.where(np.isfinite(coupling), coupling, 0.0)
-        C = U1[:l]
-        raw = C @ psi[:, idx]
-        d_raw = d_C @ psi[:, idx] + C @ (psi @ coupling)  # (blocks, l, picks)
+        C = model.U[:l, :n]
+        raw = C @ P
+        d_raw = np.swapaxes(d_C, 0, 1) + C @ (psi @ coupling)  # (blocks, l, picks)
         shapes, lead, value = _normalised(raw)
         d_shape = (d_raw - shapes[None] * d_raw[:, lead, picks][:, None, :]) / value[None, None, :]
         return {"pole": d_lam * self.scale[:, None], "shape": d_shape * self.scale[:, None, None]}
+
+
+def _real_columns(real: np.ndarray, columns: np.ndarray, dtype=np.float64) -> np.ndarray:
+    """``real @ columns`` for a real (a, b) matrix and complex (b, c) columns, as one real product (in ``dtype``):
+    (a, 2c), the real parts' columns first, then the imaginary parts'."""
+    return real @ np.concatenate([columns.real, columns.imag], axis=1).astype(dtype)
+
+
+def _by_rows(x: np.ndarray, dtype=None) -> np.ndarray:
+    """(blocks, rows, columns) -> (rows, blocks, columns), contiguous."""
+    return np.ascontiguousarray(np.swapaxes(x, 0, 1), dtype=dtype)
