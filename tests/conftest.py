@@ -17,6 +17,23 @@ if "HYPOTHESIS_STORAGE_DIRECTORY" not in os.environ:
 
     set_hypothesis_home_dir(os.path.join(tempfile.gettempdir(), f"modalbal-hypothesis-{os.getuid()}"))
 
+# with PYTHONDONTWRITEBYTECODE set, bytecode is cached outside the checkout (support.bytecode); set here,
+# before the xdist workers and the tests' subprocesses start, which inherit it; this process's import
+# system reads both settings at every import
+def _cache_bytecode() -> None:
+    import sys
+    import tempfile
+
+    from support.bytecode import cache_outside_the_checkout
+
+    prefix = cache_outside_the_checkout(os.environ, tempfile.gettempdir())
+    if prefix is not None:
+        sys.pycache_prefix = prefix
+        sys.dont_write_bytecode = False
+
+
+_cache_bytecode()
+
 
 def pytest_configure(config):
     """The default run's derandomised hypothesis tests draw the same cases whatever else runs.
