@@ -82,28 +82,11 @@ class _Plan:
     right: tuple | None
 
 
-def _quadratic_pinv(x):
-    """Pseudo-inverse (3, n) of the quadratic design ``np.vander(x, 3)`` (columns x², x, 1), x increasing.
-
-    Solved in the centred variable t = (x − c)/h ∈ [−1, 1] (c, h the middle and half-width of x), whose
-    design is well conditioned (cond ≤ 6 for lines equally spaced), by its 3×3 normal equations, and
-    mapped back to x's coefficients: the same matrix as ``np.linalg.pinv`` to its rounding, which grows
-    with the condition of x's own design (cond ≈ 1/h² for the peak fit's lines, crowded near x = 1),
-    without an SVD per call (half-power runs thousands of these tiny fits).
-    """
-    c = 0.5 * (x[0] + x[-1])
-    h = 0.5 * (x[-1] - x[0])
-    design = np.vander((x - c) / h, 3)
-    # α t² + β t + γ = a x² + b x + c0 with t = (x − c)/h
-    to_x = np.array([[1 / h**2, 0.0, 0.0], [-2 * c / h**2, 1 / h, 0.0], [c**2 / h**2, -c / h, 1.0]])
-    return (to_x @ np.linalg.inv(design.T @ design)) @ design.T
-
-
 def _peak_fit(omega, lo, hi):
     """Design of the least-squares quadratic in ω² through lines lo..hi (pseudo-inverse, scale)."""
     u = omega[lo:hi + 1] ** 2
     scale = u[len(u) // 2]
-    return _quadratic_pinv(u / scale), u, scale
+    return np.linalg.pinv(np.vander(u / scale, 3)), u, scale
 
 
 def _peak_values(omega, mag, plan: _Plan, power: int):
@@ -162,7 +145,7 @@ def _crossing(omega, db, level_db, j_below, j_above):
 
 def _fit_design(w):
     """Pseudo-inverse of the quadratic design in x = (ω − ω0)/ptp(ω) over lines ``w``."""
-    return _quadratic_pinv((w - w[0]) / np.ptp(w))
+    return np.linalg.pinv(np.vander((w - w[0]) / np.ptp(w), 3))
 
 
 def _fit_roots(coef, w):
