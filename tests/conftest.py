@@ -1,6 +1,7 @@
 """Shared fixtures. Guards against the unrelated PyPI ``modal`` shadowing ours."""
 from __future__ import annotations
 
+import functools
 import os
 from pathlib import Path
 
@@ -16,6 +17,23 @@ if "HYPOTHESIS_STORAGE_DIRECTORY" not in os.environ:
     from hypothesis.configuration import set_hypothesis_home_dir
 
     set_hypothesis_home_dir(os.path.join(tempfile.gettempdir(), f"modalbal-hypothesis-{os.getuid()}"))
+
+# with PYTHONDONTWRITEBYTECODE set, bytecode is cached outside the checkout (support.bytecode); set here,
+# before the xdist workers and the tests' subprocesses start, which inherit it; this process's import
+# system reads both settings at every import
+def _cache_bytecode() -> None:
+    import sys
+    import tempfile
+
+    from support.bytecode import cache_outside_the_checkout
+
+    prefix = cache_outside_the_checkout(os.environ, tempfile.gettempdir())
+    if prefix is not None:
+        sys.pycache_prefix = prefix
+        sys.dont_write_bytecode = False
+
+
+_cache_bytecode()
 
 
 def pytest_configure(config):
@@ -98,10 +116,54 @@ def real_dir() -> Path:
     return REAL
 
 
-@pytest.fixture(scope="session")
-def dask_cluster(tmp_path_factory):
-    """A real ``dask scheduler`` and two ``dask worker`` processes on 127.0.0.1: (address, folder, processes)."""
-    from support.daskcluster import cluster
+_CLUSTER = pytest.StashKey()
+_CLUSTER_LAST_USER = pytest.StashKey()
 
-    yield from cluster(tmp_path_factory)
+
+@pytest.fixture(scope="session")
+def _session_cluster(request, tmp_path_factory):
+    from support.daskcluster import SessionCluster
+
+    holder = request.session.stash[_CLUSTER] = SessionCluster(tmp_path_factory)
+    yield holder
+    holder.stop()
+
+
+@pytest.fixture(scope="module")
+def dask_cluster(_session_cluster):
+    """A real ``dask scheduler`` and two ``dask worker`` processes on 127.0.0.1: (address, folder, processes).
+
+    One cluster serves every file that asks for it; it stops after the last of them on this process
+    (:func:`pytest_runtest_teardown`), not at the end of the session."""
+    return _session_cluster.get()
+
+
+def pytest_collection_finish(session):
+    """The last test, in the run's order, that asks for the Dask cluster (a run in one process stops it there)."""
+    from support.daskcluster import last_user
+
+    fixtures = {item.nodeid: item.fixturenames for item in session.items}
+    session.stash[_CLUSTER_LAST_USER] = last_user(fixtures, lambda nodeid: "dask_cluster" in fixtures[nodeid])
+
+
+@pytest.hookimpl(trylast=True)
+def pytest_runtest_teardown(item, nextitem):
+    """Stop the Dask cluster once no test left on this process needs it (support.daskcluster.done_with_cluster);
+    after the test's own teardown, so the module fixtures built on the cluster are gone first."""
+    holder = item.session.stash.get(_CLUSTER, None)
+    if holder is None or not holder.running:
+        return
+    from support.daskcluster import done_with_cluster
+
+    if done_with_cluster(item.nodeid, None if nextitem is None else nextitem.nodeid,
+                         item.session.stash.get(_CLUSTER_LAST_USER, None),
+                         item.config.getvalue("dist") == "loadfile", _in_cluster_group):
+        holder.stop()
+
+
+@functools.lru_cache(maxsize=None)
+def _in_cluster_group(path: str) -> bool:
+    from support.workergroups import file_group
+
+    return file_group(path, ROOT) == "dask_cluster"
 

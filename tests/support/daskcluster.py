@@ -62,3 +62,59 @@ def cluster(tmp_path_factory):
         # too waits out its timeouts (8 s against 1 s)
         stop(procs[1:])
         stop(procs[:1])
+
+
+class SessionCluster:
+    """The run's cluster (:func:`cluster`), started when a test first asks for it and stopped by :meth:`stop`
+    as soon as no test left on this process needs it (conftest.py), not at the end of the session: an idle
+    scheduler with two nanny workers burns about 0.1 CPU-s every second (6.3 CPU-s a minute measured),
+    taken from the tests still running. Asked for again after a stop, it starts again."""
+
+    def __init__(self, tmp_path_factory):
+        self._factory = tmp_path_factory
+        self._run = None
+        self._value = None
+        #: how often the cluster was started (for the tests of this class)
+        self.starts = 0
+
+    @property
+    def running(self) -> bool:
+        return self._value is not None
+
+    def get(self):
+        """(address, folder, processes) of the running cluster, started if it is not."""
+        if self._value is None:
+            self._run = cluster(self._factory)
+            self._value = next(self._run)
+            self.starts += 1
+        return self._value
+
+    def stop(self) -> None:
+        """Stop the processes (workers first, as :func:`cluster` does); nothing if it is not running."""
+        run, self._run, self._value = self._run, None, None
+        if run is not None:
+            run.close()
+
+
+def last_user(nodeids, needs) -> str | None:
+    """Of tests run in the order ``nodeids``, the last that ``needs`` the cluster (a predicate on a node id)."""
+    last = None
+    for nodeid in nodeids:
+        if needs(nodeid):
+            last = nodeid
+    return last
+
+
+def done_with_cluster(nodeid: str, next_nodeid: str | None, last: str | None, file_groups: bool,
+                      in_group) -> bool:
+    """Whether no test left on this process needs the cluster after test ``nodeid``.
+
+    ``next_nodeid`` is the test this process runs next (None: none), ``last`` the last test of the run's
+    order that asks for the cluster (:func:`last_user`): in a run in one process the tests after it do
+    without. Under ``-n N``'s file groups (``file_groups``, :mod:`support.workergroups`) a worker gets every
+    file naming the cluster in one piece, the others' tests never in between: the group is over when the next
+    test's file is outside it (``in_group``, a predicate on a file's path relative to the root).
+    """
+    if next_nodeid is None or nodeid == last:
+        return True
+    return file_groups and not in_group(next_nodeid.split("::", 1)[0])

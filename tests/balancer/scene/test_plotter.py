@@ -26,7 +26,7 @@ def counting_fork():
     forks[0] += 1
     return _fork()
 os.fork = counting_fork
-from balancer.scene import run_scene, plots, stages
+from balancer.scene import run_scene
 from modal.errors import SceneError
 demo = {str(DEMO)!r}
 """
@@ -40,14 +40,20 @@ def _run(tmp_path: Path, body: str) -> dict:
     return json.loads(proc.stdout.strip().splitlines()[-1])
 
 
-def test_plots_from_child_processes_are_the_same_files(tmp_path):
+def test_plots_from_child_processes_are_the_same_files_and_the_parent_never_draws(tmp_path):
+    # the forked run first, in a fresh interpreter: the parent computes while its plotting process imports
+    # matplotlib's figure machinery (about 0.6 s), so the parent itself must not import it, or the two costs
+    # add up instead of overlapping; then the serial run, which draws in the parent
     out = _run(tmp_path, """
-serial = run_scene(demo, out="a.h5", plots_dir="a")
-before = forks[0]
 forked = run_scene(demo, out="b.h5", plots_dir="b", plot_jobs=2)
-out = {"serial": list(serial.plot_paths), "forked": list(forked.plot_paths), "forks": [before, forks[0]]}
+after_forked = forks[0]
+parent_drew = "matplotlib.figure" in sys.modules
+serial = run_scene(demo, out="a.h5", plots_dir="a")
+out = {"serial": list(serial.plot_paths), "forked": list(forked.plot_paths), "forks": [after_forked, forks[0]],
+       "parent_drew": parent_drew}
 """)
-    assert out["forks"][0] == 0 and out["forks"][1] >= 1  # plot_jobs=2 did fork, the default did not
+    assert out["forks"][0] >= 1 and out["forks"][1] == out["forks"][0]  # plot_jobs=2 did fork, the default did not
+    assert out["parent_drew"] is False
     names = [Path(p).name for p in out["serial"]]
     assert names == [Path(p).name for p in out["forked"]] and len(names) == 6
     for name in names:  # Agg output is deterministic: byte for byte
@@ -55,26 +61,11 @@ out = {"serial": list(serial.plot_paths), "forked": list(forked.plot_paths), "fo
     assert not list((tmp_path / "b").glob("*.tmp"))
 
 
-def test_a_forked_run_leaves_the_drawing_to_its_plotting_process(tmp_path):
-    # the parent computes while its plotting process imports matplotlib's figure machinery (about 0.6 s):
-    # the parent itself must not import it, or the two costs add up instead of overlapping
-    script = f"""
-import json, sys
-sys.path.insert(0, {str(ROOT)!r})
-from balancer.scene import run_scene
-run = run_scene({str(DEMO)!r}, out="c.h5", plots_dir="c", plot_jobs=2)
-print(json.dumps([len(run.plot_paths), "matplotlib.figure" in sys.modules]))
-"""
-    proc = subprocess.run([sys.executable, "-c", script], cwd=tmp_path, capture_output=True, text=True, timeout=300,
-                          env={**os.environ, "MPLBACKEND": "Agg"})
-    assert proc.returncode == 0, proc.stderr[-2000:]
-    assert json.loads(proc.stdout.strip().splitlines()[-1]) == [6, False]
-
-
 def test_a_failing_plot_in_a_child_is_reported(tmp_path):
     # the identify plot is the one handed to a child as soon as its stage is done (no child
     # is running yet then), so the failure happens in the child and must reach the caller
     out = _run(tmp_path, """
+from balancer.scene import plots
 def broken(results):
     raise ValueError("no figure today")
 plots.identify_figures = broken
@@ -92,6 +83,7 @@ def test_a_failing_stage_leaves_no_plots_drawn_early(tmp_path):
     # the identify plot is drawn by a child while the later stages run; when one of them
     # fails, the run writes nothing: no archive and no plot (as without plot_jobs)
     out = _run(tmp_path, """
+from balancer.scene import stages
 def broken(scene, **kwargs):
     raise SceneError("mounts: broken on purpose")
 stages.stage_mounts = broken
