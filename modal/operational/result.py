@@ -54,11 +54,13 @@ def _estimate(pole: PoleEstimate, band_hz) -> ModeEstimate:
 
 
 def oma_result(estimates: list[PoleEstimate], *, method: str, quantity: str | None, band_hz, stabilisation,
-               settings: dict, harmonics_hz=(), source: str = "<array>") -> IdentificationResult:
+               settings: dict, harmonics_hz=(), source: str = "<array>",
+               record_flags=frozenset()) -> IdentificationResult:
     """The result of an operational identification: one :class:`ModeResult` per estimate (in order of
     frequency) with k, c, m undefined, a warning per flagged mode, the stabilisation diagram and the machine
-    tones found."""
-    estimates = sorted(estimates, key=lambda e: abs(e.pole))
+    tones found. ``record_flags``: flags of the record (e.g. ``non_stationary``) that every mode carries."""
+    estimates = sorted((replace(e, flags=frozenset(e.flags) | frozenset(record_flags)) for e in estimates),
+                       key=lambda e: abs(e.pole))
     modes = assemble_modes([_estimate(e, band_hz) for e in estimates], method=method, source=source, single=False,
                            driving=None)
     n_ch = estimates[0].shape.size if estimates else int(settings.get("n_channels", 0))
