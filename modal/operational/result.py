@@ -113,10 +113,11 @@ def scaled_result(before: IdentificationResult, scaled, settings: dict) -> Ident
 
 def merged_result(first: IdentificationResult, merged, settings: dict, harmonics_hz) -> IdentificationResult:
     """Merged setups as one result: each entry of ``merged`` is (the first setup's mode, shape, shape's standard
-    error, (frequency Hz, its error), (damping ratio, its error), missing in a setup)."""
+    error, (frequency Hz, its error), (damping ratio, its error), the merge's flags: ``missing_in_setup``,
+    ``reference_at_node``)."""
     estimates = []
-    for mode, shape, shape_std, (f, sf), (z, sz), missing in merged:
-        estimates.append(_again(mode, {"missing_in_setup"} if missing else set(), mode_shape=np.asarray(shape, complex),
+    for mode, shape, shape_std, (f, sf), (z, sz), flags in merged:
+        estimates.append(_again(mode, set(flags), mode_shape=np.asarray(shape, complex),
                                 std_mode_shape=np.asarray(shape_std, float), omega_n=TWO_PI * f, damping_ratio=z,
                                 std_omega_n=TWO_PI * sf, std_damping_ratio=sz))
     modes = assemble_modes(estimates, method=first.method, source=_source(first), single=False, driving=None)

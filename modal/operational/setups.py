@@ -17,12 +17,15 @@ from ..results import IdentificationResult
 from .result import merged_result
 from .selection import shape_mac
 
-__all__ = ["merge_setups", "FREQ_TOL", "REF_MAC"]
+__all__ = ["merge_setups", "FREQ_TOL", "REF_MAC", "NODE_SIGMAS"]
 
 #: a mode of another setup lies within this relative frequency difference (or 3 combined standard errors)
 FREQ_TOL = 0.01
 #: ... and its reference entries have at least this MAC with the first setup's
 REF_MAC = 0.8
+#: a setup's scale factor within this many of its standard errors of zero is undetermined (the references sit at
+#: a node of the mode): for Gaussian errors a determined factor falls there with probability below 0.3 %
+NODE_SIGMAS = 3.0
 
 
 def _references(reference_channels, results) -> list[np.ndarray]:
@@ -103,6 +106,20 @@ def _find(mode, ref0, result, ref):
     return best
 
 
+def _scale(mode, ref0, other, ref) -> tuple[complex, float]:
+    """The factor ``a`` that maps ``other``'s reference entries onto ``mode``'s (least squares), and its standard
+    error to first order from both setups' reference entries' errors (NaN where a setup gives none):
+    ``σ_a² = Σ_r |φ_r|² (σ₁,r² + |a|² σ_r²) / (Σ_r |φ_r|²)²``. A reference entry within its errors of zero (a
+    reference at a node of the mode) leaves ``a`` undetermined: ``|a|`` comparable to ``σ_a``."""
+    phi, phi1 = np.asarray(other.mode_shape, complex)[ref], np.asarray(mode.mode_shape, complex)[ref0]
+    power = float(np.vdot(phi, phi).real)
+    a = np.vdot(phi, phi1) / power
+    std1 = np.asarray(mode.std.mode_shape, float)[ref0] if mode.std.mode_shape is not None else np.nan
+    std2 = np.asarray(other.std.mode_shape, float)[ref] if other.std.mode_shape is not None else np.nan
+    std_a = float(np.sqrt(np.sum(np.abs(phi) ** 2 * (std1**2 + abs(a) ** 2 * std2**2))) / power)
+    return complex(a), std_a
+
+
 def merge_setups(results, reference_channels) -> IdentificationResult:
     """Merge operational results of several setups into shapes over all their channels.
 
@@ -119,7 +136,9 @@ def merge_setups(results, reference_channels) -> IdentificationResult:
     IdentificationResult
         The first setup's modes; each shape holds the first setup's channels, then each further setup's
         non-reference channels in order. A mode missing from a setup has NaN there and the flag
-        ``missing_in_setup``.
+        ``missing_in_setup``; a mode that moves at none of a setup's references (the scale factor within
+        :data:`NODE_SIGMAS` of its standard error of zero, :func:`_scale`) has NaN there and the flag
+        ``reference_at_node``. The merged entries' standard errors include the scale factor's.
 
     Raises
     ------
@@ -140,22 +159,23 @@ def merge_setups(results, reference_channels) -> IdentificationResult:
                                 else np.full(mode.mode_shape.size, np.nan), float)]
         f, sf, z, sz = [mode.natural_frequency_hz], [mode.std.natural_frequency_hz], [mode.damping_ratio], \
             [mode.std.damping_ratio]
-        missing = False
+        flags = set()
         for result, ref, rest in zip(results[1:], refs[1:], others[1:]):
             other = _find(mode, refs[0], result, ref)
-            if other is None:
-                missing = True
+            a, std_a = (np.nan, np.nan) if other is None else _scale(mode, refs[0], other, ref)
+            if other is None or abs(a) <= NODE_SIGMAS * std_a:
+                flags.add("missing_in_setup" if other is None else "reference_at_node")
                 shape.append(np.full(rest.size, np.nan + 0j))
                 shape_std.append(np.full(rest.size, np.nan))
                 continue
             phi = np.asarray(other.mode_shape, complex)
-            a = np.vdot(phi[ref], mode.mode_shape[refs[0]]) / np.vdot(phi[ref], phi[ref])
             shape.append(a * phi[rest])
             s = other.std.mode_shape
-            shape_std.append(abs(a) * (np.asarray(s, float)[rest] if s is not None else np.full(rest.size, np.nan)))
+            s = np.asarray(s, float)[rest] if s is not None else np.full(rest.size, np.nan)
+            shape_std.append(np.hypot(abs(a) * s, np.abs(phi[rest]) * std_a))
             f.append(other.natural_frequency_hz), sf.append(other.std.natural_frequency_hz)
             z.append(other.damping_ratio), sz.append(other.std.damping_ratio)
-        merged.append((mode, np.concatenate(shape), np.concatenate(shape_std), _mean(f, sf), _mean(z, sz), missing))
+        merged.append((mode, np.concatenate(shape), np.concatenate(shape_std), _mean(f, sf), _mean(z, sz), flags))
     names = []
     for k, (result, rest) in enumerate(zip(results, others)):
         own = list(result.settings.get("channel_names") or range(result.n_channels))
