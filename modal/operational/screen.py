@@ -251,7 +251,7 @@ def warn_transients(prepared) -> bool:
         return False
     warn(f"{prepared.source}: the record is not stationary random response: {_channel_label(prepared.names, ch)} "
          f"has kurtosis {kurtosis:.3g} ({excess / std:.0f} standard errors above a Gaussian response's 3): hammer "
-         "hits, shocks or bursts ringing down; operational analysis assumes stationary random forces, and its "
+         "hits, shocks or bursts ringing down (or steps: a dropout to zero); operational analysis assumes stationary random forces, and its "
          "frequencies, damping and error bars are biased (modes flagged non_stationary): for a hammer test with a "
          "force channel use python -m modal fit --impact, otherwise cut the transients out or record the machine "
          "running steadily", QualityWarning)

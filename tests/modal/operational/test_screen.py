@@ -201,6 +201,9 @@ def test_hammer_responses_given_to_oma_are_flagged_non_stationary():
     record_level = [t for t in texts if t.startswith("<array>: the record is not stationary random response")]
     assert len(record_level) == 1
     assert "kurtosis" in record_level[0] and "modal fit --impact" in record_level[0]
+    # the quick look's peaks carry it too
+    quick, _ = _oma(signals, 100.0, method="efdd")
+    assert len(quick) and all("non_stationary" in mode.flags for mode in quick)
 
 
 def test_frequent_hits_are_flagged_as_well():
