@@ -19,7 +19,7 @@ from ..results import IdentificationResult
 from .correlations import choose_references, correlations
 from .inputs import MIN_LAGS_IN_RECORD, Prepared, prepare
 from .modes import error_blocks, estimates_from_clusters, resolved
-from .tones import nearly_undamped, separate_tones
+from .tones import flag_mains_hum, nearly_undamped, separate_tones
 from .result import oma_result
 from .screen import warn_transients, warn_unresponsive
 from .selection import OMAStabilisation, mpc, stabilise
@@ -187,6 +187,7 @@ def oma(data, sample_rate_hz: float | None = None, *, band_hz=None, method: str 
     resolution_hz = corr.sample_rate_hz / corr.max_lag  # what the correlation lags tell apart
     estimates, tones, dropped, diagram = _sort_out(estimates, chosen, clusters, flat, stable, prepared,
                                                    rotor_speed_hz, method, resolution_hz)
+    estimates = flag_mains_hum(estimates, prepared)
     if not estimates and not tones:
         raise IdentificationError(f"{prepared.source}: no stable pole in the band {prepared.band_hz[0]:g}-"
                                   f"{prepared.band_hz[1]:g} Hz (orders {settings['orders'][0]}-"
