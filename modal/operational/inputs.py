@@ -12,7 +12,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from .correlations import decimate, decimation_factor
-from .screen import check_units, screen_samples
+from .screen import check_held, check_units, screen_samples
 
 __all__ = ["Prepared", "prepare", "check_band", "channel_statistics"]
 
@@ -328,6 +328,7 @@ def prepare(data, sample_rate_hz=None, band_hz=None, quantity: str | None = None
     if not (np.isfinite(rate) and rate > 0):
         raise ParameterError(f"{src}: 'sample_rate_hz' is {rate!r}; expected a positive number of samples per second")
     low, high = check_band(band_hz, rate / 2, src)
+    check_held(signals, rate, (low, high), src, names)
     factor = decimation_factor(rate, high)
     # a record to be decimated is centred (an offset would ring in the filter) and filtered in double precision,
     # channel by channel; any other is used as it is stored (see Prepared)

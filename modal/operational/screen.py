@@ -12,6 +12,9 @@ what suffers are the shapes and the errors, silently. These checks name the dama
 * :func:`unresponsive_channels`: a channel whose shape entry is indistinguishable from zero in every
   mode found does not respond to the structure's modes: a disconnected or dead sensor, a channel
   that is not a response (a force, a tachometer pulse), or a sensor on a node of every mode: warned.
+* :func:`held_factor`: a channel that repeats each sample h times (sampled at a rate h times lower than the
+  record says, written out by holding each sample) holds images of its modes above its real Nyquist
+  frequency: a band reaching above it is refused (:func:`check_held`).
 * :func:`transient_kurtosis`: a record of transients (hammer hits, shocks, bursts) rather than stationary
   random response: its modes are flagged ``non_stationary`` and the record warned of.
 
@@ -27,7 +30,7 @@ import numpy as np
 from ..errors import ParameterError, QualityWarning, warn
 
 __all__ = ["check_units", "screen_samples", "stuck_runs", "unresponsive_channels", "transient_kurtosis",
-           "warn_transients", "STRIDE", "MIN_STUCK_SAMPLES", "NODE_SIGMAS", "TRANSIENT_SIGMAS", "TRANSIENT_KURTOSIS"]
+           "warn_transients", "held_factor", "check_held", "STRIDE", "MIN_STUCK_SAMPLES", "NODE_SIGMAS", "TRANSIENT_SIGMAS", "TRANSIENT_KURTOSIS"]
 
 #: the sample checks first look at every STRIDE-th sample of each channel
 STRIDE = 128
@@ -47,6 +50,12 @@ TRANSIENT_SIGMAS = 6.0
 #: ... and at least this far from 3 (a Gaussian response's kurtosis; a sinusoid's 1.5): a deviation too small to
 #: bias the covariances, however well determined, is not named
 TRANSIENT_KURTOSIS = 4.0
+#: the hold check reads this many samples of each channel from its start
+HELD_SAMPLES = 1 << 14
+#: ... and calls a channel held when at least this fraction of its neighbouring samples repeat exactly, every one
+#: of them within a run of one length h (a measured response sampled at its rate repeats a value between two
+#: neighbours rarely: never in the shipped real record; a coarsely quantised one often, but in runs of any length)
+HELD_FRACTION = 0.45
 #: the kurtosis is judged on at most this many channels (spread over the record's channels; transients reach them
 #: all) ...
 TRANSIENT_CHANNELS = 8
@@ -256,3 +265,40 @@ def warn_transients(prepared) -> bool:
          "force channel use python -m modal fit --impact, otherwise cut the transients out or record the machine "
          "running steadily", QualityWarning)
     return True
+
+
+def held_factor(row: np.ndarray) -> int:
+    """h when ``row`` repeats each sample h times (h ≥ 2: all but one in every h neighbouring pairs equal, the
+    changes exactly h samples apart) over its first :data:`HELD_SAMPLES`, else 1."""
+    head = np.asarray(row[:HELD_SAMPLES])
+    if head.size < 16:
+        return 1
+    same = head[1:] == head[:-1]
+    if same.mean() < HELD_FRACTION:
+        return 1
+    changes = np.flatnonzero(~same)
+    if changes.size < 8:
+        return 1  # a stuck channel (screen_samples names it), not a held one
+    gaps = np.diff(changes)
+    h = int(np.median(gaps))
+    return h if h >= 2 and np.all(gaps % h == 0) and np.mean(gaps == h) > 0.5 else 1
+
+
+def check_held(signals: np.ndarray, sample_rate_hz: float, band_hz, src: str, names=()) -> None:
+    """Refuse a band reaching above the real Nyquist frequency of channels that repeat each sample
+    (:func:`held_factor`): there they hold images of the modes below it, which the identification reports as
+    modes (a 50 Hz record written at 100 Hz by holding gave 'modes' at 38.6 and 38.8 Hz, images of 11.4 and 11.2)."""
+    factors = [held_factor(row) for row in signals]
+    held = [ch for ch, h in enumerate(factors) if h > 1]
+    if not held:
+        return
+    h = max(factors[ch] for ch in held)
+    nyquist = sample_rate_hz / (2 * h)
+    if band_hz[1] <= nyquist:
+        return
+    listing = "every channel" if len(held) == signals.shape[0] else ", ".join(_channel_label(names, ch) for ch in held)
+    raise ParameterError(f"{src}: {listing} repeat{'' if 1 < len(held) < signals.shape[0] else 's'} each sample {h} times: sampled at "
+                         f"{sample_rate_hz / h:g} Hz and written at {sample_rate_hz:g} Hz, so above {nyquist:g} Hz "
+                         f"{'it holds' if len(held) == 1 else 'they hold'} images of the modes below, not modes; "
+                         f"expected a band up to {nyquist:g} Hz ('band_hz', --band; the band asked for reaches "
+                         f"{band_hz[1]:g} Hz), or the record at its own rate")

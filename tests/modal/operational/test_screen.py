@@ -16,8 +16,8 @@ from modal.errors import ParameterError, QualityWarning
 from modal.io.timedata import TimeRecord, read_time
 from modal.io.timewrite import write_time
 from modal.operational.inputs import prepare
-from modal.operational.screen import (MIN_STUCK_SAMPLES, TRANSIENT_KURTOSIS, TRANSIENT_SIGMAS, screen_samples,
-                                     stuck_runs, transient_kurtosis)
+from modal.operational.screen import (HELD_FRACTION, MIN_STUCK_SAMPLES, TRANSIENT_KURTOSIS, TRANSIENT_SIGMAS,
+                                     held_factor, screen_samples, stuck_runs, transient_kurtosis)
 from support.ambient import anchor_record
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -246,3 +246,33 @@ def test_hammer_file_given_to_modal_oma_says_so_on_the_command_line(tmp_path):
     flags = [mode["flags"] for mode in doc["modes"]]
     assert flags and all("non_stationary" in f for f in flags)
     assert "hammer_responses.h5: the record is not stationary random response" in done.stderr
+
+
+# -- samples held: a record written at a multiple of the rate it was sampled at ----------------------------
+
+
+def test_held_samples_above_their_nyquist_frequency_are_refused():
+    # a 50 Hz record written at 100 Hz by holding each sample twice: over the default band (to 40 Hz) SSI reported
+    # unflagged 'modes' at 38.58 Hz (0.36 %) and 38.81 Hz, images of the 11.41 and 11.2 Hz modes about 25 Hz
+    slow = anchor_record(7, noise=0.1, tones=False, duration_s=300, sample_rate_hz=50.0)
+    held = np.repeat(slow.signals, 2, axis=1)
+    with pytest.raises(ParameterError, match=r"<array>: every channel repeats each sample 2 times: sampled at 50 Hz "
+                                             r"and written at 100 Hz, so above 25 Hz .* expected a band up to 25 Hz"):
+        prepare(held, 100.0)
+    # over a band below its real Nyquist frequency the record is what it is
+    assert prepare(held, 100.0, (1.0, 24.0)).band_hz == (1.0, 24.0)
+    # one channel held among channels sampled at the record's rate is named
+    mixed = anchor_record(8, noise=0.1, tones=False, duration_s=300).signals.copy()
+    mixed[2] = held[2]
+    with pytest.raises(ParameterError, match=r"<array>: channel 3 repeats each sample 2 times"):
+        prepare(mixed, 100.0, (1.0, 30.0))
+
+
+def test_real_and_quantised_records_are_not_held(record):
+    real = read_time(REAL)
+    assert [held_factor(row) for row in real.signals] == [1] * 4
+    # quantised to a few codes: many neighbours repeat, in runs of every length
+    code = 2 * record.signals.std()  # three codes or so: 59 % of neighbours repeat
+    coarse = np.round(record.signals / code) * code
+    assert np.mean(coarse[0, 1:] == coarse[0, :-1]) > HELD_FRACTION
+    assert [held_factor(row) for row in coarse] == [1] * 8
