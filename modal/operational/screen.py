@@ -59,8 +59,9 @@ HELD_FRACTION = 0.45
 #: the kurtosis is judged on at most this many channels (spread over the record's channels; transients reach them
 #: all) ...
 TRANSIENT_CHANNELS = 8
-#: ... and on at most about this many samples of each (every k-th: the band's responses span several samples)
-TRANSIENT_SAMPLES = 1 << 18
+#: ... and on at most about this many samples of each (every k-th: the band's responses span several samples; its
+#: standard error's correlation sum, one FFT of twice this length, costs about 10 ms)
+TRANSIENT_SAMPLES = 1 << 16
 
 
 def _channel_label(names, ch: int) -> str:
