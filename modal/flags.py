@@ -111,9 +111,6 @@ FLAG_TEXT = {
                           "the mode barely moves): the mass-normalised shape and k, c, m are poorly determined"),
     "missing_in_setup": ("merged setups: the mode was not found in every setup; the shape entries of the setups "
                          "without it are NaN"),
-    "reference_at_node": ("merged setups: the mode barely moves at a setup's reference channels (the factor that "
-                          "scales that setup's shape onto the first's lies within 3 of its standard errors of zero): "
-                          "its shape entries there are NaN"),
     "mains_hum": ("operational: the mode lies within 1 % of a multiple of the mains frequency (50 or 60 Hz) where a "
                   "channel's spectrum holds a line far above its surroundings: electrical hum; frequency, damping and "
                   "shape may be the hum's"),
@@ -189,7 +186,6 @@ FLAG_ACTION = {
     "harmonic": "check the running speed; measure at another speed to move the tone off the mode",
     "scaling_uncertain": "add more mass (a frequency shift of 2-5 %), where the mode moves most",
     "missing_in_setup": "excite the mode better in that setup, or leave its channels out of the merged shape",
-    "reference_at_node": "choose references that move in every mode of interest (away from its nodes), or add one",
     "mains_hum": "ground the sensors' cables at one point (a ground loop) or shield them, and measure again; or "
                  "leave the humming channels out",
     "non_stationary": "for a hammer test with a force channel use modal fit --impact; otherwise cut the transients "

@@ -113,8 +113,7 @@ def scaled_result(before: IdentificationResult, scaled, settings: dict) -> Ident
 
 def merged_result(first: IdentificationResult, merged, settings: dict, harmonics_hz) -> IdentificationResult:
     """Merged setups as one result: each entry of ``merged`` is (the first setup's mode, shape, shape's standard
-    error, (frequency Hz, its error), (damping ratio, its error), the merge's flags: ``missing_in_setup``,
-    ``reference_at_node``)."""
+    error, (frequency Hz, its error), (damping ratio, its error), the merge's flags: ``missing_in_setup``)."""
     estimates = []
     for mode, shape, shape_std, (f, sf), (z, sz), flags in merged:
         estimates.append(_again(mode, set(flags), mode_shape=np.asarray(shape, complex),

@@ -17,15 +17,12 @@ from ..results import IdentificationResult
 from .result import merged_result
 from .selection import shape_mac
 
-__all__ = ["merge_setups", "FREQ_TOL", "REF_MAC", "NODE_SIGMAS"]
+__all__ = ["merge_setups", "FREQ_TOL", "REF_MAC"]
 
 #: a mode of another setup lies within this relative frequency difference (or 3 combined standard errors)
 FREQ_TOL = 0.01
 #: ... and its reference entries have at least this MAC with the first setup's
 REF_MAC = 0.8
-#: a setup's scale factor within this many of its standard errors of zero is undetermined (the references sit at
-#: a node of the mode): for Gaussian errors a determined factor falls there with probability below 0.3 %
-NODE_SIGMAS = 3.0
 
 
 def _references(reference_channels, results) -> list[np.ndarray]:
@@ -136,9 +133,8 @@ def merge_setups(results, reference_channels) -> IdentificationResult:
     IdentificationResult
         The first setup's modes; each shape holds the first setup's channels, then each further setup's
         non-reference channels in order. A mode missing from a setup has NaN there and the flag
-        ``missing_in_setup``; a mode that moves at none of a setup's references (the scale factor within
-        :data:`NODE_SIGMAS` of its standard error of zero, :func:`_scale`) has NaN there and the flag
-        ``reference_at_node``. The merged entries' standard errors include the scale factor's.
+        ``missing_in_setup``. The merged entries' standard errors include the scale factor's (:func:`_scale`):
+        references near a node of a mode leave that setup's entries of it as uncertain as the factor.
 
     Raises
     ------
@@ -162,12 +158,12 @@ def merge_setups(results, reference_channels) -> IdentificationResult:
         flags = set()
         for result, ref, rest in zip(results[1:], refs[1:], others[1:]):
             other = _find(mode, refs[0], result, ref)
-            a, std_a = (np.nan, np.nan) if other is None else _scale(mode, refs[0], other, ref)
-            if other is None or abs(a) <= NODE_SIGMAS * std_a:
-                flags.add("missing_in_setup" if other is None else "reference_at_node")
+            if other is None:
+                flags.add("missing_in_setup")
                 shape.append(np.full(rest.size, np.nan + 0j))
                 shape_std.append(np.full(rest.size, np.nan))
                 continue
+            a, std_a = _scale(mode, refs[0], other, ref)
             phi = np.asarray(other.mode_shape, complex)
             shape.append(a * phi[rest])
             s = other.std.mode_shape
