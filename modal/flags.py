@@ -111,6 +111,12 @@ FLAG_TEXT = {
                           "the mode barely moves): the mass-normalised shape and k, c, m are poorly determined"),
     "missing_in_setup": ("merged setups: the mode was not found in every setup; the shape entries of the setups "
                          "without it are NaN"),
+    "mains_hum": ("operational: the mode lies within 1 % of a multiple of the mains frequency (50 or 60 Hz) where a "
+                  "channel's spectrum holds a line far above its surroundings: electrical hum; frequency, damping and "
+                  "shape may be the hum's"),
+    "non_stationary": ("operational: the record is not stationary random response (its kurtosis lies far above a "
+                       "Gaussian response's 3: hammer hits, shocks or bursts ringing down): frequency, damping and "
+                       "their errors assume stationary random forces and are biased"),
 }
 
 
@@ -180,6 +186,10 @@ FLAG_ACTION = {
     "harmonic": "check the running speed; measure at another speed to move the tone off the mode",
     "scaling_uncertain": "add more mass (a frequency shift of 2-5 %), where the mode moves most",
     "missing_in_setup": "excite the mode better in that setup, or leave its channels out of the merged shape",
+    "mains_hum": "ground the sensors' cables at one point (a ground loop) or shield them, and measure again; or "
+                 "leave the humming channels out",
+    "non_stationary": "for a hammer test with a force channel use modal fit --impact; otherwise cut the transients "
+                      "out of the record or measure while the machine runs steadily",
 }
 
 #: Flags of an estimate the line spacing limits: its error includes the grid's quantisation

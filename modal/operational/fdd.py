@@ -82,9 +82,10 @@ def _decay(lines, S, u_peak, v_peak, bell, fs, beta):
     return complex(-(sigma - beta), abs(omega_d))
 
 
-def fdd(prepared: Prepared, refs, *, enhanced: bool, rotor_speed_hz=None):
-    """FDD (``enhanced=False``) or EFDD of a prepared record: an :class:`~modal.results.IdentificationResult`."""
-    from .tones import separate_tones
+def fdd(prepared: Prepared, refs, *, enhanced: bool, rotor_speed_hz=None, record_flags=frozenset()):
+    """FDD (``enhanced=False``) or EFDD of a prepared record: an :class:`~modal.results.IdentificationResult`
+    (``record_flags`` on every mode, see :func:`modal.operational.result.oma_result`)."""
+    from .tones import flag_mains_hum, separate_tones
 
     lines, s1, u1, S, beta = singular_values(prepared, refs)
     fs = prepared.sample_rate_hz
@@ -115,7 +116,7 @@ def fdd(prepared: Prepared, refs, *, enhanced: bool, rotor_speed_hz=None):
                 pole, known = found, True
         estimates.append(PoleEstimate(pole, shape, np.nan, np.nan, nan_shape, 1, 1, 0, damping_known=known))
     is_tone, estimates = separate_tones(estimates, prepared, rotor_speed_hz, 4 * (lines[1] - lines[0]))
-    modes = [e for e, t in zip(estimates, is_tone) if not t]
+    modes = flag_mains_hum([e for e, t in zip(estimates, is_tone) if not t], prepared)
     tones = [e.natural_frequency_hz for e, t in zip(estimates, is_tone) if t]
     method = "efdd" if enhanced else "fdd"
     settings = {"band_hz": list(prepared.band_hz), "reference_channels": list(refs),
@@ -124,4 +125,5 @@ def fdd(prepared: Prepared, refs, *, enhanced: bool, rotor_speed_hz=None):
                 "channel_names": list(prepared.names), "n_channels": prepared.n_channels, "source": prepared.source,
                 "window_decay_per_s": float(beta), "line_spacing_hz": float(lines[1] - lines[0])}
     return oma_result(modes, method=method, quantity=prepared.quantity, band_hz=prepared.band_hz,
-                      stabilisation=None, settings=settings, harmonics_hz=tones, source=prepared.source)
+                      stabilisation=None, settings=settings, harmonics_hz=tones, source=prepared.source,
+                      record_flags=record_flags)

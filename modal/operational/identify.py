@@ -19,9 +19,9 @@ from ..results import IdentificationResult
 from .correlations import choose_references, correlations
 from .inputs import MIN_LAGS_IN_RECORD, Prepared, prepare
 from .modes import error_blocks, estimates_from_clusters, resolved
-from .tones import nearly_undamped, separate_tones
+from .tones import flag_mains_hum, nearly_undamped, separate_tones
 from .result import oma_result
-from .screen import warn_unresponsive
+from .screen import warn_transients, warn_unresponsive
 from .selection import OMAStabilisation, mpc, stabilise
 
 __all__ = ["oma", "OMA_METHODS"]
@@ -161,7 +161,8 @@ def oma(data, sample_rate_hz: float | None = None, *, band_hz=None, method: str 
     -----
     QualityWarning
         A flagged mode; a dropout (a run of identical samples) or a clipped channel; a channel that
-        moves in none of the modes found (:mod:`modal.operational.screen`).
+        moves in none of the modes found; a record of transients (hammer hits, shocks), its modes flagged
+        ``non_stationary`` (:mod:`modal.operational.screen`).
     """
     if method not in OMA_METHODS:
         raise ParameterError(f"'method' is {method!r}; expected one of {', '.join(OMA_METHODS)}")
@@ -169,10 +170,12 @@ def oma(data, sample_rate_hz: float | None = None, *, band_hz=None, method: str 
         raise ParameterError(f"'rotor_speed_hz' is {rotor_speed_hz!r}; expected a positive frequency in Hz")
     prepared = prepare(data, sample_rate_hz, band_hz, quantity)
     refs = _references(prepared, reference_channels)
+    record_flags = frozenset({"non_stationary"}) if warn_transients(prepared) else frozenset()
     if method in ("fdd", "efdd"):
         from .fdd import fdd
 
-        result = fdd(prepared, refs, enhanced=method == "efdd", rotor_speed_hz=rotor_speed_hz)
+        result = fdd(prepared, refs, enhanced=method == "efdd", rotor_speed_hz=rotor_speed_hz,
+                     record_flags=record_flags)
         warn_unresponsive(result, prepared.source)
         return result
     if method == "ssi":
@@ -184,6 +187,7 @@ def oma(data, sample_rate_hz: float | None = None, *, band_hz=None, method: str 
     resolution_hz = corr.sample_rate_hz / corr.max_lag  # what the correlation lags tell apart
     estimates, tones, dropped, diagram = _sort_out(estimates, chosen, clusters, flat, stable, prepared,
                                                    rotor_speed_hz, method, resolution_hz)
+    estimates = flag_mains_hum(estimates, prepared)
     if not estimates and not tones:
         raise IdentificationError(f"{prepared.source}: no stable pole in the band {prepared.band_hz[0]:g}-"
                                   f"{prepared.band_hz[1]:g} Hz (orders {settings['orders'][0]}-"
@@ -194,7 +198,8 @@ def oma(data, sample_rate_hz: float | None = None, *, band_hz=None, method: str 
                 "channel_names": list(prepared.names), "n_channels": prepared.n_channels, "source": prepared.source,
                 "dropped_unresolved_hz": dropped}
     result = oma_result(estimates, method=method, quantity=prepared.quantity, band_hz=prepared.band_hz,
-                        stabilisation=diagram, settings=settings, harmonics_hz=tones, source=prepared.source)
+                        stabilisation=diagram, settings=settings, harmonics_hz=tones, source=prepared.source,
+                        record_flags=record_flags)
     warn_unresponsive(result, prepared.source)
     return result
 

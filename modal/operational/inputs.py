@@ -12,7 +12,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from .correlations import decimate, decimation_factor
-from .screen import check_units, screen_samples
+from .screen import check_held, check_units, screen_samples
 
 __all__ = ["Prepared", "prepare", "check_band", "channel_statistics"]
 
@@ -109,7 +109,24 @@ def _record(data, sample_rate_hz):
     if sample_rate_hz is None:
         raise ParameterError("<array>: 'sample_rate_hz' is missing; expected the sampling rate in Hz for an array")
     names = tuple(str(k) for k in range(arr.shape[0])) if arr.ndim == 2 else ()
+    _warn_low_rate(sample_rate_hz)
     return _real_samples(arr), float(sample_rate_hz), None, names, "<array>"
+
+
+def _warn_low_rate(sample_rate_hz) -> None:
+    """Name an array's rate below what vibration tests sample at (:data:`modal.io.timedata.LOW_RATE_HZ`, as for a
+    file's rate field): a rate in kHz given as Hz divides every frequency by 1000, and the modes still come out
+    stable and within their errors."""
+    from ..errors import QualityWarning, warn
+    from ..io.timedata import LOW_RATE_HZ
+
+    try:
+        rate = float(sample_rate_hz)
+    except (TypeError, ValueError):
+        return  # refused by prepare, naming the value
+    if np.isfinite(rate) and 0 < rate < LOW_RATE_HZ:
+        warn(f"<array>: 'sample_rate_hz' is {rate:.6g} Hz, below what vibration tests sample at ({LOW_RATE_HZ:g} Hz); "
+             f"every frequency scales with it: if it is in kHz, give {1000 * rate:.6g} (Hz)", QualityWarning)
 
 
 def _real_samples(signals) -> np.ndarray:
@@ -311,6 +328,7 @@ def prepare(data, sample_rate_hz=None, band_hz=None, quantity: str | None = None
     if not (np.isfinite(rate) and rate > 0):
         raise ParameterError(f"{src}: 'sample_rate_hz' is {rate!r}; expected a positive number of samples per second")
     low, high = check_band(band_hz, rate / 2, src)
+    check_held(signals, rate, (low, high), src, names)
     factor = decimation_factor(rate, high)
     # a record to be decimated is centred (an offset would ring in the filter) and filtered in double precision,
     # channel by channel; any other is used as it is stored (see Prepared)

@@ -54,11 +54,13 @@ def _estimate(pole: PoleEstimate, band_hz) -> ModeEstimate:
 
 
 def oma_result(estimates: list[PoleEstimate], *, method: str, quantity: str | None, band_hz, stabilisation,
-               settings: dict, harmonics_hz=(), source: str = "<array>") -> IdentificationResult:
+               settings: dict, harmonics_hz=(), source: str = "<array>",
+               record_flags=frozenset()) -> IdentificationResult:
     """The result of an operational identification: one :class:`ModeResult` per estimate (in order of
     frequency) with k, c, m undefined, a warning per flagged mode, the stabilisation diagram and the machine
-    tones found."""
-    estimates = sorted(estimates, key=lambda e: abs(e.pole))
+    tones found. ``record_flags``: flags of the record (e.g. ``non_stationary``) that every mode carries."""
+    estimates = sorted((replace(e, flags=frozenset(e.flags) | frozenset(record_flags)) for e in estimates),
+                       key=lambda e: abs(e.pole))
     modes = assemble_modes([_estimate(e, band_hz) for e in estimates], method=method, source=source, single=False,
                            driving=None)
     n_ch = estimates[0].shape.size if estimates else int(settings.get("n_channels", 0))
@@ -111,10 +113,10 @@ def scaled_result(before: IdentificationResult, scaled, settings: dict) -> Ident
 
 def merged_result(first: IdentificationResult, merged, settings: dict, harmonics_hz) -> IdentificationResult:
     """Merged setups as one result: each entry of ``merged`` is (the first setup's mode, shape, shape's standard
-    error, (frequency Hz, its error), (damping ratio, its error), missing in a setup)."""
+    error, (frequency Hz, its error), (damping ratio, its error), the merge's flags: ``missing_in_setup``)."""
     estimates = []
-    for mode, shape, shape_std, (f, sf), (z, sz), missing in merged:
-        estimates.append(_again(mode, {"missing_in_setup"} if missing else set(), mode_shape=np.asarray(shape, complex),
+    for mode, shape, shape_std, (f, sf), (z, sz), flags in merged:
+        estimates.append(_again(mode, set(flags), mode_shape=np.asarray(shape, complex),
                                 std_mode_shape=np.asarray(shape_std, float), omega_n=TWO_PI * f, damping_ratio=z,
                                 std_omega_n=TWO_PI * sf, std_damping_ratio=sz))
     modes = assemble_modes(estimates, method=first.method, source=_source(first), single=False, driving=None)

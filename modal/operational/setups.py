@@ -103,6 +103,20 @@ def _find(mode, ref0, result, ref):
     return best
 
 
+def _scale(mode, ref0, other, ref) -> tuple[complex, float]:
+    """The factor ``a`` that maps ``other``'s reference entries onto ``mode``'s (least squares), and its standard
+    error to first order from both setups' reference entries' errors (NaN where a setup gives none):
+    ``σ_a² = Σ_r |φ_r|² (σ₁,r² + |a|² σ_r²) / (Σ_r |φ_r|²)²``. A reference entry within its errors of zero (a
+    reference at a node of the mode) leaves ``a`` undetermined: ``|a|`` comparable to ``σ_a``."""
+    phi, phi1 = np.asarray(other.mode_shape, complex)[ref], np.asarray(mode.mode_shape, complex)[ref0]
+    power = float(np.vdot(phi, phi).real)
+    a = np.vdot(phi, phi1) / power
+    std1 = np.asarray(mode.std.mode_shape, float)[ref0] if mode.std.mode_shape is not None else np.nan
+    std2 = np.asarray(other.std.mode_shape, float)[ref] if other.std.mode_shape is not None else np.nan
+    std_a = float(np.sqrt(np.sum(np.abs(phi) ** 2 * (std1**2 + abs(a) ** 2 * std2**2))) / power)
+    return complex(a), std_a
+
+
 def merge_setups(results, reference_channels) -> IdentificationResult:
     """Merge operational results of several setups into shapes over all their channels.
 
@@ -119,7 +133,8 @@ def merge_setups(results, reference_channels) -> IdentificationResult:
     IdentificationResult
         The first setup's modes; each shape holds the first setup's channels, then each further setup's
         non-reference channels in order. A mode missing from a setup has NaN there and the flag
-        ``missing_in_setup``.
+        ``missing_in_setup``. The merged entries' standard errors include the scale factor's (:func:`_scale`):
+        references near a node of a mode leave that setup's entries of it as uncertain as the factor.
 
     Raises
     ------
@@ -140,22 +155,23 @@ def merge_setups(results, reference_channels) -> IdentificationResult:
                                 else np.full(mode.mode_shape.size, np.nan), float)]
         f, sf, z, sz = [mode.natural_frequency_hz], [mode.std.natural_frequency_hz], [mode.damping_ratio], \
             [mode.std.damping_ratio]
-        missing = False
+        flags = set()
         for result, ref, rest in zip(results[1:], refs[1:], others[1:]):
             other = _find(mode, refs[0], result, ref)
             if other is None:
-                missing = True
+                flags.add("missing_in_setup")
                 shape.append(np.full(rest.size, np.nan + 0j))
                 shape_std.append(np.full(rest.size, np.nan))
                 continue
+            a, std_a = _scale(mode, refs[0], other, ref)
             phi = np.asarray(other.mode_shape, complex)
-            a = np.vdot(phi[ref], mode.mode_shape[refs[0]]) / np.vdot(phi[ref], phi[ref])
             shape.append(a * phi[rest])
             s = other.std.mode_shape
-            shape_std.append(abs(a) * (np.asarray(s, float)[rest] if s is not None else np.full(rest.size, np.nan)))
+            s = np.asarray(s, float)[rest] if s is not None else np.full(rest.size, np.nan)
+            shape_std.append(np.hypot(abs(a) * s, np.abs(phi[rest]) * std_a))
             f.append(other.natural_frequency_hz), sf.append(other.std.natural_frequency_hz)
             z.append(other.damping_ratio), sz.append(other.std.damping_ratio)
-        merged.append((mode, np.concatenate(shape), np.concatenate(shape_std), _mean(f, sf), _mean(z, sz), missing))
+        merged.append((mode, np.concatenate(shape), np.concatenate(shape_std), _mean(f, sf), _mean(z, sz), flags))
     names = []
     for k, (result, rest) in enumerate(zip(results, others)):
         own = list(result.settings.get("channel_names") or range(result.n_channels))

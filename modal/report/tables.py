@@ -60,7 +60,7 @@ def jsonable(obj):
     if isinstance(obj, (list, tuple)):
         return [jsonable(v) for v in obj]
     if isinstance(obj, complex):
-        return {"re": obj.real, "im": obj.imag}
+        return {"re": jsonable(obj.real), "im": jsonable(obj.imag)}
     if isinstance(obj, float) and not np.isfinite(obj):
         return None
     return obj

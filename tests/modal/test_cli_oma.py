@@ -62,6 +62,22 @@ def test_setups_are_merged(tmp_path):
     assert refused.returncode == 1 and refused.stderr.startswith("error:") and "--reference-channels" in refused.stderr
 
 
+def test_setups_with_a_mode_missing_from_one_print_json(tmp_path):
+    # setup 2 holds the two lowest modes only: the merged shapes of the others are NaN there, which --json wrote
+    # as {"re": NaN} and stopped on with a traceback (JSON has no NaN)
+    from modal.synthetic import ambient_modal_response
+    from support.ambient import FN, ZETA, anchor_shapes
+
+    one = _write(tmp_path / "s1.h5", anchor_record(52, noise=0.1, tones=False), [0, 5, 1, 2, 3])
+    two = _write(tmp_path / "s2.h5", ambient_modal_response(FN[:2], ZETA[:2], anchor_shapes()[[0, 5, 4, 6, 7], :2],
+                                                            100.0, 100_000, seed=44))
+    done = _run("oma", one, two, "--band", 1, 30, "--reference-channels", 1, 2, "--json")
+    assert done.returncode == 0, done.stderr
+    modes = json.loads(done.stdout)["modes"]
+    missing = [m for m in modes if "missing_in_setup" in m["flags"]]
+    assert missing and all(v["re"] is None for m in missing for v in m["mode_shape"][5:])
+
+
 def test_bad_band_is_one_error_line(tmp_path):
     path = _write(tmp_path / "ambient.h5", anchor_record(54, noise=0.1, tones=False, duration_s=300))
     done = _run("oma", path, "--band", 10, 80)

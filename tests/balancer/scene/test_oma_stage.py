@@ -118,3 +118,22 @@ def test_k_c_m_at_a_channel_that_does_not_move_are_refused(tmp_path):
     assert "\n" not in str(info.value)
     # modal oma says so too, of both records
     assert sum("channel 5 moves in none of the 4 modes" in str(w.message) for w in caught) == 2
+
+
+def test_a_record_of_bursts_does_not_feed_the_study(tmp_path):
+    # the 'before' record holds the machine's response in bursts (running 2 s of every 10, idle between): not
+    # stationary, its modes flagged non_stationary, which the scene refuses as it refuses any flagged mode
+    M, C, K = chain_matrices(MASSES, SPRINGS, 0.01)
+    rec = ambient_response(M, C, K, 200.0, 40_000, noise=0.1, seed=1)
+    running = (np.arange(rec.signals.shape[1]) / 200.0) % 10.0 < 2.0
+    _write(tmp_path / "before.h5", SimpleNamespace(signals=rec.signals * np.where(running, 1.0, 0.02),
+                                                   sample_rate_hz=200.0))
+    _write(tmp_path / "after.h5", ambient_response(M + np.diag(ADDED), C, K, 200.0, 40_000, noise=0.1, seed=2))
+    oma = {"file": "before.h5", "band_hz": [1.0, 60.0], "mass_change": "after.h5",
+           "added_mass_kg": {str(k + 1): kg for k, kg in enumerate(ADDED)}, "channel": 2}
+    with pytest.raises(SceneError, match=r"key 'rotor\.M' = 'identified:mode1\.mass': mode 1 .* is flagged "
+                                         r"\(.*non_stationary.*\)") as info:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            run_scene(_scene_file(tmp_path, "bursts.toml", oma))
+    assert "\n" not in str(info.value)

@@ -127,3 +127,13 @@ def test_transposed_record_gives_the_same_statistics(dtype):
     transposed[6, 5] = np.inf
     with pytest.raises(ParameterError, match=r"channel 4, sample 70000: nan; expected finite samples \(2 are not\)"):
         prepare(transposed, 100.0)
+
+
+def test_an_array_rate_in_khz_is_named():
+    # 0.1 for 100 Hz: the modes come out at a thousandth of their frequencies, stable and within their errors
+    # (3.1 Hz as 0.0031 Hz, no flag), so the rate itself is the only sign; as for a file's rate field
+    from modal.errors import QualityWarning
+
+    with pytest.warns(QualityWarning, match=r"<array>: 'sample_rate_hz' is 0\.1 Hz, below .* give 100 \(Hz\)"):
+        prepared = prepare(_record(n_samples=20_000), 0.1)
+    assert prepared.sample_rate_hz == 0.1  # named, not changed

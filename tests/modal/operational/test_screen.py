@@ -2,6 +2,7 @@
 mode warned of, naming the channel; none of it on the shipped real record or a clean synthetic one."""
 from __future__ import annotations
 
+import json
 import subprocess
 import sys
 import warnings
@@ -14,7 +15,9 @@ import modal
 from modal.errors import ParameterError, QualityWarning
 from modal.io.timedata import TimeRecord, read_time
 from modal.io.timewrite import write_time
-from modal.operational.screen import MIN_STUCK_SAMPLES, screen_samples, stuck_runs
+from modal.operational.inputs import prepare
+from modal.operational.screen import (HELD_FRACTION, MIN_STUCK_SAMPLES, TRANSIENT_KURTOSIS, TRANSIENT_SIGMAS,
+                                     held_factor, screen_samples, stuck_runs, transient_kurtosis)
 from support.ambient import anchor_record
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -169,3 +172,107 @@ def test_hammer_force_among_the_responses_is_named(record):
     _, texts = _oma(np.vstack([record.signals, force]), record.sample_rate_hz)
     found = _unresponsive(texts)
     assert len(found) == 1 and found[0].startswith("<array>: channel 9 moves in none of the 6 modes")
+
+
+# -- records of transients (a hammer test's responses) ---------------------------------------------------
+
+
+def _hammer_responses(hit_every_s: float, duration_s: float = 60.0):
+    """A hammer test of the anchor structure (responses only, 100 Hz): hits every ``hit_every_s``, each mode
+    ringing down over seconds, as a roving-hammer file's accelerometers are."""
+    from modal.synthetic_time import DigitalModes, impact_record
+    from support.ambient import FN, ZETA, anchor_shapes
+
+    shapes = anchor_shapes()
+    system = DigitalModes(FN, ZETA, shapes * shapes[0][None, :], 100.0)
+    hits = list(np.arange(1.0, duration_s - 1.0, hit_every_s))
+    made = impact_record(system, hits, duration_s, pulse_width_s=0.03, amplitude_variation=0.2,
+                         response_noise=0.01, seed=1)
+    return made.record.signals[1:]
+
+
+def test_hammer_responses_given_to_oma_are_flagged_non_stationary():
+    # the responses of a hammer test, hits every 8 s: SSI finds the modes, but the frequency errors it reports
+    # are 8-13 times too small (7.3953 ± 0.0004 Hz for 7.4) because nothing in the record is stationary
+    signals = _hammer_responses(8.0)
+    result, texts = _oma(signals, 100.0)
+    assert len(result) >= 5
+    assert all("non_stationary" in mode.flags for mode in result)
+    record_level = [t for t in texts if t.startswith("<array>: the record is not stationary random response")]
+    assert len(record_level) == 1
+    assert "kurtosis" in record_level[0] and "modal fit --impact" in record_level[0]
+    # the quick look's peaks carry it too
+    quick, _ = _oma(signals, 100.0, method="efdd")
+    assert len(quick) and all("non_stationary" in mode.flags for mode in quick)
+
+
+def test_frequent_hits_are_flagged_as_well():
+    # hits every 2 s: the decays overlap, the kurtosis is only about 7, still far beyond a Gaussian record's spread;
+    # SSI printed mode 1 at 3.011 ± 0.003 Hz for 3.1 Hz
+    kurtosis, std, _ = transient_kurtosis(prepare(_hammer_responses(2.0), 100.0, BAND, screen=False))
+    assert kurtosis > TRANSIENT_KURTOSIS and kurtosis - 3 > TRANSIENT_SIGMAS * std
+
+
+def test_kurtosis_error_of_gaussian_records_is_calibrated():
+    # stationary Gaussian response, one lightly damped mode dominating a short record (few independent samples):
+    # the kurtosis's deviation from 3 in its own standard errors has SD near 1 (the first-order formula is a
+    # little conservative: 0.72 over 150 records), far from TRANSIENT_SIGMAS in every record
+    from modal.synthetic import ambient_modal_response
+
+    z = []
+    for seed in range(40):
+        rec = ambient_modal_response([5.0], [0.005], [[1.0], [0.7]], 100.0, 6000, noise=0.05, seed=seed)
+        kurtosis, std, _ = transient_kurtosis(prepare(rec.signals, 100.0, screen=False))
+        z.append((kurtosis - 3) / std)
+    z = np.array(z)
+    # 40 draws: a sample SD within about ±25 % of its value, around 0.72
+    assert 0.45 < z.std() < 1.15 and abs(z.mean()) < 0.5
+    assert np.abs(z).max() < TRANSIENT_SIGMAS / 2
+
+
+def test_real_and_clean_records_are_not_flagged_non_stationary(record):
+    real = read_time(REAL)
+    for prepared in (prepare(real, screen=False), prepare(record.signals, 100.0, BAND, screen=False)):
+        kurtosis, std, _ = transient_kurtosis(prepared)
+        assert abs(kurtosis - 3) < 3 * std  # Gaussian within its spread (real: 3.17 ± 0.16)
+
+
+def test_hammer_file_given_to_modal_oma_says_so_on_the_command_line(tmp_path):
+    path = _write(tmp_path / "hammer_responses.h5", _hammer_responses(8.0), ["m/s^2"] * 8, [ACC] * 8)
+    done = subprocess.run([sys.executable, "-m", "modal", "oma", str(path), "--band", "1", "30", "--json"],
+                          capture_output=True, text=True, cwd=ROOT, timeout=300)
+    assert done.returncode == 0, done.stderr
+    doc = json.loads(done.stdout)
+    flags = [mode["flags"] for mode in doc["modes"]]
+    assert flags and all("non_stationary" in f for f in flags)
+    assert "hammer_responses.h5: the record is not stationary random response" in done.stderr
+
+
+# -- samples held: a record written at a multiple of the rate it was sampled at ----------------------------
+
+
+def test_held_samples_above_their_nyquist_frequency_are_refused():
+    # a 50 Hz record written at 100 Hz by holding each sample twice: over the default band (to 40 Hz) SSI reported
+    # unflagged 'modes' at 38.58 Hz (0.36 %) and 38.81 Hz, images of the 11.41 and 11.2 Hz modes about 25 Hz
+    slow = anchor_record(7, noise=0.1, tones=False, duration_s=300, sample_rate_hz=50.0)
+    held = np.repeat(slow.signals, 2, axis=1)
+    with pytest.raises(ParameterError, match=r"<array>: every channel repeats each sample 2 times: sampled at 50 Hz "
+                                             r"and written at 100 Hz, so above 25 Hz .* expected a band up to 25 Hz"):
+        prepare(held, 100.0)
+    # over a band below its real Nyquist frequency the record is what it is
+    assert prepare(held, 100.0, (1.0, 24.0)).band_hz == (1.0, 24.0)
+    # one channel held among channels sampled at the record's rate is named
+    mixed = anchor_record(8, noise=0.1, tones=False, duration_s=300).signals.copy()
+    mixed[2] = held[2]
+    with pytest.raises(ParameterError, match=r"<array>: channel 3 repeats each sample 2 times"):
+        prepare(mixed, 100.0, (1.0, 30.0))
+
+
+def test_real_and_quantised_records_are_not_held(record):
+    real = read_time(REAL)
+    assert [held_factor(row) for row in real.signals] == [1] * 4
+    # quantised to a few codes: many neighbours repeat, in runs of every length
+    code = 2 * record.signals.std()  # three codes or so: 59 % of neighbours repeat
+    coarse = np.round(record.signals / code) * code
+    assert np.mean(coarse[0, 1:] == coarse[0, :-1]) > HELD_FRACTION
+    assert [held_factor(row) for row in coarse] == [1] * 8

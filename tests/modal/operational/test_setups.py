@@ -73,3 +73,39 @@ def test_references_that_disagree_are_refused(damage):
     with pytest.raises(ParameterError, match=r"setup 2 \(<array>\): the reference channels \[0, 1\] disagree with "
                                              r"setup 1's \[0, 1\] in [3-5] of the 5 modes both hold: 3\.\d+ Hz"):
         modal.merge_setups([first, _oma(two)], reference_channels=[0, 1])
+
+
+def _node_setups(reference_entries, seed):
+    """The anchor case with mode 2 (7.4 Hz) given ``reference_entries`` at the two references (channels 0 and 5):
+    the setups' records, and the true shapes in the merged order."""
+    shapes = anchor_shapes()
+    shapes[[0, 5], 1] = reference_entries
+    one = modal.synthetic.ambient_modal_response(FN, ZETA, shapes, 100.0, 100_000, seed=seed, noise=0.1)
+    two = modal.synthetic.ambient_modal_response(FN, ZETA, shapes, 100.0, 100_000, seed=seed + 1, noise=0.1)
+    return one.signals[SETUP1], two.signals[SETUP2], one.mode_shape[SETUP1 + [4, 6, 7]]
+
+
+def test_a_reference_at_a_node_leaves_the_merged_entries_as_uncertain_as_the_factor():
+    # the one reference (channel 0) on a node of mode 2: the factor that maps setup 2's shape onto setup 1's is
+    # noise over noise (before: setup 2's entries of mode 2 merged at a random scale with setup 2's own errors alone,
+    # 0.2-0.3 % of the largest entry)
+    first, second, _ = _node_setups([0.0, 0.7], 51)
+    merged = modal.merge_setups([_oma(first), _oma(second)], reference_channels=[0])
+    mode2 = [m for m in merged if abs(m.natural_frequency_hz / FN[1] - 1) < 0.005]
+    assert len(mode2) == 1
+    entries, errors = np.abs(mode2[0].mode_shape[5:]), np.asarray(mode2[0].std.mode_shape)[5:]
+    assert np.all(errors > 0.3 * entries)
+
+
+def test_merged_entries_carry_the_scale_factors_error():
+    # references barely moving in mode 2 (1 % of its largest entry): the factor is 4-8 % off, and the merged entries
+    # with it; their standard errors include the factor's (before: setup 2's own entries' errors alone, 0.2 %)
+    first, second, truth = _node_setups([0.01, -0.01], 1)
+    merged = modal.merge_setups([_oma(first), _oma(second)], reference_channels=[0, 1])
+    mode2 = [m for m in merged if abs(m.natural_frequency_hz / FN[1] - 1) < 0.005][0]
+    assert np.all(np.isfinite(mode2.mode_shape))
+    true = truth[:, 1]
+    a = np.vdot(true[:5], mode2.mode_shape[:5]) / np.vdot(true[:5], true[:5])
+    error = np.abs(mode2.mode_shape[5:] - a * true[5:])
+    assert error.max() > 0.01 * np.abs(true[5:]).max()  # the case is one of a poorly determined factor
+    assert np.all(error < 3 * np.asarray(mode2.std.mode_shape)[5:])  # within three of the stated errors
