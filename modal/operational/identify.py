@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..blas import one_blas_thread
 from ..errors import IdentificationError, ParameterError
 from ..results import IdentificationResult
 from .correlations import choose_references, correlations
@@ -103,6 +104,7 @@ def _ssi(prepared: Prepared, refs, max_order, block_rows):
     return estimates, chosen, kept, flat, stable, corr, settings
 
 
+@one_blas_thread()
 def oma(data, sample_rate_hz: float | None = None, *, band_hz=None, method: str = "ssi", reference_channels=None,
         rotor_speed_hz: float | None = None, max_order: int | None = None, block_rows: int | None = None,
         quantity: str | None = None) -> IdentificationResult:
@@ -163,6 +165,10 @@ def oma(data, sample_rate_hz: float | None = None, *, band_hz=None, method: str 
         A flagged mode; a dropout (a run of identical samples) or a clipped channel; a channel that
         moves in none of the modes found; a record of transients (hammer hits, shocks), its modes flagged
         ``non_stationary`` (:mod:`modal.operational.screen`).
+
+    Notes
+    -----
+    Runs with one BLAS thread (:func:`modal.blas.one_blas_thread`): its many small products are faster so.
     """
     if method not in OMA_METHODS:
         raise ParameterError(f"'method' is {method!r}; expected one of {', '.join(OMA_METHODS)}")

@@ -223,3 +223,27 @@ def test_single_and_double_precision_records_give_the_same_modes():
         assert abs(x.damping_ratio - y.damping_ratio) < 1e-4 * x.std.damping_ratio
         assert np.isclose(x.std.natural_frequency_hz, y.std.natural_frequency_hz, rtol=1e-4)
         assert shape_mac(x.mode_shape, y.mode_shape) > 1 - 1e-9
+
+
+def test_runs_with_one_blas_thread_and_gives_the_callers_setting_back(monkeypatch):
+    """modal.oma's many small products are slower with a BLAS thread per core (modal/blas.py): it limits the BLAS
+    to one thread for the call, whatever the caller set, and the caller's setting holds again after it."""
+    from threadpoolctl import threadpool_info, threadpool_limits
+
+    import modal.operational.identify as identify
+
+    seen = []
+    real = identify.correlations
+
+    def spy(*args, **kwargs):
+        seen.append({lib["num_threads"] for lib in threadpool_info() if lib["user_api"] == "blas"})
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(identify, "correlations", spy)
+    rec = ambient_modal_response([3.1, 11.2, 20.0], [0.015, 0.01, 0.02], np.eye(3)[:, :3] + 0.3, 100.0, 60_000,
+                                 noise=0.1, seed=2)
+    with threadpool_limits(2, user_api="blas"):
+        _oma(rec.signals, 100.0, band_hz=(1, 30))
+        after = {lib["num_threads"] for lib in threadpool_info() if lib["user_api"] == "blas"}
+    assert seen and all(threads == {1} for threads in seen)
+    assert after == {2}
