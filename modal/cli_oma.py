@@ -103,14 +103,39 @@ def _kcm_table(result) -> str:
 
 def run_oma(args) -> int:
     """Run ``modal oma`` (errors propagate to :func:`modal.cli.main`, which prints them)."""
-    from .errors import ParameterError
-    from .operational.files import OMAOptions, oma_file, oma_files, scale_files
+    from .errors import ParameterError, kept_warnings
+    from .operational.files import OMAOptions
     from .report import jsonable
 
     options = OMAOptions.from_args(args)
     paths = list(args.path)
     if args.added_mass_kg and not args.mass_change:
         raise ParameterError("--added-mass-kg needs --mass-change AFTER (the record with the masses added)")
+    with kept_warnings() as said:  # shown as they come, and kept for the JSON document and the archive
+        result, results, items = _identify(args, paths, options)
+    if args.json:
+        json.dump(jsonable({**_doc(result, paths), "warnings": said}), sys.stdout, indent=1, allow_nan=False)
+        sys.stdout.write("\n")
+    else:
+        print(_table(result, paths[0] if len(paths) == 1 else f"{paths[0]} (+{len(paths) - 1} setups)"))
+        if args.mass_change:
+            print(_kcm_table(result))
+    if args.plot:
+        _plot(results[0], paths[0], args)
+    if args.archive:
+        from .archive import write_archive
+
+        write_archive(args.archive, {f"oma_{result.method}": result, **items},
+                      warnings={f"oma_{result.method}": said})
+        print(f"archive: {args.archive}", file=sys.stderr)
+    return 0
+
+
+def _identify(args, paths, options):
+    """The result to report, every result identified (one per setup) and what else the archive holds."""
+    from .errors import ParameterError
+    from .operational.files import oma_file, oma_files, scale_files
+
     items = {}
     if args.mass_change:
         if len(paths) > 1:
@@ -130,21 +155,7 @@ def run_oma(args) -> int:
     else:
         result = oma_file(paths[0], options)
         results = [result]
-    if args.json:
-        json.dump(jsonable(_doc(result, paths)), sys.stdout, indent=1, allow_nan=False)
-        sys.stdout.write("\n")
-    else:
-        print(_table(result, paths[0] if len(paths) == 1 else f"{paths[0]} (+{len(paths) - 1} setups)"))
-        if args.mass_change:
-            print(_kcm_table(result))
-    if args.plot:
-        _plot(results[0], paths[0], args)
-    if args.archive:
-        from .archive import write_archive
-
-        write_archive(args.archive, {f"oma_{result.method}": result, **items})
-        print(f"archive: {args.archive}", file=sys.stderr)
-    return 0
+    return result, results, items
 
 
 def _plot(result, path, args) -> None:

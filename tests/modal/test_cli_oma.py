@@ -40,6 +40,8 @@ def test_json_table_plot_and_archive(tmp_path):
     doc = json.loads(done.stdout)
     found = [m["natural_frequency_hz"] for m in doc["modes"]]
     assert len(found) == 6 and np.allclose(sorted(found), FN, rtol=5e-3)
+    assert doc["warnings"] == [line.removeprefix("warning: ") for line in done.stderr.splitlines()
+                               if line.startswith("warning: ")]
     assert np.allclose(sorted(doc["harmonics_hz"]), [4.8, 9.6, 14.4], atol=0.01)
     assert doc["modes"][0]["std"]["natural_frequency_hz"] > 0
     assert (tmp_path / "d.png").stat().st_size > 10_000
@@ -76,6 +78,9 @@ def test_setups_with_a_mode_missing_from_one_print_json(tmp_path):
     modes = json.loads(done.stdout)["modes"]
     missing = [m for m in modes if "missing_in_setup" in m["flags"]]
     assert missing and all(v["re"] is None for m in missing for v in m["mode_shape"][5:])
+    # the warnings shown on stderr travel in the document too
+    shown = [line.removeprefix("warning: ") for line in done.stderr.splitlines() if line.startswith("warning: ")]
+    assert shown and json.loads(done.stdout)["warnings"] == shown
 
 
 def test_bad_band_is_one_error_line(tmp_path):
