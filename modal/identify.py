@@ -81,6 +81,10 @@ def _auto_choice(frf: FRF, bands_hz, min_prominence_db: float,
     return ("global" if references > 1 or len(bands) >= AUTO_GLOBAL_PEAKS else "nls"), bands
 
 
+#: the options ``identify`` passes to the global method (:func:`modal.global_.identify_global`)
+GLOBAL_OPTIONS = ("modes_hz", "order", "max_order", "band_hz", "max_evaluations")
+
+
 def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, driving_point=None,
              min_prominence_db: float = 6.0, max_modes: int | None = None, max_evaluations: int | None = None,
              **global_options) -> IdentificationResult:
@@ -101,8 +105,8 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
         ``"global"``: poly-reference LSCF (PolyMAX) poles with a stabilisation
         diagram, then a joint refinement of all poles, modal constants and
         residual terms over the whole band (:func:`modal.global_.identify_global`;
-        its options ``modes_hz``, ``order``, ``max_order`` pass through
-        ``**global_options``; ``bands_hz`` gives the band by its extremes).
+        its options ``modes_hz``, ``order``, ``max_order`` and ``band_hz`` pass through
+        ``**global_options``; ``bands_hz`` gives the band by its extremes instead).
         ``"circle"``: Kennedy–Pancu circle fit on the mobility.
         ``"halfpower"``: half-power bandwidth with exact inversion.
     bands_hz : list of (f_low, f_high), optional
@@ -147,6 +151,13 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
         raise TypeError(f"identify() expects a modal.FRF, got {type(frf).__name__}")
     if global_options and method not in ("global", "auto"):
         raise TypeError(f"identify() got options {', '.join(sorted(global_options))} that only method='global' takes")
+    unknown = sorted(set(global_options) - set(GLOBAL_OPTIONS))
+    if unknown:
+        raise TypeError(f"identify() got unexpected option(s) {', '.join(unknown)}; method='global' takes "
+                        f"{', '.join(GLOBAL_OPTIONS)}")
+    if global_options.get("band_hz") is not None and bands_hz is not None:
+        raise IdentificationError("give the global method's band once: band_hz=(f_low, f_high) or bands_hz "
+                                  "(whose extremes make the band), not both")
     one_of("method", method, METHODS + ("auto",), IdentificationError)
     if max_evaluations is not None:
         max_evaluations = checked_max_evaluations(max_evaluations, IdentificationError)
@@ -199,8 +210,11 @@ def _identify(frf: FRF, method: str, bands_hz, noise_std, driving_point, min_pro
     if method == "global":
         from .global_ import identify_global
 
-        band = None if bands_hz is None else (min(b[0] for b in bands_hz), max(b[1] for b in bands_hz))
-        return identify_global(frf, band_hz=band, noise_std=noise_std, driving_point=driving_point, **global_options)
+        options = dict(global_options)
+        band = options.pop("band_hz", None)
+        if bands_hz is not None:
+            band = (min(b[0] for b in bands_hz), max(b[1] for b in bands_hz))
+        return identify_global(frf, band_hz=band, noise_std=noise_std, driving_point=driving_point, **options)
     if bands_hz is not None:
         bands = bands_from_hz(frf, bands_hz, indicator=indicator[0])
     elif found is not None and max_modes is None:  # the automatic choice's search, with the same arguments

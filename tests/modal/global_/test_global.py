@@ -499,3 +499,19 @@ def test_pseudo_inverse_factor_leaves_out_the_directions_zero_to_rounding():
     # eigenvalue by 4e-7 of itself and its inverse (1e9) by ~400, hence 1e3 absolute (1e-6 of the largest entry)
     np.testing.assert_allclose(G.T @ G, basis @ np.diag(kept) @ basis.T, rtol=1e-6, atol=1e3)
     assert _pseudo_inverse_factor(np.zeros((3, 3))) is None
+
+
+def test_the_band_given_as_band_hz_as_bands_hz_extremes_and_bad_options_named():
+    """identify(frf, "global", band_hz=(lo, hi)), the name modal.oma uses, raised a TypeError from deep inside
+    (identify passed its own band_hz too); it is the band, as bands_hz's extremes are. Both at once, or an option
+    the global method does not take, are named."""
+    f = np.arange(1.0, 200.0, 0.5)
+    frf = modal.add_noise(modal.modal_frf(f, [30.0, 80.0, 150.0], [0.02, 0.01, 0.01], [1.0, 0.5, 0.8],
+                                          kind="accelerance"), 0.002, seed=3)
+    by_name, by_extremes = _fit(frf, band_hz=(60.0, 190.0)), _fit(frf, bands_hz=[(60.0, 100.0), (120.0, 190.0)])
+    assert [m.natural_frequency_hz for m in by_name] == [m.natural_frequency_hz for m in by_extremes]
+    assert np.allclose([m.natural_frequency_hz for m in by_name], [80.0, 150.0], rtol=1e-3)
+    with pytest.raises(modal.IdentificationError, match="band once: band_hz=.* or bands_hz"):
+        _fit(frf, band_hz=(60.0, 190.0), bands_hz=[(60.0, 190.0)])
+    with pytest.raises(TypeError, match=r"unexpected option\(s\) band; method='global' takes modes_hz, order"):
+        _fit(frf, band=(60.0, 190.0))
