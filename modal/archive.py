@@ -363,6 +363,7 @@ def read_archive(path: str | os.PathLike) -> Archive:
             items[name] = read_node(f[name])
             if "inputs_hash" in f[name].attrs:
                 hashes[name] = str(f[name].attrs["inputs_hash"])
-            if read_warnings(f[name]):
-                said[name] = read_warnings(f[name])
+            warned = read_warnings(f[name])
+            if warned:
+                said[name] = warned
     return Archive(items=items, attrs=attrs, scene_text=scene, inputs_hash=hashes, warnings=said)

@@ -212,8 +212,9 @@ def run_scene(scene: str | Path | dict | Scene, out: str | Path | None = None, p
                 from modal.archive import read_node, read_warnings
 
                 results[stage] = read_node(earlier[stage])
-                if read_warnings(earlier[stage]):
-                    given[stage] = read_warnings(earlier[stage])
+                said = read_warnings(earlier[stage])
+                if said:
+                    given[stage] = said
     finally:
         if earlier is not None:
             earlier.close()
