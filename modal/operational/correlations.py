@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError
+from ..parallel import split_over_threads
 
 __all__ = ["Correlations", "correlations", "decimation_factor", "decimate", "choose_references"]
 
@@ -94,7 +95,7 @@ def _segment_length(max_lag: int, n_samples: int) -> int:
 
 
 def correlations(signals: np.ndarray, sample_rate_hz: float, references, max_lag: int,
-                 max_blocks: int = MAX_BLOCKS, mean=None, scale=None) -> Correlations:
+                 max_blocks: int = MAX_BLOCKS, mean=None, scale=None, workers=None) -> Correlations:
     """Correlations ``R_k``, k = 0…``max_lag``, of every output with the references, per block.
 
     Parameters
@@ -114,6 +115,9 @@ def correlations(signals: np.ndarray, sample_rate_hz: float, references, max_lag
     scale : ndarray, shape (n_outputs,), optional
         Each signal's RMS: the correlations are those of the signals divided by it (``R_k`` divided by
         ``scale[o] scale[r]``), the samples themselves left as they are.
+    workers : int, optional
+        Threads over which the blocks are shared (default: every usable core, :mod:`modal.parallel`); the
+        result is the same, bit for bit, whatever their number.
 
     Returns
     -------
@@ -131,29 +135,34 @@ def correlations(signals: np.ndarray, sample_rate_hz: float, references, max_lag
         raise ParameterError(f"{n} samples hold no segment of {n_seg} samples plus the longest lag {max_lag}")
     n_blocks = int(min(max_blocks, n_segments))
     edges = np.linspace(0, n_segments, n_blocks + 1).round().astype(int)
-    # float32 FFTs: their rounding (1e-7 relative) lies far below the estimates' scatter (1/√samples)
-    if mean is None:
-        record = np.ascontiguousarray(signals, dtype=np.float32)
-    else:  # each block's samples centred into one buffer, reused
-        shift = np.asarray(mean, float)[:, None]
-        buffer = np.empty((n_out, int(np.diff(edges).max()) * n_seg + max_lag), np.float32)
     spectra = np.empty((n_blocks, n_fft // 2 + 1, n_out, refs.size), np.complex64)
-    for b in range(n_blocks):
-        first, stop = edges[b] * n_seg, edges[b + 1] * n_seg + max_lag
-        if mean is None:
-            data = record[:, first:stop]
-        else:
-            data = buffer[:, :stop - first]
-            np.subtract(signals[:, first:stop], shift, out=data)
-        # (samples, n_out, segs): transformed along the first axis, the spectra come out line by line, each
-        # line's (outputs × segments) matrix contiguous for the product below
-        windows = np.lib.stride_tricks.sliding_window_view(data, n_seg + max_lag, axis=1)
-        ext = windows[:, ::n_seg].transpose(2, 0, 1)
-        future = sfft.rfft(ext, n=n_fft, axis=0)  # every output, extended by the longest lag
-        past = sfft.rfft(ext[:n_seg, refs], n=n_fft, axis=0)  # the references' segments, zero-padded
-        # Σ over the block's segments of Y_o(f) conj(X_r(f)): one (outputs × segments)(segments × refs)
-        # product per line
-        np.matmul(future, past.conj().transpose(0, 2, 1), out=spectra[b])
+    shift = None if mean is None else np.asarray(mean, float)[:, None]
+    # float32 FFTs: their rounding (1e-7 relative) lies far below the estimates' scatter (1/√samples)
+    record = np.ascontiguousarray(signals, dtype=np.float32) if mean is None else None
+
+    def block_spectra(first_block: int, stop_block: int) -> None:
+        """The cross-spectra of blocks ``first_block``…``stop_block − 1``, into ``spectra``."""
+        if mean is not None:  # each block's samples centred into one buffer, reused
+            longest = int(np.diff(edges[first_block:stop_block + 1]).max()) * n_seg + max_lag
+            buffer = np.empty((n_out, longest), np.float32)
+        for b in range(first_block, stop_block):
+            first, stop = edges[b] * n_seg, edges[b + 1] * n_seg + max_lag
+            if mean is None:
+                data = record[:, first:stop]
+            else:
+                data = buffer[:, :stop - first]
+                np.subtract(signals[:, first:stop], shift, out=data)
+            # (samples, n_out, segs): transformed along the first axis, the spectra come out line by line, each
+            # line's (outputs × segments) matrix contiguous for the product below
+            windows = np.lib.stride_tricks.sliding_window_view(data, n_seg + max_lag, axis=1)
+            ext = windows[:, ::n_seg].transpose(2, 0, 1)
+            future = sfft.rfft(ext, n=n_fft, axis=0)  # every output, extended by the longest lag
+            past = sfft.rfft(ext[:n_seg, refs], n=n_fft, axis=0)  # the references' segments, zero-padded
+            # Σ over the block's segments of Y_o(f) conj(X_r(f)): one (outputs × segments)(segments × refs)
+            # product per line
+            np.matmul(future, past.conj().transpose(0, 2, 1), out=spectra[b])
+
+    split_over_threads(block_spectra, n_blocks, workers)
     lagged = sfft.irfft(spectra, n=n_fft, axis=1)[:, :max_lag + 1]  # (blocks, lags, n_out, refs)
     lagged = lagged.astype(float)
     weights = (np.diff(edges) * n_seg).astype(float)

@@ -15,6 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..blas import one_blas_thread
+from ..parallel import thread_count
 from ..errors import IdentificationError, ParameterError
 from ..results import IdentificationResult
 from .correlations import choose_references, correlations
@@ -83,12 +84,12 @@ def _sweep_size(prepared: Prepared, n_refs: int, max_order, block_rows):
     return int(max_order), rows, cols
 
 
-def _ssi(prepared: Prepared, refs, max_order, block_rows):
+def _ssi(prepared: Prepared, refs, max_order, block_rows, workers: int = 1):
     from .ssi import Perturbation, poles_at, subspace_model
 
     max_order, rows, cols = _sweep_size(prepared, len(refs), max_order, block_rows)
     corr = correlations(prepared.signals, prepared.sample_rate_hz, refs, rows + cols, mean=prepared.mean,
-                        scale=prepared.scale)
+                        scale=prepared.scale, workers=workers)
     model = subspace_model(corr.mean, rows, max_order, prepared.sample_rate_hz, cols)
     orders = list(range(2, model.max_order + 1, 2))
     sets = [poles_at(model, n) for n in orders]
@@ -98,7 +99,7 @@ def _ssi(prepared: Prepared, refs, max_order, block_rows):
         medians = np.array([np.median(flat.pole[c.members]) for c in clusters])
         n_blocks = error_blocks(prepared.duration_s, medians, corr.blocks.shape[0])
         if n_blocks >= 2:
-            perturb = Perturbation(model, *corr.grouped(n_blocks)).at
+            perturb = Perturbation(model, *corr.grouped(n_blocks), workers=workers).at
     estimates, chosen, kept = estimates_from_clusters(flat, clusters, perturb, len(orders), prepared.scale)
     settings = {"orders": [orders[0], orders[-1]], "block_rows": rows, "block_cols": cols}
     return estimates, chosen, kept, flat, stable, corr, settings
@@ -107,7 +108,7 @@ def _ssi(prepared: Prepared, refs, max_order, block_rows):
 @one_blas_thread()
 def oma(data, sample_rate_hz: float | None = None, *, band_hz=None, method: str = "ssi", reference_channels=None,
         rotor_speed_hz: float | None = None, max_order: int | None = None, block_rows: int | None = None,
-        quantity: str | None = None) -> IdentificationResult:
+        quantity: str | None = None, workers: int | None = None) -> IdentificationResult:
     """Identify the modes of a structure from its responses alone (operational modal analysis).
 
     Parameters
@@ -139,6 +140,10 @@ def oma(data, sample_rate_hz: float | None = None, *, band_hz=None, method: str 
     quantity : str, optional
         What an array's channels measured (``"acceleration"``, ``"velocity"``, ``"displacement"``);
         names the result's ``kind``. Default: acceleration.
+    workers : int, optional
+        Threads among which a long record's blocks and channels are shared (default: every core the process
+        may use; 1 where the caller parallelises already, as ``modal batch`` does). The result does not
+        depend on it.
 
     Returns
     -------
@@ -169,12 +174,15 @@ def oma(data, sample_rate_hz: float | None = None, *, band_hz=None, method: str 
     Notes
     -----
     Runs with one BLAS thread (:func:`modal.blas.one_blas_thread`): its many small products are faster so.
+The long loops over the record's blocks (correlations, the error bars' deviations) and channels (the input
+check) are shared among ``workers`` threads instead, one contiguous share each (:mod:`modal.parallel`).
     """
     if method not in OMA_METHODS:
         raise ParameterError(f"'method' is {method!r}; expected one of {', '.join(OMA_METHODS)}")
     if rotor_speed_hz is not None and not (np.isfinite(rotor_speed_hz) and rotor_speed_hz > 0):
         raise ParameterError(f"'rotor_speed_hz' is {rotor_speed_hz!r}; expected a positive frequency in Hz")
-    prepared = prepare(data, sample_rate_hz, band_hz, quantity)
+    workers = thread_count(workers)
+    prepared = prepare(data, sample_rate_hz, band_hz, quantity, workers=workers)
     refs = _references(prepared, reference_channels)
     record_flags = frozenset({"non_stationary"}) if warn_transients(prepared) else frozenset()
     if method in ("fdd", "efdd"):
@@ -185,11 +193,12 @@ def oma(data, sample_rate_hz: float | None = None, *, band_hz=None, method: str 
         warn_unresponsive(result, prepared.source)
         return result
     if method == "ssi":
-        estimates, chosen, clusters, flat, stable, corr, settings = _ssi(prepared, refs, max_order, block_rows)
+        estimates, chosen, clusters, flat, stable, corr, settings = _ssi(prepared, refs, max_order, block_rows,
+                                                                         workers)
     else:
         from .plscf import plscf
 
-        estimates, chosen, clusters, flat, stable, corr, settings = plscf(prepared, refs, max_order)
+        estimates, chosen, clusters, flat, stable, corr, settings = plscf(prepared, refs, max_order, workers)
     resolution_hz = corr.sample_rate_hz / corr.max_lag  # what the correlation lags tell apart
     estimates, tones, dropped, diagram = _sort_out(estimates, chosen, clusters, flat, stable, prepared,
                                                    rotor_speed_hz, method, resolution_hz)

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError
+from ..parallel import split_over_threads
 from .correlations import decimate, decimation_factor
 from .screen import check_held, check_units, screen_samples
 
@@ -150,7 +151,7 @@ def check_band(band_hz, nyquist_hz: float, src: str) -> tuple[float, float]:
     return low, high
 
 
-def channel_statistics(signals: np.ndarray, src: str, names=()) -> tuple[np.ndarray, np.ndarray]:
+def channel_statistics(signals: np.ndarray, src: str, names=(), workers=None) -> tuple[np.ndarray, np.ndarray]:
     """Each channel's mean and RMS about it, checking that there are two or more channels of finite samples,
     none constant.
 
@@ -160,7 +161,8 @@ def channel_statistics(signals: np.ndarray, src: str, names=()) -> tuple[np.ndar
     pieces' means and sums of squares are then pooled exactly (Chan, Golub & LeVeque). A record whose channels'
     samples are not contiguous in memory (an array of shape (n_samples, n_channels) transposed) is read a stretch
     of samples of every channel at a time instead (:func:`_moments_by_samples`): channel by channel, each read
-    would touch the whole record.
+    would touch the whole record. The channels are shared among ``workers`` threads (default: every usable
+    core, :mod:`modal.parallel`).
 
     Returns
     -------
@@ -177,12 +179,16 @@ def channel_statistics(signals: np.ndarray, src: str, names=()) -> tuple[np.ndar
             _refuse_non_finite(signals, int(np.flatnonzero(~finite)[0]), src, names)
     else:
         squares = np.empty(n_channels)
-        buffer = np.empty(min(n, CHUNK_SAMPLES))
-        for ch, row in enumerate(signals):
-            moments = _moments(row, buffer)
-            if moments is None:
-                _refuse_non_finite(signals, ch, src, names)
-            mean[ch], squares[ch] = moments
+
+        def channels_moments(first: int, stop: int) -> None:
+            buffer = np.empty(min(n, CHUNK_SAMPLES))
+            for ch in range(first, stop):
+                moments = _moments(signals[ch], buffer)
+                if moments is None:
+                    _refuse_non_finite(signals, ch, src, names)
+                mean[ch], squares[ch] = moments
+
+        split_over_threads(channels_moments, n_channels, workers)
     for ch, row in enumerate(signals):
         rms[ch] = np.sqrt(squares[ch] / n)
         if not np.isfinite(rms[ch]):
@@ -307,7 +313,8 @@ def _name(names, ch) -> str:
     return f" ({names[ch]})" if names and ch < len(names) and names[ch] != str(ch) else ""
 
 
-def prepare(data, sample_rate_hz=None, band_hz=None, quantity: str | None = None, screen: bool = True) -> Prepared:
+def prepare(data, sample_rate_hz=None, band_hz=None, quantity: str | None = None, screen: bool = True,
+            workers=None) -> Prepared:
     """Check a record, bring it to a rate suited to the band and find each channel's mean and RMS.
 
     Parameters
@@ -323,6 +330,8 @@ def prepare(data, sample_rate_hz=None, band_hz=None, quantity: str | None = None
     screen : bool
         Warn of dropouts and clipping (:func:`modal.operational.screen.screen_samples`); False for a record
         prepared again (a plot of a record identified already).
+    workers : int, optional
+        Threads for the channels' statistics (default: every usable core).
     """
     signals, rate, file_quantity, names, src = _record(data, sample_rate_hz)
     if not (np.isfinite(rate) and rate > 0):
@@ -339,7 +348,7 @@ def prepare(data, sample_rate_hz=None, band_hz=None, quantity: str | None = None
                                  f"{high:g} Hz")
     else:
         work = signals
-    mean, scale = channel_statistics(work, src, names)
+    mean, scale = channel_statistics(work, src, names, workers)
     if screen:  # on the samples as recorded, known finite by now
         screen_samples(signals, rate, names, src)
     return Prepared(work, rate / factor, mean, scale, (low, high), factor, rate, quantity or file_quantity, names,

@@ -115,10 +115,11 @@ def _poles_of_order(omega, S, order, beta):
     return _unwindow(pack.omega_n, pack.damping_ratio, beta), pack.participation.T
 
 
-def plscf(prepared: Prepared, refs, max_order=None):
+def plscf(prepared: Prepared, refs, max_order=None, workers: int = 1):
     """Poles over the polynomial orders, stabilisation, clusters and estimates (see the module docstring).
 
-    Returns the same tuple as the SSI path of :func:`modal.operational.oma`.
+    Returns the same tuple as the SSI path of :func:`modal.operational.oma`; the record's blocks are shared among
+    ``workers`` threads.
     """
     fs = prepared.sample_rate_hz
     low, high = prepared.band_hz
@@ -131,7 +132,8 @@ def plscf(prepared: Prepared, refs, max_order=None):
 
         raise ParameterError(f"{prepared.source}: the record lasts {n_samples / fs:.4g} s; the half-spectra over "
                              f"{n_lags} lags need at least {MIN_LAGS_IN_RECORD * n_lags / fs:.4g} s")
-    corr = correlations(prepared.signals, fs, refs, n_lags - 1, mean=prepared.mean, scale=prepared.scale)
+    corr = correlations(prepared.signals, fs, refs, n_lags - 1, mean=prepared.mean, scale=prepared.scale,
+                        workers=workers)
     spacing = fs / (2 * n_lags)
     lines = np.arange(max(low, spacing), high + spacing / 2, spacing)
     omega = 2 * np.pi * lines

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import IdentificationError
+from ..parallel import split_over_threads
 
 __all__ = ["SubspaceModel", "PoleSet", "subspace_model", "hankel", "poles_at", "Perturbation", "continuous"]
 
@@ -146,9 +147,15 @@ class Perturbation:
         Each block's correlations.
     weights : ndarray, shape (n_blocks,)
         Samples per block.
+    max_order : int, optional
+        The highest order whose deviations are asked for (default: the model's).
+    workers : int, optional
+        Threads over which the blocks are shared (default: every usable core); the deviations are the same,
+        bit for bit, whatever their number.
     """
 
-    def __init__(self, model: SubspaceModel, block_R: np.ndarray, weights: np.ndarray, max_order: int | None = None):
+    def __init__(self, model: SubspaceModel, block_R: np.ndarray, weights: np.ndarray, max_order: int | None = None,
+                 workers=None):
         self.model = model
         n_blocks = block_R.shape[0]
         if n_blocks < 2:
@@ -163,8 +170,6 @@ class Perturbation:
         # ΔH is the Hankel matrix of the correlations' deviations (it is linear in them), built in single
         # precision from deviations formed in double
         d_R = (block_R - np.tensordot(w, block_R, axes=1)[None]).astype(np.float32)
-        dH = hankel(d_R, model.block_rows, model.block_cols)
-        G = dH @ V[:, :top]  # (blocks, p, top): ΔH V₁ for every order up to top
         # each perturbed singular vector's part outside the signal subspace of order n is ΔU₁ = U₂ X + E/σ₁, with
         # X (k − n, n) = (U₂ᵀ ΔH V₁ σ₁ + σ₂ (U₁ᵀ ΔH V₂)ᵀ) / (σ₁² − σ₂²) elementwise (the part inside only rotates
         # the basis, which leaves the eigenvalues and the observed shapes as they are). Entry (i, j) of X, i ≥ n > j,
@@ -175,33 +180,47 @@ class Perturbation:
         with np.errstate(divide="ignore", invalid="ignore"):
             inverse_gap = 1.0 / (sv[None, :top] ** 2 - sv[:, None] ** 2)  # (k, top)
         inverse_gap[~np.isfinite(inverse_gap)] = 0.0
-        UtG = U.T @ G  # (blocks, k, top): Uᵀ ΔH V₁
-        inside = UtG * (sv[None, :top] * inverse_gap).astype(np.float32)
-        inside += (V.T @ (np.swapaxes(dH, 1, 2) @ U[:, :top])) * (sv[:, None] * inverse_gap).astype(np.float32)
-        # every array an order slices is kept as (rows, blocks, columns): an order's rows and columns of all the
-        # blocks are then one matrix ((rows · blocks) × columns, or rows × (blocks · columns)), and each product
-        # with them one call
-        self.inside = _by_rows(inside)
+        gap_right = (sv[None, :top] * inverse_gap).astype(np.float32)
+        gap_left = (sv[:, None] * inverse_gap).astype(np.float32)
         # E = (I − U Uᵀ) ΔH V₁, the part of ΔH V₁ outside the range of H, enters every order only through its
         # first l rows and the projections Qᵀ E_down, Qᵀ E_up, E_upᵀ U_down, E_upᵀ U_up, whose leading n × n
         # blocks are those of order n: formed once for all orders
         l, rows = model.n_outputs, model.n_outputs * model.block_rows
         Q = model.Q[:, :top]
+        Q32 = Q.astype(np.float32)
+
+        def block_terms(first: int, stop: int):
+            """(inside, E's first rows, Qᵀ E_down, Qᵀ E_up, E_upᵀ U_down, E_upᵀ U_up) of blocks first…stop − 1."""
+            dH = hankel(d_R[first:stop], model.block_rows, model.block_cols)
+            G = dH @ V[:, :top]  # (blocks, p, top): ΔH V₁ for every order up to top
+            UtG = U.T @ G  # (blocks, k, top): Uᵀ ΔH V₁
+            inside = UtG * gap_right
+            inside += (V.T @ (np.swapaxes(dH, 1, 2) @ U[:, :top])) * gap_left
+            E = G - U @ UtG
+            E_up, E_down = E[:, :rows], E[:, l:]
+            E_up_t = np.swapaxes(E_up, 1, 2)
+            return (inside, E[:, :l], Q32.T @ E_down, Q32.T @ E_up, E_up_t @ U[l:, :top], E_up_t @ U[:rows, :top])
+
+        # the blocks are independent: shared among threads (:mod:`modal.parallel`), each share's products those
+        # of one loop
+        parts = split_over_threads(block_terms, n_blocks, workers)
+        inside, E_C, QtE_down, QtE_up, EtU_down, EtU_up = (np.concatenate(terms) if len(parts) > 1 else terms[0]
+                                                          for terms in zip(*parts))
+        # every array an order slices is kept as (rows, blocks, columns): an order's rows and columns of all the
+        # blocks are then one matrix ((rows · blocks) × columns, or rows × (blocks · columns)), and each product
+        # with them one call
+        self.inside = _by_rows(inside)
         # U₂'s projections of order n (Qₙᵀ U₂ down and up) and U_upᵀ U_down, U_upᵀ U_up, whose blocks [n:, :n]
         # give U₂ᵀ (O_down − O_up A): slices of these
         self.QtU_down = Q.T @ model.U[l:]  # (top, k)
         self.QtU_up = Q.T @ model.U[:rows]
         self.UtU_down = model.U[:rows].T @ model.U[l:, :top]  # (k, top)
         self.UtU_up = model.U[:rows].T @ model.U[:rows, :top]
-        Q32 = Q.astype(np.float32)
-        E = G - U @ UtG
-        E_up, E_down = E[:, :rows], E[:, l:]
-        E_up_t = np.swapaxes(E_up, 1, 2)
-        self.E_C = _by_rows(E[:, :l], float)  # (l, blocks, top)
-        self.QtE_down = _by_rows(Q32.T @ E_down, float)  # (top, blocks, top): Qᵀ E_down
-        self.QtE_up = _by_rows(Q32.T @ E_up, float)
-        self.EtU_down = _by_rows(E_up_t @ U[l:, :top], float)  # E_upᵀ U_down
-        self.EtU_up = _by_rows(E_up_t @ U[:rows, :top], float)  # E_upᵀ U_up
+        self.E_C = _by_rows(E_C, float)  # (l, blocks, top)
+        self.QtE_down = _by_rows(QtE_down, float)  # (top, blocks, top): Qᵀ E_down
+        self.QtE_up = _by_rows(QtE_up, float)
+        self.EtU_down = _by_rows(EtU_down, float)  # E_upᵀ U_down
+        self.EtU_up = _by_rows(EtU_up, float)  # E_upᵀ U_up
 
     def at(self, order: int, indices) -> dict[str, np.ndarray]:
         """Deviations of the poles ``indices`` of :func:`poles_at` (``order``).

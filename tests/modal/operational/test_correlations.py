@@ -81,3 +81,14 @@ def test_references_are_the_independent_channels():
 def test_decimation_keeps_the_band_below_half_the_new_nyquist():
     assert decimation_factor(3200.0, 200.0) == 4  # 400 Hz Nyquist: 200 Hz at half of it
     assert decimation_factor(100.0, 30.0) == 1
+
+
+def test_correlations_do_not_depend_on_the_number_of_threads():
+    # each thread takes a contiguous share of the blocks and computes them as one loop would: bit for bit the same
+    rng = np.random.default_rng(2)
+    y = rng.standard_normal((4, 40_000)) + 3.0
+    mean, scale = y.mean(axis=1), y.std(axis=1)
+    one = correlations(y, 50.0, [0, 3], 12, max_blocks=7, mean=mean, scale=scale, workers=1)
+    for workers in (2, 3, 16):
+        other = correlations(y, 50.0, [0, 3], 12, max_blocks=7, mean=mean, scale=scale, workers=workers)
+        assert np.array_equal(other.blocks, one.blocks) and np.array_equal(other.weights, one.weights)

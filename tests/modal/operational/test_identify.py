@@ -156,6 +156,7 @@ def _record(n_channels=3, n=20_000, seed=0):
     (_record(), {"rotor_speed_hz": -3.0}, "rotor_speed_hz"),
     (_record(), {"band_hz": (0.1, 2.0)}, "the record lasts 200 s; the band from 0.2 Hz"),
     (_record(), {"max_order": 4000}, "the record lasts 200 s; .* model order 4000"),
+    (_record(), {"workers": 0}, "'workers' is 0; expected a positive integer"),
 ])
 def test_bad_input_is_one_clear_error(data, kwargs, message):
     kwargs = {"sample_rate_hz": 100.0, **kwargs}
@@ -247,3 +248,17 @@ def test_runs_with_one_blas_thread_and_gives_the_callers_setting_back(monkeypatc
         after = {lib["num_threads"] for lib in threadpool_info() if lib["user_api"] == "blas"}
     assert seen and all(threads == {1} for threads in seen)
     assert after == {2}
+
+
+@pytest.mark.parametrize("method", ["ssi", "plscf"])
+def test_modes_do_not_depend_on_the_number_of_threads(method):
+    """A long record's blocks and channels are shared among threads (modal/parallel.py), each share computed as
+    one loop computes it: the same modes and errors, bit for bit."""
+    rec = anchor_record(32, noise=0.1, tones=False, duration_s=400.0)
+    one = _oma(rec.signals, rec.sample_rate_hz, band_hz=(1.0, 30.0), method=method, workers=1)
+    two = _oma(rec.signals, rec.sample_rate_hz, band_hz=(1.0, 30.0), method=method, workers=2)
+    assert len(one) == len(two) >= 5
+    for x, y in zip(one, two):
+        assert (x.natural_frequency_hz, x.damping_ratio, x.std.natural_frequency_hz, x.std.damping_ratio) == \
+            (y.natural_frequency_hz, y.damping_ratio, y.std.natural_frequency_hz, y.std.damping_ratio)
+        assert np.array_equal(x.mode_shape, y.mode_shape)

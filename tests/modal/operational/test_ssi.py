@@ -140,3 +140,16 @@ def test_deviations_equal_the_plain_formulas_to_single_precision_rounding():
         assert np.abs(fast["pole"] - d_pole).max() <= 1e-4 * np.abs(d_pole).max()
         for j in range(picks.size):
             assert np.abs(fast["shape"][:, :, j] - d_shape[:, :, j]).max() <= 1e-4 * np.abs(d_shape[:, :, j]).max()
+
+
+def test_deviations_do_not_depend_on_the_number_of_threads():
+    # each thread forms the deviations' products of a contiguous share of the blocks, as one loop would
+    _, corr, model = _model()
+    blocks, weights = corr.grouped(8)
+    one = Perturbation(model, blocks, weights, workers=1)
+    three = Perturbation(model, blocks, weights, workers=3)
+    for name in ("inside", "E_C", "QtE_down", "QtE_up", "EtU_down", "EtU_up"):
+        assert np.array_equal(getattr(one, name), getattr(three, name)), name
+    ps = poles_at(model, 12)
+    picks = np.flatnonzero(ps.poles.imag > 0)
+    assert np.array_equal(one.at(12, picks)["pole"], three.at(12, picks)["pole"])
