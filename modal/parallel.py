@@ -1,4 +1,5 @@
-"""Long array work split over the machine's cores, a contiguous share of the items per thread.
+"""Long array work split over the machine's cores: a contiguous share of the items per thread, or the items
+taken in turn by threads as they come free.
 
 Operational analysis of a long record spends most of its time in loops whose iterations are independent
 (the record's blocks, its channels) and whose work happens in numpy, scipy.fft and BLAS calls that release
@@ -15,13 +16,14 @@ from __future__ import annotations
 import operator
 import os
 from concurrent.futures import ThreadPoolExecutor
-from typing import Callable, TypeVar
+from typing import Callable, Iterable, TypeVar
 
 from .errors import ParameterError
 
-__all__ = ["usable_cores", "thread_count", "shares", "split_over_threads"]
+__all__ = ["usable_cores", "thread_count", "shares", "split_over_threads", "map_over_threads"]
 
 T = TypeVar("T")
+Item = TypeVar("Item")
 
 
 def usable_cores() -> int:
@@ -82,3 +84,18 @@ def split_over_threads(work: Callable[[int, int], T], n_items: int, workers) -> 
     with ThreadPoolExecutor(max_workers=len(parts)) as pool:
         futures = [pool.submit(work, a, b) for a, b in parts]
         return [future.result() for future in futures]
+
+
+def map_over_threads(function: Callable[[Item], T], items: Iterable[Item], workers) -> list[T]:
+    """``[function(item) for item in items]``, the items taken in order by ``workers`` threads as they come free
+    (for items of unequal cost, such as eigenproblems of growing order).
+
+    Each result is computed as one loop would compute it; an exception is raised for the earliest item that
+    raised one.
+    """
+    items = list(items)
+    count = min(thread_count(workers), len(items))
+    if count <= 1:
+        return [function(item) for item in items]
+    with ThreadPoolExecutor(max_workers=count) as pool:
+        return list(pool.map(function, items))

@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..blas import one_blas_thread
-from ..parallel import thread_count
+from ..parallel import map_over_threads, thread_count
 from ..errors import IdentificationError, ParameterError
 from ..results import IdentificationResult
 from .correlations import choose_references, correlations
@@ -92,7 +92,7 @@ def _ssi(prepared: Prepared, refs, max_order, block_rows, workers: int = 1):
                         scale=prepared.scale, workers=workers)
     model = subspace_model(corr.mean, rows, max_order, prepared.sample_rate_hz, cols)
     orders = list(range(2, model.max_order + 1, 2))
-    sets = [poles_at(model, n) for n in orders]
+    sets = map_over_threads(lambda n: poles_at(model, n), orders, workers)  # an eigenproblem per order
     flat, stable, clusters = stabilise(sets, *prepared.band_hz)
     perturb = None
     if clusters:
@@ -100,7 +100,8 @@ def _ssi(prepared: Prepared, refs, max_order, block_rows, workers: int = 1):
         n_blocks = error_blocks(prepared.duration_s, medians, corr.blocks.shape[0])
         if n_blocks >= 2:
             perturb = Perturbation(model, *corr.grouped(n_blocks), workers=workers).at
-    estimates, chosen, kept = estimates_from_clusters(flat, clusters, perturb, len(orders), prepared.scale)
+    estimates, chosen, kept = estimates_from_clusters(flat, clusters, perturb, len(orders), prepared.scale,
+                                                      workers=workers)
     settings = {"orders": [orders[0], orders[-1]], "block_rows": rows, "block_cols": cols}
     return estimates, chosen, kept, flat, stable, corr, settings
 

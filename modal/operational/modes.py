@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..parallel import map_over_threads
 from ..units import TWO_PI
 from .correlations import MAX_BLOCKS
 from .pole import PoleEstimate
@@ -71,7 +72,7 @@ def _physical_shape(unit_shape: np.ndarray, d_unit: np.ndarray | None, scale: np
 
 
 def estimates_from_clusters(flat, clusters: list[Cluster], perturb, n_orders_swept: int,
-                            scale: np.ndarray, representative: str = "consensus"
+                            scale: np.ndarray, representative: str = "consensus", workers: int = 1
                             ) -> tuple[list[PoleEstimate], list[int], list[Cluster]]:
     """One estimate per cluster, from its member with the smallest frequency error among a few probed orders
     that agrees with the cluster's medians (:data:`CONSENSUS_SIGMAS`), with the representative
@@ -94,6 +95,8 @@ def estimates_from_clusters(flat, clusters: list[Cluster], perturb, n_orders_swe
         that agree with the cluster's medians. ``"upper_half"``: every order of the upper half of the
         cluster's own orders (:func:`upper_half`), for an estimator whose under-fitted low orders hold biased
         poles of small error (ranked by their errors, they would be chosen).
+    workers : int
+        Threads among which the probed orders' deviations are computed (``perturb`` must allow it).
     """
     # the errors are computed at a few orders spread over the sweep (one perturbation per order serves every
     # cluster), and at each cluster's top order when it has no pole at those; or at every order of the
@@ -109,6 +112,7 @@ def estimates_from_clusters(flat, clusters: list[Cluster], perturb, n_orders_swe
         if not own & probe:
             probe.add(max(own))
     errors = {}  # member -> (sf, sz, d_shape, unit shape, d_pole)
+    probed = []  # (order, members of the clusters at it)
     for order in sorted(probe):
         at = np.concatenate([c.members[flat.order[c.members] == order] for c in clusters]) if clusters else []
         if not len(at):
@@ -117,7 +121,10 @@ def estimates_from_clusters(flat, clusters: list[Cluster], perturb, n_orders_swe
             for member in at:
                 errors[int(member)] = (np.nan, np.nan, None, flat.shape[:, member], None)
             continue
-        dev = perturb(int(order), flat.index[at])
+        probed.append((int(order), at))
+    # each order's deviations are independent of the others'
+    deviations = map_over_threads(lambda job: perturb(job[0], flat.index[job[1]]), probed, workers)
+    for (order, at), dev in zip(probed, deviations):
         sf, sz = pole_errors(flat.pole[at], dev["pole"])
         for j, member in enumerate(at):
             unit = flat.shape[:, member]

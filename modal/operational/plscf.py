@@ -167,7 +167,7 @@ def plscf(prepared: Prepared, refs, max_order=None, workers: int = 1):
     # the poles' participation vectors, their shapes until the residue fit below, lie on the references
     estimates, chosen, kept = estimates_from_clusters(flat, clusters, perturb, len(orders),
                                                       prepared.scale[np.asarray(refs, int)],
-                                                      representative="upper_half")
+                                                      representative="upper_half", workers=workers)
     estimates = _with_shapes(estimates, S, omega, beta, 1.0 / fs, blocks_dS, prepared.scale)
     settings = {"orders": [orders[0], orders[-1]], "lags": n_lags, "window_decay_per_s": float(beta)}
     return estimates, chosen, kept, flat, stable, corr, settings

@@ -6,7 +6,7 @@ import threading
 import pytest
 
 from modal.errors import ParameterError
-from modal.parallel import shares, split_over_threads, thread_count, usable_cores
+from modal.parallel import map_over_threads, shares, split_over_threads, thread_count, usable_cores
 
 
 @pytest.mark.parametrize("n_items, workers", [(50, 2), (7, 3), (2, 8), (1, 4), (64, 1)])
@@ -57,3 +57,18 @@ def test_default_threads_follow_omp_num_threads(monkeypatch):
     assert thread_count(None) == usable_cores() == 1
     monkeypatch.setenv("OMP_NUM_THREADS", "not a number")  # ignored
     assert usable_cores() == every_core
+
+
+def test_items_mapped_over_threads_come_back_in_order():
+    assert map_over_threads(lambda x: x * x, range(40), 3) == [x * x for x in range(40)]
+    assert map_over_threads(lambda x: x, [], 3) == []
+
+
+def test_the_earliest_items_error_is_raised():
+    def fails_from_seven(x):
+        if x >= 7:
+            raise ValueError(f"item {x}")
+        return x
+
+    with pytest.raises(ValueError, match="item 7$"):
+        map_over_threads(fails_from_seven, range(20), 2)
