@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import inspect
 import io
 import os
 import statistics
@@ -225,14 +226,21 @@ def tone_calls(n_records: int) -> str:
 
 def speed(runs: int = 3) -> str:
     """CPU and wall time of ``modal.oma`` per record size (median of ``runs`` after one warm-up call), SSI,
-    band 1-30 Hz at 100 Hz. The header names the ``modal`` package measured: run this file with another
-    tree's interpreter (``OTHER/.venv/bin/python OTHER/benchmarks/bench_oma.py --records 0 --speed`` from outside
-    either tree) to time that tree's code on the same records."""
+    band 1-30 Hz at 100 Hz, with one thread and with the default (every usable core, :mod:`modal.parallel`),
+    interleaved. The header names the ``modal`` package measured: run this file with another tree's interpreter
+    (``OTHER/.venv/bin/python OTHER/benchmarks/bench_oma.py --records 0 --speed`` from outside either tree) to
+    time that tree's code on the same records."""
+    from modal.parallel import usable_cores
     from modal.synthetic import ambient_modal_response
 
+    threaded = "workers" in inspect.signature(modal.oma).parameters
+    cores = usable_cores() if threaded else 1
     lines = [f"modal from {Path(modal.__file__).resolve().parent.parent}, OPENBLAS_NUM_THREADS="
-             f"{os.environ.get('OPENBLAS_NUM_THREADS', 'unset')}, median of {runs}", "",
-             "| samples × channels | band [Hz] | CPU [s] | wall [s] |", "|---|---|---|---|"]
+             f"{os.environ.get('OPENBLAS_NUM_THREADS', 'unset')}, {cores} usable core(s), median of {runs}, "
+             f"load {os.getloadavg()[0]:.1f}", "",
+             f"| samples × channels | band [Hz] | CPU, 1 thread [s] | wall, 1 thread [s] | CPU, {cores} threads [s] | "
+             f"wall, {cores} threads [s] |", "|---|---|---|---|---|---|"]
+    settings = [{"workers": 1}, {}] if threaded else [{}, {}]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         warm = ambient_modal_response(FN, ZETA, np.random.default_rng(1).standard_normal((8, 6)), 100.0, 20_000)
@@ -241,14 +249,15 @@ def speed(runs: int = 3) -> str:
             rng = np.random.default_rng(1)
             shapes = rng.standard_normal((ch, 6))
             rec = ambient_modal_response(FN, ZETA, shapes, 100.0, n, noise=0.1, seed=2)
-            cpu, wall = [], []
+            times = [([], []) for _ in settings]
             for _ in range(runs):
-                c0, w0 = time.process_time(), time.perf_counter()
-                modal.oma(rec.signals, 100.0, band_hz=BAND)
-                cpu.append(time.process_time() - c0)
-                wall.append(time.perf_counter() - w0)
-            lines.append(f"| {n} × {ch} | {BAND[0]:g}-{BAND[1]:g} | {statistics.median(cpu):.2f} | "
-                         f"{statistics.median(wall):.2f} |")
+                for (cpu, wall), kwargs in zip(times, settings):
+                    c0, w0 = time.process_time(), time.perf_counter()
+                    modal.oma(rec.signals, 100.0, band_hz=BAND, **kwargs)
+                    cpu.append(time.process_time() - c0)
+                    wall.append(time.perf_counter() - w0)
+            cells = " | ".join(f"{statistics.median(cpu):.2f} | {statistics.median(wall):.2f}" for cpu, wall in times)
+            lines.append(f"| {n} × {ch} | {BAND[0]:g}-{BAND[1]:g} | {cells} |")
             del rec
     return "\n".join(lines)
 
