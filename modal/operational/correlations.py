@@ -6,7 +6,8 @@ of the record: each segment of ``n_seg`` samples of the references is correlated
 with the same stretch of every output extended by the longest lag (overlap-save), so that every pair
 of samples up to the longest lag is counted exactly once. The cross-spectra are summed over the
 segments of a block with one matrix product per frequency line; the block sums, transformed back,
-are the blocks' unbiased correlations and their mean the record's.
+are the blocks' unbiased correlations and their mean the record's. The blocks are independent: each
+thread (:mod:`modal.parallel`) takes a contiguous share of them.
 """
 from __future__ import annotations
 
@@ -135,13 +136,14 @@ def correlations(signals: np.ndarray, sample_rate_hz: float, references, max_lag
         raise ParameterError(f"{n} samples hold no segment of {n_seg} samples plus the longest lag {max_lag}")
     n_blocks = int(min(max_blocks, n_segments))
     edges = np.linspace(0, n_segments, n_blocks + 1).round().astype(int)
-    spectra = np.empty((n_blocks, n_fft // 2 + 1, n_out, refs.size), np.complex64)
+    lagged = np.empty((n_blocks, max_lag + 1, n_out, refs.size))
     shift = None if mean is None else np.asarray(mean, float)[:, None]
     # float32 FFTs: their rounding (1e-7 relative) lies far below the estimates' scatter (1/√samples)
     record = np.ascontiguousarray(signals, dtype=np.float32) if mean is None else None
 
-    def block_spectra(first_block: int, stop_block: int) -> None:
-        """The cross-spectra of blocks ``first_block``…``stop_block − 1``, into ``spectra``."""
+    def block_correlations(first_block: int, stop_block: int) -> None:
+        """The correlation sums of blocks ``first_block``…``stop_block − 1``, into ``lagged``."""
+        spectra = np.empty((n_fft // 2 + 1, n_out, refs.size), np.complex64)
         if mean is not None:  # each block's samples centred into one buffer, reused
             longest = int(np.diff(edges[first_block:stop_block + 1]).max()) * n_seg + max_lag
             buffer = np.empty((n_out, longest), np.float32)
@@ -160,11 +162,10 @@ def correlations(signals: np.ndarray, sample_rate_hz: float, references, max_lag
             past = sfft.rfft(ext[:n_seg, refs], n=n_fft, axis=0)  # the references' segments, zero-padded
             # Σ over the block's segments of Y_o(f) conj(X_r(f)): one (outputs × segments)(segments × refs)
             # product per line
-            np.matmul(future, past.conj().transpose(0, 2, 1), out=spectra[b])
+            np.matmul(future, past.conj().transpose(0, 2, 1), out=spectra)
+            lagged[b] = sfft.irfft(spectra, n=n_fft, axis=0)[:max_lag + 1]  # (lags, n_out, refs)
 
-    split_over_threads(block_spectra, n_blocks, workers)
-    lagged = sfft.irfft(spectra, n=n_fft, axis=1)[:, :max_lag + 1]  # (blocks, lags, n_out, refs)
-    lagged = lagged.astype(float)
+    split_over_threads(block_correlations, n_blocks, workers)
     weights = (np.diff(edges) * n_seg).astype(float)
     lagged /= weights[:, None, None, None]
     if scale is not None:
