@@ -254,10 +254,10 @@ def test_runs_with_one_blas_thread_and_gives_the_callers_setting_back(monkeypatc
 def test_modes_do_not_depend_on_the_number_of_threads(method):
     """A long record's blocks and channels are shared among threads (modal/parallel.py), each share computed as
     one loop computes it: the same modes and errors, bit for bit."""
-    rec = anchor_record(32, noise=0.1, tones=False, duration_s=400.0)
+    rec = anchor_record(32, noise=0.1, tones=False, duration_s=150.0)
     one = _oma(rec.signals, rec.sample_rate_hz, band_hz=(1.0, 30.0), method=method, workers=1)
     two = _oma(rec.signals, rec.sample_rate_hz, band_hz=(1.0, 30.0), method=method, workers=2)
-    assert len(one) == len(two) >= 5
+    assert len(one) == len(two) >= 4
     for x, y in zip(one, two):
         assert (x.natural_frequency_hz, x.damping_ratio, x.std.natural_frequency_hz, x.std.damping_ratio) == \
             (y.natural_frequency_hz, y.damping_ratio, y.std.natural_frequency_hz, y.std.damping_ratio)
