@@ -295,17 +295,20 @@ def _refuse_non_finite(signals: np.ndarray, ch: int, src: str, names) -> None:
                          "expected values whose sum fits double precision (rescale the record)")
 
 
-def _centred_decimated(signals: np.ndarray, factor: int, src: str, names) -> np.ndarray:
+def _centred_decimated(signals: np.ndarray, factor: int, src: str, names, workers=None) -> np.ndarray:
     """Each channel less its mean (in double precision), decimated by ``factor``: one channel at a time, so that
-    no double-precision copy of the whole record is made (a 10⁶ × 64 record's would be 512 MB)."""
+    no double-precision copy of the whole record is made (a 10⁶ × 64 record's would be 512 MB); the channels
+    shared among ``workers`` threads."""
     _check_shape(signals, src)
-    out = None
-    for ch in range(signals.shape[0]):
-        mean = _finite_mean(signals, ch, src, names)
-        reduced = decimate((signals[ch] - mean)[None, :], factor)[0]
-        if out is None:
-            out = np.empty((signals.shape[0], reduced.size))
-        out[ch] = reduced
+    n_channels, n = signals.shape
+    out = np.empty((n_channels, -(-n // factor)))  # resample_poly keeps ceil(n / factor) samples
+
+    def decimate_channels(first: int, stop: int) -> None:
+        for ch in range(first, stop):
+            mean = _finite_mean(signals, ch, src, names)
+            out[ch] = decimate((signals[ch] - mean)[None, :], factor)[0]
+
+    split_over_threads(decimate_channels, n_channels, workers)
     return out
 
 
@@ -331,7 +334,7 @@ def prepare(data, sample_rate_hz=None, band_hz=None, quantity: str | None = None
         Warn of dropouts and clipping (:func:`modal.operational.screen.screen_samples`); False for a record
         prepared again (a plot of a record identified already).
     workers : int, optional
-        Threads for the channels' statistics (default: every usable core).
+        Threads for the channels' decimation and statistics (default: every usable core).
     """
     signals, rate, file_quantity, names, src = _record(data, sample_rate_hz)
     if not (np.isfinite(rate) and rate > 0):
@@ -342,7 +345,7 @@ def prepare(data, sample_rate_hz=None, band_hz=None, quantity: str | None = None
     # a record to be decimated is centred (an offset would ring in the filter) and filtered in double precision,
     # channel by channel; any other is used as it is stored (see Prepared)
     if factor > 1:
-        work = _centred_decimated(signals, factor, src, names)
+        work = _centred_decimated(signals, factor, src, names, workers)
         if work.shape[1] < 2:
             raise ParameterError(f"{src}: {signals.shape[1]} samples; too short a record for the band up to "
                                  f"{high:g} Hz")

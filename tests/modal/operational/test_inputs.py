@@ -141,11 +141,14 @@ def test_an_array_rate_in_khz_is_named():
     assert prepared.sample_rate_hz == 0.1  # named, not changed
 
 
-def test_statistics_do_not_depend_on_the_number_of_threads():
-    # the channels are shared among threads, each channel read as one loop reads it: bit for bit the same
+@pytest.mark.parametrize("rate_hz", [100.0, 1000.0])  # (the second decimated by 8 first)
+def test_statistics_do_not_depend_on_the_number_of_threads(rate_hz):
+    # the channels are shared among threads, each channel read (and decimated) as one loop does it: bit for bit
+    # the same
     signals = _record(n_channels=5)
     signals[3] += 1e6  # a channel whose pieces are centred first
-    one = prepare(signals, 100.0, workers=1)
+    one = prepare(signals, rate_hz, (1.0, 30.0), workers=1)
     for workers in (2, 3, 8):
-        other = prepare(signals, 100.0, workers=workers)
+        other = prepare(signals, rate_hz, (1.0, 30.0), workers=workers)
+        assert np.array_equal(other.signals, one.signals)
         assert np.array_equal(other.mean, one.mean) and np.array_equal(other.scale, one.scale)
