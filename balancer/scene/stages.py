@@ -532,6 +532,20 @@ def stage_rotor(scene: Scene, identify=None, drive=None, oma=None) -> RotorStage
     return RotorStage(params, ParameterStd(**std, correlation=correlation), tuple(sources))
 
 
+#: fastest speed of the balls' race accepted (m/s): a spinning steel ring bursts near √(σ/ρ), about 450 m/s for
+#: the strongest steels; ball balancers run 10-150 m/s
+MAX_RACE_SPEED_M_S = 500.0
+
+
+def _check_race_speed(scene: Scene, params: ADBParameters, speed_rad_s: float, what: str) -> None:
+    """A race that would burst at ``speed_rad_s``: a radius in the wrong unit."""
+    race_speed = params.R * speed_rad_s
+    if race_speed > MAX_RACE_SPEED_M_S:
+        raise SceneError(f"{scene.source}: key 'adb.R' = {params.R:.6g} m at {speed_rad_s:.6g} rad/s ({what}) moves "
+                         f"the balls at {race_speed:.4g} m/s; expected below {MAX_RACE_SPEED_M_S:.0f} m/s (a steel "
+                         "race bursts near 450 m/s): a radius in mm or cm written as m?")
+
+
 def stage_adb_stability(scene: Scene, rotor: RotorStage) -> StabilityStage:
     """Stable speed intervals of the balanced state, and max Re λ against speed."""
     from ..adb import balanced_stability
@@ -539,6 +553,8 @@ def stage_adb_stability(scene: Scene, rotor: RotorStage) -> StabilityStage:
     cfg = scene.section("adb.stability", {})
     params = rotor.params
     wn = params.natural_frequency_rad_s
+    # the balls balance only above the natural frequency: a race that cannot reach it leaves nothing to study
+    _check_race_speed(scene, params, wn, "the rotor's natural frequency")
     speed_max = cfg.get("speed_max_rad_s", cfg.get("speed_max_ratio", 4.0) * wn)
     can = params.can_balance
     if not can:
@@ -560,12 +576,17 @@ def stage_adb_response(scene: Scene, rotor: RotorStage, drive=None) -> Simulatio
             raise SceneError(f"{scene.source}: key 'adb.response' needs speed_rad_s, or speed_end_rad_s and ramp_s")
         end = resolve(cfg["speed_end_rad_s"], "adb.response.speed_end_rad_s", scene, drive=drive)
         speed = LinearRunUp(cfg.get("speed_start_rad_s", 0.0), end, cfg["ramp_s"])
+    top = speed if isinstance(speed, (int, float)) else max(speed.start_speed, speed.end_speed)
+    _check_race_speed(scene, rotor.params, float(top), "the response's top speed")
     t_end = cfg.get("t_end_s", 2 * cfg.get("ramp_s", 1.0))
     return simulate(rotor.params, speed, t_end, cfg.get("initial_ball_angles_rad"), rtol=cfg.get("rtol", 1e-8))
 
 
 #: fastest mean piston speed accepted (m/s): compressors run 2-6 m/s, racing engines about 25 m/s
 MAX_MEAN_PISTON_SPEED_M_S = 30.0
+#: below this mean piston speed (m/s) a slider-crank is warned of: the slowest machines (large gas compressors,
+#: oil-field pump jacks) run about 0.5 m/s; a speed in rev/s or Hz written as rpm lands near 0.04 m/s
+MIN_MEAN_PISTON_SPEED_M_S = 0.2
 
 
 def check_compressor(scene: Scene) -> None:
@@ -590,11 +611,36 @@ def check_mounts(scene: Scene) -> None:
                          "body's mass: masses in g written as kg?")
 
 
+#: standard gravity (m/s²)
+STANDARD_GRAVITY_M_S2 = 9.80665
+#: largest static sag of the body on its mounts accepted (m): the softest spring isolators (near 0.7 Hz) sag about
+#: half a metre, a compressor's mounts a few millimetres
+MAX_MOUNT_SAG_M = 0.5
+
+
+def _check_sag(scene: Scene, body_mass_kg: float, mounts) -> None:
+    """A body that would sink further under its own weight than any isolator lets it, even along the mounts'
+    stiffest direction (whichever is vertical): a stiffness or a mass in the wrong unit."""
+    stiffest = max(sum(float(m.stiffness_n_per_m[axis]) for m in mounts) for axis in range(3))
+    sag = body_mass_kg * STANDARD_GRAVITY_M_S2 / stiffest if stiffest > 0 else math.inf
+    if sag > MAX_MOUNT_SAG_M:
+        raise SceneError(f"{scene.source}: key 'compressor.mounts': the {body_mass_kg:.6g} kg body would sag "
+                         f"{sag:.3g} m under its weight even along the mounts' stiffest direction ({stiffest:.6g} N/m "
+                         f"together); expected below {MAX_MOUNT_SAG_M:g} m (the softest spring isolators): a stiffness "
+                         "in kN/m written as N/m, or a mass in g written as kg?")
+
+
 def stage_compressor(scene: Scene) -> CompressorStage:
     """Exact optimum counterweight of the slider-crank (lightest: r_c = r, or a given k)."""
     from ..compressor.crank import SliderCrank, counterweight_on_curve, optimal_counterweight
 
     cfg = scene.section("compressor")
+    piston_speed = 4.0 * cfg["crank_radius_m"] * cfg["speed_rpm"] / 60.0
+    if piston_speed < MIN_MEAN_PISTON_SPEED_M_S:  # (warned here, where the stage's warnings are kept with it)
+        warn(f"{scene.source}: key 'compressor.speed_rpm' = {cfg['speed_rpm']:.6g} rpm with crank_radius_m = "
+             f"{cfg['crank_radius_m']:.6g} m moves the piston at {piston_speed:.3g} m/s on average, slower than any "
+             f"machine runs (above {MIN_MEAN_PISTON_SPEED_M_S:g} m/s): a speed in rev/s or Hz written as rpm? The "
+             "balance fraction does not depend on the speed; the shaking forces scale with its square")
     mech = SliderCrank(cfg["crank_radius_m"], cfg["rod_length_m"], cfg["rotating_mass_kg"],
                        cfg["reciprocating_mass_kg"], harmonics=cfg.get("harmonics", (1, 2)))
     optimum = optimal_counterweight(mech, cfg["speed_rpm"])
@@ -618,6 +664,7 @@ def stage_mounts(scene: Scene, compressor: CompressorStage, identify=None) -> Mo
                 raw = [value, value, value]
             vectors[key] = raw
         mounts.append(Mount(m["position_m"], vectors["stiffness_n_per_m"], vectors["damping_n_s_per_m"]))
+    _check_sag(scene, body_cfg["mass_kg"], mounts)
     system = MountedBody(RigidBody(body_cfg["mass_kg"], np.array(body_cfg["inertia_kg_m2"])), tuple(mounts),
                          damping_ratio=body_cfg.get("damping_ratio", 0.0))
     modes = natural_modes(system)

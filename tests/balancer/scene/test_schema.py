@@ -8,6 +8,12 @@ from balancer import run_scene
 from modal.errors import SceneError
 from support.scenes import SYNTH_FRF, ROTOR, ADB, COMPRESSOR, DRIVE
 
+#: seed 000's compressor body on its three mounts (data/synthetic/demo_scene.toml): it sags 0.85 mm
+BODY = {"mass_kg": 16.3, "inertia_kg_m2": [[0.067, 0.0, -0.001], [0.0, 0.059, 0.0], [-0.001, 0.0, 0.0405]],
+        "crank_centre_m": [0.005, 0.008, 0.005], "damping_ratio": 0.05}
+MOUNTS = [{"position_m": position, "stiffness_n_per_m": [30500.0, 30500.0, 63000.0]}
+          for position in ([0.0, 0.076, -0.056], [-0.052, -0.060, -0.056], [0.052, -0.060, -0.056])]
+
 
 BAD_SCENES = [
     ({"outputs": {"tables": ["compressor"]}, "compresor": {}}, "unknown key 'compresor'"),
@@ -59,6 +65,19 @@ BAD_SCENES = [
                  "crank_centre_m": [0.005, 0.008, 0.005]},
         "mounts": [{"position_m": [0.0, 0.076, -0.056], "stiffness_n_per_m": [3e4, 3e4, 6e4]}]}},
      "key 'compressor.body.mass_kg' = 16.3 kg is not above the crank's moving masses (245 kg)"),
+    # the race radius in mm (50 m) or cm (5 m) written as m: balls at 2-5 km/s, beyond a steel ring's burst speed
+    ({"outputs": {"tables": ["adb_stability"]}, "frf": SYNTH_FRF, "adb": {**ADB, "R": 50.0}, "rotor": ROTOR},
+     "key 'adb.R' = 50 m at 98.0185 rad/s (the rotor's natural frequency) moves the balls at 4901 m/s"),
+    ({"outputs": {"tables": ["adb_response"]}, "frf": SYNTH_FRF, "rotor": ROTOR,
+      "adb": {**ADB, "R": 5.0, "response": {"speed_end_rad_s": 400.0, "ramp_s": 1.0}}},
+     "key 'adb.R' = 5 m at 400 rad/s (the response's top speed) moves the balls at 2000 m/s"),
+    # mount stiffness in kN/m written as N/m, the body's mass in g written as kg: the body would sink 0.85 m
+    ({"outputs": {"tables": ["mounts"]}, "compressor": {**COMPRESSOR, "body": BODY, "mounts": [
+        {**mount, "stiffness_n_per_m": [k / 1000 for k in mount["stiffness_n_per_m"]]} for mount in MOUNTS]}},
+     "key 'compressor.mounts': the 16.3 kg body would sag 0.846 m"),
+    ({"outputs": {"tables": ["mounts"]}, "compressor": {**COMPRESSOR, "body": {**BODY, "mass_kg": 16300.0},
+                                                        "mounts": MOUNTS}},
+     "key 'compressor.mounts': the 16300 kg body would sag 0.846 m"),
     ({"outputs": {"tables": ["identify"]}, "frf": {"file": "x.csv", **SYNTH_FRF}}, "both 'file' and 'synthetic'"),
     ({"outputs": {"tables": ["identify"]}, "frf": {"kind": "mobility"}}, "needs 'file'"),
     ({"outputs": {"tables": ["identify"]}, "frf": {"file": "missing.csv"}}, "missing.csv"),
@@ -95,3 +114,25 @@ def test_invalid_toml_and_missing_scene(tmp_path):
         run_scene(path)
     with pytest.raises(SceneError, match="no such scene file"):
         run_scene(tmp_path / "none.toml")
+
+
+def test_the_bodys_own_mounts_pass_the_sag_check(tmp_path):
+    # the same body and mounts as the refused scenes above, in their units: 0.85 mm of sag, no error
+    run = run_scene(copy.deepcopy({"outputs": {"tables": ["mounts"]},
+                                   "compressor": {**COMPRESSOR, "body": BODY, "mounts": MOUNTS}}),
+                    out=tmp_path / "o.h5")
+    assert run.stages["mounts"] == "ran"
+
+
+def test_a_compressor_slower_than_any_machine_is_warned(tmp_path):
+    """2950 rpm written as rev/s (49.2): the balance fraction is the same, the forces 3600 times too small; a
+    piston moving at 0.04 m/s on average (the slowest machines run about 0.5 m/s) is warned, and the warning is
+    kept with the stage; the compressor at its speed is not."""
+    from modal.errors import ModalWarning
+
+    slow = {"outputs": {"tables": ["compressor"]}, "compressor": {**COMPRESSOR, "speed_rpm": 49.2}}
+    with pytest.warns(ModalWarning, match=r"'compressor.speed_rpm' = 49.2 rpm .* moves the piston at 0.039 m/s"):
+        run = run_scene(copy.deepcopy(slow), out=tmp_path / "slow.h5")
+    assert list(run.warnings) == ["compressor"]
+    normal = run_scene(copy.deepcopy({**slow, "compressor": COMPRESSOR}), out=tmp_path / "normal.h5")
+    assert normal.warnings == {}
