@@ -27,7 +27,7 @@ from typing import Sequence
 
 import numpy as np
 
-from modal.errors import ParameterError
+from modal.errors import ParameterError, warn
 from modal.units import rpm_to_rad_s
 
 from .._checks import finite, non_negative, positive
@@ -122,6 +122,12 @@ ARC_CORRECTION_VV = CorrectionTable(
 #: fastest belt speed accepted (m/s): classical V-belts are rated to about 30 m/s, narrow wedge belts to 40-50 m/s;
 #: above this a pulley diameter was given in the wrong unit
 MAX_BELT_SPEED_M_S = 60.0
+#: slowest belt speed not warned of (m/s): V-belt drives run 5-30 m/s; a motor speed in rad/s written as rpm runs
+#: the belt about 10 times slower than meant, in rev/s 60 times
+MIN_BELT_SPEED_M_S = 1.0
+#: longest belt accepted (m): V-belt catalogues end near 15 m; a centre distance in mm written as m makes belts
+#: hundreds of metres long
+MAX_BELT_LENGTH_M = 30.0
 
 
 def _check_pulleys(driver_diameter_m: float, driven_diameter_m: float, center_distance_m: float) -> tuple[float, float, float]:
@@ -486,6 +492,15 @@ def belt_stage(
             f"driver_diameter_m = {d1:.6g} m at {n1_rpm:.6g} rpm runs the belt at {speed:.4g} m/s; expected below "
             f"{MAX_BELT_SPEED_M_S:.0f} m/s (V-belts are rated to 30-50 m/s): diameters in mm written as m?"
         )
+    if length > MAX_BELT_LENGTH_M:
+        raise ParameterError(
+            f"center_distance_m = {c:.6g} m with pulleys of {d1:.6g} m and {d2:.6g} m makes a belt {length:.4g} m "
+            f"long; expected below {MAX_BELT_LENGTH_M:.0f} m (V-belt catalogues end near 15 m): a distance in mm "
+            "written as m?")
+    if speed < MIN_BELT_SPEED_M_S:
+        warn(f"driver_diameter_m = {d1:.6g} m at {n1_rpm:.6g} rpm runs the belt at {speed:.3g} m/s (its pull for the "
+             f"power would be {power / speed:.4g} N); V-belt drives run 5-30 m/s: a motor speed in rad/s or rev/s "
+             "written as rpm?")
     pull = power / speed
 
     if per_belt_rating_w is not None:

@@ -5,6 +5,7 @@ import math
 from dataclasses import dataclass
 from typing import Sequence
 
+from modal.errors import ParameterError
 from modal.units import rad_s_to_rpm
 
 from ..._checks import positive
@@ -71,6 +72,31 @@ class RotorHandover:
     margin: SpeedMargin
 
 
+#: standard gravity (m/s²)
+STANDARD_GRAVITY_M_S2 = 9.80665
+#: largest bending stress (Pa) the rotor's weight alone may put in the shaft: the strongest shaft steels yield near
+#: 1 GPa, and a running shaft is loaded far below its yield; everyday rotors stress it a few MPa
+MAX_WEIGHT_STRESS_PA = 1e9
+
+
+def _check_weight_stress(geometry: ShaftGeometry, position_m: float, diameter_m: float, mass_kg: float) -> None:
+    """A rotor whose weight across the shaft would bend it beyond any steel's yield: a mass in g written as kg,
+    or a diameter in the wrong unit. The moment is the point load's largest: ``W a b / L`` under it between the
+    bearings, ``W c`` at the bearing next to an overhang ``c``."""
+    weight = mass_kg * STANDARD_GRAVITY_M_S2
+    x, span = float(position_m), geometry.span_m
+    if geometry.bearing_a_m < x < geometry.bearing_b_m:
+        moment = weight * (x - geometry.bearing_a_m) * (geometry.bearing_b_m - x) / span
+    else:
+        moment = weight * (geometry.bearing_a_m - x if x < geometry.bearing_a_m else x - geometry.bearing_b_m)
+    stress = moment * (0.5 * diameter_m) / second_moment_of_area_m4(diameter_m)
+    if stress > MAX_WEIGHT_STRESS_PA:
+        raise ParameterError(
+            f"rotor_mass_kg = {mass_kg:.6g} kg at {x:.6g} m would bend the {diameter_m:.6g} m shaft at "
+            f"{stress / 1e9:.3g} GPa under its weight alone; expected far below {MAX_WEIGHT_STRESS_PA / 1e9:g} GPa "
+            "(the strongest shaft steels yield there): a mass in g written as kg, or the diameter in the wrong unit?")
+
+
 def rotor_handover(shaft_speed_rad_s: float, geometry: ShaftGeometry, diameter_m: float, rotor_position_m: float,
                    rotor_mass_kg: float, *, other_masses_kg: Sequence[float] = (), other_positions_m: Sequence[float] = (),
                    youngs_modulus_pa: float = STEEL_YOUNGS_MODULUS_PA, density_kg_m3: float = STEEL_DENSITY_KG_M3,
@@ -110,6 +136,7 @@ def rotor_handover(shaft_speed_rad_s: float, geometry: ShaftGeometry, diameter_m
     mass = positive("rotor_mass_kg", rotor_mass_kg, "kg")
     position = _check_position(geometry, "rotor_position_m", rotor_position_m)
     k = bending_stiffness_n_per_m(geometry, position, diameter_m, youngs_modulus_pa)
+    _check_weight_stress(geometry, position, diameter_m, mass)
     critical = critical_speed(
         geometry, diameter_m, [mass, *other_masses_kg], [position, *other_positions_m],
         youngs_modulus_pa, density_kg_m3, include_shaft_mass,

@@ -68,6 +68,28 @@ def rotor_layout(geometry: ShaftGeometry, position_m: float) -> str:
     return "between bearings" if geometry.bearing_a_m < x < geometry.bearing_b_m else "overhung"
 
 
+#: Young's moduli accepted (Pa): from engineering plastics (PTFE 0.5 GPa, nylon 3 GPa) to tungsten carbide
+#: (about 700 GPa) with room on either side; a modulus in GPa or MPa written as Pa lies far below
+SOLID_MODULUS_RANGE_PA = (1e8, 1.2e12)
+
+
+def solid_modulus_pa(youngs_modulus_pa: float) -> float:
+    """``youngs_modulus_pa`` checked to be a solid shaft's modulus (:data:`SOLID_MODULUS_RANGE_PA`).
+
+    Raises
+    ------
+    ParameterError
+        Not a positive number, or outside the range: a modulus in GPa or MPa written as Pa.
+    """
+    modulus = positive("youngs_modulus_pa", youngs_modulus_pa, "Pa")
+    low, high = SOLID_MODULUS_RANGE_PA
+    if not low <= modulus <= high:
+        raise ParameterError(
+            f"youngs_modulus_pa = {modulus:.6g} Pa; expected a solid shaft's modulus, {low / 1e9:g}-{high / 1e9:g} GPa "
+            "(steel 205 GPa, aluminium 70 GPa, nylon 3 GPa): a modulus in GPa or MPa written as Pa?")
+    return modulus
+
+
 def bending_stiffness_n_per_m(geometry: ShaftGeometry, position_m: float, diameter_m: float,
                               youngs_modulus_pa: float = STEEL_YOUNGS_MODULUS_PA) -> float:
     """Transverse bending stiffness of a uniform shaft at ``position_m`` (load and deflection there).
@@ -93,7 +115,7 @@ def bending_stiffness_n_per_m(geometry: ShaftGeometry, position_m: float, diamet
         Stiffness, N/m.
     """
     layout = rotor_layout(geometry, position_m)
-    ei = positive("youngs_modulus_pa", youngs_modulus_pa, "Pa") * second_moment_of_area_m4(diameter_m)
+    ei = solid_modulus_pa(youngs_modulus_pa) * second_moment_of_area_m4(diameter_m)
     if diameter_m >= geometry.length_m:
         raise ParameterError(
             f"diameter_m = {diameter_m:.6g} m is not below the shaft's length_m = {geometry.length_m:.6g} m; expected "

@@ -287,3 +287,27 @@ def test_pulley_diameters_in_millimetres_are_refused():
                                              r"expected below 60 m/s"):
         belt_stage(100.0, 120.0, 300.0, 930.0, 750.0)
     assert belt_stage(0.25, 0.5, 1.0, 3600.0, 5000.0).belt_speed_m_s == pytest.approx(math.pi * 0.25 * 60, rel=1e-12)
+
+
+def test_a_centre_distance_in_millimetres_is_refused():
+    """Stage A's centre distance written in mm as m (300 m) ran a 600 m belt with exit 0; V-belt catalogues end
+    near 15 m, and a belt longer than 30 m is refused naming the distance. A long real drive (2 m centres) computes."""
+    with pytest.raises(ParameterError, match=r"center_distance_m = 300 m with pulleys of 0.1 m and 0.12 m makes a "
+                                             r"belt 600.3 m long; expected below 30 m"):
+        belt_stage(0.100, 0.120, 300.0, 930.0, 750.0)
+    assert belt_stage(0.100, 0.120, 2.0, 930.0, 750.0).belt_length_m == pytest.approx(4.346, abs=1e-3)
+
+
+def test_a_motor_speed_in_rad_per_s_is_warned():
+    """930 rpm written as 97.4 (rad/s) runs stage A's belt at 0.51 m/s: every speed downstream is ten times too
+    slow. V-belt drives run 5-30 m/s; a belt below 1 m/s is warned of, naming the speed; at 930 rpm (4.9 m/s) no
+    warning."""
+    import warnings
+
+    from modal.errors import ModalWarning
+
+    with pytest.warns(ModalWarning, match=r"driver_diameter_m = 0.1 m at 97.4 rpm runs the belt at 0.51 m/s"):
+        belt_stage(0.100, 0.120, 0.300, 97.4, 750.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        belt_stage(0.100, 0.120, 0.300, 930.0, 750.0)

@@ -58,3 +58,33 @@ def test_worked_example_motor_to_ball_balancer_input():
     assert handover.margin.ok_1x and handover.margin.ok_2x
     assert not handover.margin.supercritical
     assert handover.speed_ratio == pytest.approx((775.0 * 2 * math.pi / 60) / math.sqrt(k / 2.0), rel=1e-12)
+
+
+def test_a_rotor_mass_in_grams_or_a_thin_shaft_is_refused():
+    """The 2 kg rotor overhung 0.15 m beyond bearing B of a 25 mm shaft bends it at 2 × 9.81 × 0.15 / (π 0.025³/32)
+    = 1.9 MPa under its weight. Its mass in g written as kg (2000), or the diameter 2.5 mm, makes that 1.9 GPa,
+    above the strongest shaft steels' yield, and a hand-over with Ω/ω = 5.7 and 18 printed with exit 0: refused,
+    naming the mass, the shaft and the stress. Between the bearings the moment is W a b / L."""
+    from modal.errors import ParameterError
+
+    assert rotor_handover(81.0, SHAFT_1, 0.025, 1.30, 2.0).rotor_mass_kg == 2.0
+    with pytest.raises(ParameterError, match=r"rotor_mass_kg = 2000 kg at 1.3 m would bend the 0.025 m shaft at "
+                                             r"1.92 GPa under its weight alone"):
+        rotor_handover(81.0, SHAFT_1, 0.025, 1.30, 2000.0)
+    with pytest.raises(ParameterError, match=r"the 0.0025 m shaft at 1.92 GPa"):
+        rotor_handover(81.0, SHAFT_1, 0.0025, 1.30, 2.0)
+    # mid-span of the 1.15 m span: W L / 4 = 2000 × 9.81 × 0.2875 against the 25 mm section: 3.68 GPa
+    with pytest.raises(ParameterError, match=r"at 3.68 GPa"):
+        rotor_handover(81.0, SHAFT_1, 0.025, 0.575, 2000.0)
+
+
+@pytest.mark.parametrize("modulus", [205.0, 205e3, 2.05e14])  # GPa or MPa written as Pa; 1000 times too large
+def test_a_youngs_modulus_in_the_wrong_unit_is_refused(modulus):
+    """205 (GPa written as Pa) made the 25 mm shaft's stiffness 4e-4 N/m and a hand-over with Ω/ω = 5720, exit 0."""
+    from modal.errors import ParameterError
+
+    import re
+
+    with pytest.raises(ParameterError, match=re.escape(f"youngs_modulus_pa = {modulus:.6g} Pa; expected a solid "
+                                                       "shaft's modulus, 0.1-1200 GPa")):
+        rotor_handover(81.0, SHAFT_1, 0.025, 1.30, 2.0, youngs_modulus_pa=modulus)
