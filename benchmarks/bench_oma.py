@@ -153,16 +153,16 @@ def compare(n_records: int) -> str:
     return "\n".join(lines)
 
 
-def calibration(n_records: int, n_sensors: int = 8, method: str = "ssi") -> str:
+def calibration(n_records: int, n_sensors: int = 8, method: str = "ssi", sample_rate_hz: float = 100.0) -> str:
     zf, zz, wrong = [], [], 0
     layout = None
     for seed in range(n_records):
-        rec = anchor_record(5000 + seed, noise=0.1, tones=True, n_sensors=n_sensors)
+        rec = anchor_record(5000 + seed, noise=0.1, tones=True, n_sensors=n_sensors, sample_rate_hz=sample_rate_hz)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             result = modal.oma(rec.signals, rec.sample_rate_hz, band_hz=BAND, method=method)
         layout = (len(result.settings["reference_channels"]), result.settings.get("block_rows"),
-                  result.settings.get("block_cols"), result.settings.get("lags"))
+                  result.settings.get("block_cols"), result.settings.get("lags"), result.settings["decimation"])
         wrong += len(result) != FN.size or len(result.harmonics_hz) != TONES.size
         row_f, row_z = [], []
         for k, fn in enumerate(FN):
@@ -175,7 +175,7 @@ def calibration(n_records: int, n_sensors: int = 8, method: str = "ssi") -> str:
     shape = (f"{layout[1]} + 1 output block rows, {layout[2]} reference block columns; SSI" if method == "ssi"
              else f"half-spectra over {layout[3]} lags; pLSCF")
     lines = [f"z = error / reported standard error over {n_records} records (anchor case, {n_sensors} sensors, "
-             f"{layout[0]} references, {shape}); "
+             f"{layout[0]} references, {shape}; sampled at {sample_rate_hz:g} Hz, decimated by {layout[4]}); "
              f"records with a mode missing, twice or a tone missing: {wrong}", "",
              "| mode [Hz] | ζ | z(f) mean | z(f) SD | z(ζ) mean | z(ζ) SD |", "|---|---|---|---|---|---|"]
     for k in range(FN.size):
@@ -271,6 +271,8 @@ def main(argv=None) -> None:
     parser.add_argument("--channels", type=int, default=8)
     parser.add_argument("--method", choices=("ssi", "plscf"), default="ssi",
                         help="the estimator whose errors --calibration checks")
+    parser.add_argument("--sample-rate", dest="sample_rate_hz", type=float, default=100.0,
+                        help="the --calibration records' rate, Hz (above 120 Hz they are decimated to the band first)")
     parser.add_argument("--tones", type=int, default=0)
     parser.add_argument("--speed", action="store_true")
     args = parser.parse_args(argv)
@@ -278,7 +280,7 @@ def main(argv=None) -> None:
         print(compare(args.records))
     if args.calibration:
         print()
-        print(calibration(args.calibration, args.channels, args.method))
+        print(calibration(args.calibration, args.channels, args.method, args.sample_rate_hz))
     if args.tones:
         print()
         print(tone_calls(args.tones))
