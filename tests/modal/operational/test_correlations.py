@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from modal.operational.correlations import choose_references, correlations, decimation_factor
+from modal.operational.correlations import choose_references, correlations, decimation_factor, decimation_filter
 from modal.errors import ParameterError
 
 
@@ -92,3 +92,18 @@ def test_correlations_do_not_depend_on_the_number_of_threads():
     for workers in (2, 3, 16):
         other = correlations(y, 50.0, [0, 3], 12, max_blocks=7, mean=mean, scale=scale, workers=workers)
         assert np.array_equal(other.blocks, one.blocks) and np.array_equal(other.weights, one.weights)
+
+
+@pytest.mark.parametrize("factor", [2, 3, 5, 8, 30])
+def test_decimation_filter_keeps_the_band_and_what_would_alias_into_it_out(factor):
+    # the band lies at or below half the new Nyquist frequency f_N (in these units 1): there the filter is flat
+    # within 0.002 dB; what folds into the band after decimation lies above 1.5 f_N, held 70 dB down or more
+    # (a Kaiser window of β = 8: its side lobes near -74 dB); unit gain at 0 Hz
+    from scipy.signal import freqz
+
+    taps = decimation_filter(factor)
+    assert taps.size == 10 * factor + 1 and np.isclose(taps.sum(), 1.0, rtol=0, atol=1e-12)
+    f, response = freqz(taps, worN=1 << 15, fs=2.0 * factor)
+    gain_db = 20 * np.log10(np.abs(response))
+    assert np.abs(gain_db[f <= 0.5]).max() < 0.002
+    assert gain_db[f >= 1.5].max() < -70.0

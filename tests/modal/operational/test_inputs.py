@@ -77,10 +77,12 @@ def test_decimated_record_is_the_centred_channels_filtered():
     # record): the same numbers as centring the whole record and filtering it at once
     from scipy.signal import resample_poly
 
+    from modal.operational.correlations import decimation_filter
+
     signals = _record(n_channels=3, n_samples=40_000)
     prepared = prepare(signals, 1000.0, (1.0, 30.0))
     assert prepared.decimation == 8 and prepared.sample_rate_hz == 125.0
-    reduced = resample_poly(signals - signals.mean(axis=1, keepdims=True), 1, 8, axis=1)
+    reduced = resample_poly(signals - signals.mean(axis=1, keepdims=True), 1, 8, axis=1, window=decimation_filter(8))
     assert np.allclose(prepared.signals, reduced, rtol=0, atol=1e-12)
     centred = reduced - reduced.mean(axis=1, keepdims=True)
     assert np.allclose(prepared.mean, reduced.mean(axis=1), rtol=0, atol=1e-12)
