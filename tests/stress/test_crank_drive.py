@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import math
 import os
+import warnings
 
 import numpy as np
 import pytest
@@ -23,7 +24,7 @@ from hypothesis import strategies as st
 from balancer import drive
 from balancer.compressor import crank
 from balancer.drive import shaft
-from modal.errors import ParameterError
+from modal.errors import ModalWarning, ParameterError
 from modal.units import rpm_to_rad_s
 
 STRESS_SEED = int(os.environ.get("STRESS_SEED", "8"))
@@ -171,21 +172,42 @@ def stages(draw):
     return d, big, centre
 
 
-def check_belt(geometry, speed_rpm, power_w, service) -> None:
+def _refusal(geometry, speed_rpm) -> str | None:
+    """What a stage is refused for, before anything is computed: a belt faster than any V-belt runs (a diameter in
+    mm written as m), or longer than any is made (a centre distance in mm)."""
     d, big, centre = geometry
     if math.pi * d * speed_rpm / 60 > drive.belt.MAX_BELT_SPEED_M_S:
-        # faster than any V-belt runs (a diameter in mm written as m): refused, not computed
-        with pytest.raises(ParameterError, match="runs the belt at"):
+        return "runs the belt at"
+    if drive.belt_pitch_length_m(d, big, centre) > drive.belt.MAX_BELT_LENGTH_M:
+        return "makes a belt"
+    return None
+
+
+def _slow(geometry, speed_rpm) -> bool:
+    """A belt slower than V-belt drives run: computed, with a warning (a motor speed in rad/s written as rpm)."""
+    return math.pi * geometry[0] * speed_rpm / 60 < drive.belt.MIN_BELT_SPEED_M_S
+
+
+def check_belt(geometry, speed_rpm, power_w, service) -> None:
+    d, big, centre = geometry
+    refused = _refusal(geometry, speed_rpm)
+    if refused:
+        with pytest.raises(ParameterError, match=refused):
             drive.belt_stage(d, big, centre, speed_rpm, power_w, service, arc_correction_factor=0.6)
         return
-    if abs(big - d) / centre > ARC_TABLE_MAX:
-        # a valid geometry outside the catalogue table: the documented answer is a
-        # ParameterError asking for the factor; with the factor given it must compute
-        with pytest.raises(ParameterError, match="correction table"):
-            drive.belt_stage(d, big, centre, speed_rpm, power_w, service)
-        stage = drive.belt_stage(d, big, centre, speed_rpm, power_w, service, arc_correction_factor=0.6)
-    else:
-        stage = drive.belt_stage(d, big, centre, speed_rpm, power_w, service)
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always", ModalWarning)
+        if abs(big - d) / centre > ARC_TABLE_MAX:
+            # a valid geometry outside the catalogue table: the documented answer is a
+            # ParameterError asking for the factor; with the factor given it must compute
+            with pytest.raises(ParameterError, match="correction table"):
+                drive.belt_stage(d, big, centre, speed_rpm, power_w, service)
+            said.clear()
+            stage = drive.belt_stage(d, big, centre, speed_rpm, power_w, service, arc_correction_factor=0.6)
+        else:
+            stage = drive.belt_stage(d, big, centre, speed_rpm, power_w, service)
+    assert [str(w.message) for w in said if "runs the belt at" in str(w.message)] != [] if _slow(geometry, speed_rpm) \
+        else not said, [str(w.message) for w in said]
     for name in stage.__slots__ if hasattr(stage, "__slots__") else vars(stage):
         value = getattr(stage, name)
         if isinstance(value, float):
@@ -224,12 +246,19 @@ def check_drive(geometries, efficiencies, speed, power) -> None:
                                  arc_correction_factor=0.6 if abs(big - d) / c > ARC_TABLE_MAX else None)
              for (d, big, c), e in zip(geometries, efficiencies)]
     driver_speeds = speed / np.cumprod([1.0] + [big / d for d, big, _ in geometries[:-1]])
-    if any(math.pi * d * n / 60 > drive.belt.MAX_BELT_SPEED_M_S for (d, _, _), n in zip(geometries, driver_speeds)):
-        # a stage faster than any V-belt runs: refused, not computed
-        with pytest.raises(ParameterError, match="runs the belt at"):
+    refused = [r for r in (_refusal(g, n) for g, n in zip(geometries, driver_speeds)) if r]
+    if refused:
+        # a stage faster or longer than any V-belt: refused, not computed (the first such stage named; a slow stage
+        # before it may have warned)
+        with warnings.catch_warnings(), pytest.raises(ParameterError, match=refused[0]):
+            warnings.simplefilter("ignore", ModalWarning)
             drive.belt_drive(speed, power, specs)
         return
-    result = drive.belt_drive(speed, power, specs)
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always", ModalWarning)
+        result = drive.belt_drive(speed, power, specs)
+    slow = sum(_slow(g, n) for g, n in zip(geometries, driver_speeds))
+    assert sum("runs the belt at" in str(w.message) for w in said) == slow, [str(w.message) for w in said]
     ratio = np.prod([big / d for d, big, _ in geometries])
     assert result.output_speed_rpm == pytest.approx(speed / ratio, rel=1e-12)
     assert result.output_power_w == pytest.approx(power * np.prod(efficiencies[: len(geometries)]), rel=1e-12)
