@@ -590,11 +590,11 @@ def identify_global(frf: FRF, *, modes_hz=None, order: int | None = None, max_or
         raise IdentificationError(f"{src}: no stable pole in the stabilisation diagram (orders {orders[0]}–"
                                   f"{orders[-1]}); give modes_hz hints or a higher max_order{cut}")
 
-    line_noise = frf.noise_std
+    line_noise = work.noise_std  # the band's lines (without the window's factor, as the data)
     if noise_std is not None:
         noise = np.broadcast_to(np.asarray(noise_std, float), (n_ch,)).copy()
     elif line_noise is not None:
-        noise = np.sqrt(np.mean(np.atleast_2d(line_noise)[:, keep] ** 2, axis=1))
+        noise = np.sqrt(np.mean(np.atleast_2d(line_noise) ** 2, axis=1))
     else:
         noise = estimate_noise_std(work)
     selected, dropped = _significant(omega, H, power, selected, noise)

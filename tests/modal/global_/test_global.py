@@ -570,6 +570,8 @@ def test_an_exponentially_windowed_accelerance_is_fitted_as_the_window_made_it()
     # moves fn by ~2e-11 relative) give the structure's poles and constants to 1e-8 relative, ten times the final
     # fit's step tolerance (1e-9); fitted with the factor in the data, fn moved by 5.5e-4 Hz (1.4e-5) and the
     # constants by 4e-4
+    from dataclasses import replace
+
     tau = 0.5
     fn, zeta = np.array([40.0, 95.0]), np.array([0.02, 0.012])
     constants = np.array([[0.5, 0.8], [0.3, -0.4]])
@@ -580,8 +582,13 @@ def test_an_exponentially_windowed_accelerance_is_fitted_as_the_window_made_it()
     s = 2j * np.pi * f
     frf = modal.FRF(f, (s + 1 / tau) ** 2 * receptance, kind="accelerance", response_points=["1", "2"],
                     reference_points=["1", "1"], exponential_decay_s=tau)
-    result = _fit(modal.add_noise(frf, 1e-9, seed=0))
+    noisy = modal.add_noise(frf, 1e-9, seed=0)
+    noisy = replace(noisy, noise_std=1e-9 * np.abs(noisy.channels).max(axis=1)[:, None] * np.ones(f.size))
+    result = _fit(noisy)
     assert len(result.modes) == 2
+    # the noise level the significance test and the flags read is the data's as fitted, divided by the factor
+    factor = np.abs((s + 1 / tau) / s) ** 2
+    np.testing.assert_allclose(result.noise_std, np.sqrt(np.mean((noisy.noise_std / factor) ** 2, axis=1)))
     for mode, f_true, z_true, a_true in zip(result.modes, fn, zeta, constants.T):
         assert abs(mode.natural_frequency_hz / f_true - 1) < 1e-8
         assert abs(mode.damping_ratio / z_true - 1) < 1e-8
