@@ -32,8 +32,8 @@ from ..units import TWO_PI
 from ..work_budget import EvaluationBudget, checked_max_evaluations, default_max_evaluations
 from .plscf import MAX_DAMPING, plscf_poles
 from .stabilisation import SelectedPole, outside_band_poles, select_poles, stabilisation
-from .window import without_window_factor
 from .sweep import most_stable, plan_sweep, refinement_mode_limit, sweep_lines, sweep_orders
+from .window import without_window_factor
 
 __all__ = ["identify_global", "channel_grid", "mpc"]
 
