@@ -16,7 +16,8 @@ default settings; a hammer test with an exponential window); ``--cells all`` add
 others (rectangular window, burst random, hammer without a window, few and many
 averages, light and heavy damping, and hammer tests with one force and 2, 3 or 6
 accelerometers in one file, named ``hammer-{exp,force}-{hits}-ch{accelerometers}``,
-``-global`` with the global method).
+``-global`` with the global method), and roving-hammer tests (one accelerometer, the hammer at three points,
+one record per point joined as ``modal fit`` joins one file per hit point: ``hammer-{exp,force}-{hits}-roving3``).
 """
 from __future__ import annotations
 
@@ -114,6 +115,35 @@ def hammer_cell(n_hits: int, window: str = "exponential", decay_s: float | None 
     return make
 
 
+def roving_cell(n_hits: int, window: str = "exponential", n_points: int = 3, spacing_s: float = 4.0,
+                noise: float = 0.002):
+    """A roving hammer: one accelerometer at the driving point (:data:`ACCELEROMETER_POSITIONS`' first), the
+    hammer at ``n_points`` points in turn (the first the driving point), ``n_hits`` hits each, one record per
+    point; each point's FRF estimated from its own record and the points joined
+    (:func:`modal.roving.join_estimates`), as ``modal fit`` joins one file per hit point. By reciprocity the
+    response at the driving point to a hit at x is the response at x to a hit at the driving point: the
+    structure of the multi-channel cells, one output per point."""
+    from modal.roving import join_estimates
+
+    def make(seed: int):
+        structure = system(n_outputs=n_points)
+        hits = 0.5 + spacing_s * np.arange(n_hits)
+        estimates = []
+        for point in range(n_points):
+            seen = DigitalModes(structure.natural_frequency_hz, structure.damping_ratio,
+                                structure.modal_constant[point], SAMPLE_RATE_HZ)
+            rec = impact_record(seen, hits, hits[-1] + spacing_s, amplitude_variation=0.2, width_variation=0.1,
+                                pulse_width_s=0.002, response_noise=noise, force_noise=0.002,
+                                seed=seed * n_points + point).record
+            estimates.append(modal.estimate_frf(rec.signals[0], rec.signals[1], rec.sample_rate_hz, impact=True,
+                                                window=window, exponential_decay_s=0.5 if window == "exponential"
+                                                else None, kind="accelerance", excitation_points=[f"{point + 1}"],
+                                                response_points=["1"]))
+        frf = join_estimates(estimates, [(f"{point + 1}", [f"point {point + 1}"]) for point in range(n_points)])
+        return frf, structure
+    return make
+
+
 #: the cells the chain is held to (z spread 0.75–1.3, |mean| ≤ 0.35 for fn and ζ of every mode)
 TARGET_CELLS = ("random-hann-default", "hammer-exp-6")
 
@@ -146,6 +176,12 @@ CELLS = {c.name: c for c in [
       for short, window, long in (("exp", "exponential", "exponential window τ = 0.5 s"),
                                   ("force", "force", "force window"))
       for hits in (3, 6, 12) for outputs in counts],
+    # a roving hammer: one accelerometer, the hammer at three points, one record per point, joined
+    *[Cell(f"hammer-{short}-{hits}-roving3", f"roving hammer, 3 points × {hits} hits, {long}, one accelerometer",
+           roving_cell(hits, window))
+      for short, window, long in (("exp", "exponential", "exponential window τ = 0.5 s"),
+                                  ("force", "force", "force window"))
+      for hits in (3, 6)],
 ]}
 
 

@@ -7,7 +7,9 @@
 3. Joint refinement of every selected pole and every channel's modal constant,
    with upper and lower residual terms, by complex nonlinear least squares
    (:func:`modal.nls.fit_modes`, variable projection); standard errors from
-   its Jacobian with each channel's residual noise (or the FRF's known noise).
+   its Jacobian with each channel's residual noise (or the FRF's known noise). The final
+   fit of an FRF estimated from time records weighs and whitens its lines by the
+   estimate's noise model, as the band-wise fits do.
 4. Results per mode: the usual fields, plus mode shapes normalised per reference,
    the participation vector and the MPC; the result carries the residual terms
    (``synthesize``), the stabilisation diagram and the settings used.
@@ -24,11 +26,14 @@ from ..model import mode_basis, solve_linear
 from ..nls import fit_modes, orthonormal_factor
 from ..peaks import estimate_noise_std, find_modes
 from ..results import IdentificationResult
+from ..sdof.bands import weight_on_lines, whitening_on_lines
+from ..sdof.refine import correlated_lags
 from ..units import TWO_PI
 from ..work_budget import EvaluationBudget, checked_max_evaluations, default_max_evaluations
 from .plscf import MAX_DAMPING, plscf_poles
 from .stabilisation import SelectedPole, outside_band_poles, select_poles, stabilisation
 from .sweep import most_stable, plan_sweep, refinement_mode_limit, sweep_lines, sweep_orders
+from .window import without_window_factor
 
 __all__ = ["identify_global", "channel_grid", "mpc"]
 
@@ -217,7 +222,7 @@ def _loose_lines(omega, wn, zeta):
     return index, np.where(near[index], 1.0, np.sqrt(LOOSE_EVERY))
 
 
-def _fit_within(omega, H, power, wn, zeta, step_tol, budget=None):
+def _fit_within(omega, H, power, wn, zeta, step_tol, budget=None, weighting=(None, None, 0)):
     """The joint fit with residual terms, without the poles that widen past :data:`MAX_DAMPING`.
 
     A pole that the stabilisation kept on the tail of a mode outside the lines (or on noise) has no
@@ -228,6 +233,8 @@ def _fit_within(omega, H, power, wn, zeta, step_tol, budget=None):
     dropped and the others go on from where they are.
     Returns the fit and the dropped poles' frequencies (Hz). ``budget``: the identification's
     :class:`~modal.work_budget.EvaluationBudget` (each fit takes what is left of it; a fit it stops is returned).
+    ``weighting``: (line weights, :class:`~modal.whitening.LineWhitening`, lags) of every line, for the tight fits
+    (:func:`_line_weighting`); the loose ones, on a sample of the lines, only start others and go unweighted.
     """
     removed: list[float] = []
     while True:
@@ -237,9 +244,11 @@ def _fit_within(omega, H, power, wn, zeta, step_tol, budget=None):
             lines = None if tight else _loose_lines(omega, wn, zeta)
             allowed = None if budget is None else budget.for_fit()
             if lines is None:
+                weight, whitening, lags = weighting if tight else (None, None, 0)
                 fit = fit_modes(omega, H, power, wn, zeta, region=None, residual_terms=True, step_tol=step_tol,
                                 max_damping=MAX_DAMPING, errors=tight, max_evaluations=allowed,
-                                decrement_tol=TIGHT_DECREMENT if tight else LOOSE_DECREMENT)
+                                decrement_tol=TIGHT_DECREMENT if tight else LOOSE_DECREMENT,
+                                line_weight=weight, whitening=whitening, correlated_lags=lags if tight else 0)
             else:
                 index, line_weight = lines
                 fit = fit_modes(omega[index], H[:, index], power, wn, zeta, region=None, residual_terms=True,
@@ -259,7 +268,7 @@ def _fit_within(omega, H, power, wn, zeta, step_tol, budget=None):
         wn, zeta = fit.omega_n[~wide], fit.damping_ratio[~wide]
 
 
-def _refine(omega, H, power, wn0, zeta0, noise, step_tol=LOOSE_STEP_TOL, budget=None):
+def _refine(omega, H, power, wn0, zeta0, noise, step_tol=LOOSE_STEP_TOL, budget=None, weighting=(None, None, 0)):
     """Joint refinement of the poles (rad/s, 1) to ``step_tol``, with the significance test at the refined
     poles: the modes that only fit noise are dropped and the others refitted, until none is.
 
@@ -271,10 +280,10 @@ def _refine(omega, H, power, wn0, zeta0, noise, step_tol=LOOSE_STEP_TOL, budget=
     rounding. A collapsing noise mode creeps for tens of iterations (its ζ shrinking by ~20 % each); the
     loose stages stop it early (benchmark case: 53 -> 24 iterations).
     Returns the fit and the frequencies (Hz) of the poles dropped. ``budget``: as for :func:`_fit_within`;
-    once it is spent, no mode is tested or dropped.
+    once it is spent, no mode is tested or dropped. ``weighting``: as for :func:`_fit_within`.
     """
     n_ch = H.shape[0]
-    fit, dropped = _fit_within(omega, H, power, wn0, zeta0, step_tol, budget)
+    fit, dropped = _fit_within(omega, H, power, wn0, zeta0, step_tol, budget, weighting)
     for _ in range(3):
         if budget is not None and budget.spent:
             break
@@ -286,9 +295,22 @@ def _refine(omega, H, power, wn0, zeta0, noise, step_tol=LOOSE_STEP_TOL, budget=
         if not weak.any():
             break
         dropped += [float(w / TWO_PI) for w in fit.omega_n[weak]]
-        fit, removed = _fit_within(omega, H, power, fit.omega_n[~weak], fit.damping_ratio[~weak], step_tol, budget)
+        fit, removed = _fit_within(omega, H, power, fit.omega_n[~weak], fit.damping_ratio[~weak], step_tol, budget,
+                                   weighting)
         dropped += removed
     return fit, dropped
+
+
+def _line_weighting(frf: FRF, omega_n, damping_ratio):
+    """(line weights, :class:`~modal.whitening.LineWhitening`, lags) of every line of ``frf`` for the final fit, as
+    the band-wise fits take them (:func:`modal.sdof.bands.line_weight`, :func:`~modal.sdof.bands.line_whitening`,
+    :func:`modal.sdof.refine.correlated_lags` at the poles ``omega_n`` (rad/s), ``damping_ratio``): an estimate from
+    time records carries its lines' noise shape and their correlation (an exponential window correlates its errors
+    over tens of lines), and its errors may correlate beyond that over a half-power width (the lag covariance then
+    widens the errors of several channels); None, None, 0 where the FRF does not carry them."""
+    every = np.ones(frf.n_freq, bool)
+    return (weight_on_lines(frf, every), whitening_on_lines(frf, every),
+            correlated_lags(frf, frf.omega_rad_s, damping_ratio, omega_n))
 
 
 def _poles_above_band(omega, matrix, orders, low_hz, high_hz, taken):
@@ -517,7 +539,9 @@ def identify_global(frf: FRF, *, modes_hz=None, order: int | None = None, max_or
     if keep.sum() < 10:
         raise IdentificationError(f"{src}: the band holds {int(keep.sum())} lines above 0 Hz; the global method "
                                   "needs at least 10")
-    work = frf.cropped(float(frf.frequency_hz[keep][0]), float(frf.frequency_hz[keep][-1]))
+    # an exponentially windowed velocity or acceleration: its window's factor out of the data (see .window)
+    work, unwindowed = without_window_factor(frf.cropped(float(frf.frequency_hz[keep][0]),
+                                                         float(frf.frequency_hz[keep][-1])))
     omega = work.omega_rad_s
     H = work.channels
     n_ch = work.n_channels
@@ -566,11 +590,11 @@ def identify_global(frf: FRF, *, modes_hz=None, order: int | None = None, max_or
         raise IdentificationError(f"{src}: no stable pole in the stabilisation diagram (orders {orders[0]}–"
                                   f"{orders[-1]}); give modes_hz hints or a higher max_order{cut}")
 
-    line_noise = frf.noise_std
+    line_noise = work.noise_std  # the band's lines (without the window's factor, as the data)
     if noise_std is not None:
         noise = np.broadcast_to(np.asarray(noise_std, float), (n_ch,)).copy()
     elif line_noise is not None:
-        noise = np.sqrt(np.mean(np.atleast_2d(line_noise)[:, keep] ** 2, axis=1))
+        noise = np.sqrt(np.mean(np.atleast_2d(line_noise) ** 2, axis=1))
     else:
         noise = estimate_noise_std(work)
     selected, dropped = _significant(omega, H, power, selected, noise)
@@ -606,7 +630,8 @@ def identify_global(frf: FRF, *, modes_hz=None, order: int | None = None, max_or
                                np.concatenate([fit.damping_ratio, [p.damping_ratio for p in outside]]), noise,
                                budget=budget)
         dropped += removed
-    fit, removed = _refine(omega, H, power, fit.omega_n, fit.damping_ratio, noise, TIGHT_STEP_TOL, budget)
+    fit, removed = _refine(omega, H, power, fit.omega_n, fit.damping_ratio, noise, TIGHT_STEP_TOL, budget,
+                           _line_weighting(work, fit.omega_n, fit.damping_ratio))
     dropped += removed
     coef, misfit = _lsfd(omega, H, power, fit.omega_n, fit.damping_ratio)
     residuals = coef[-2:].T  # (n_ch, 2): upper, lower: the residual terms in physical form
@@ -680,7 +705,7 @@ def identify_global(frf: FRF, *, modes_hz=None, order: int | None = None, max_or
     # window's damping comes out of every pole as for the band-wise methods (the shift by 1/τ is exact)
     modes = assemble_modes(estimates, method="global", source=src, single=single, driving=driving,
                            driving_known=known, phase_check=False, window_decay_s=frf.exponential_decay_s,
-                           window_power=KIND_POWER[frf.kind])
+                           window_power=0 if unwindowed else KIND_POWER[frf.kind])
     settings = {"orders": [int(orders[0]), int(orders[-1])], "references": [str(r) for r in references],
                 "transposed_by_reciprocity": bool(transposed),
                 "band_hz": [float(work.frequency_hz[0]), float(work.frequency_hz[-1])],

@@ -16,6 +16,7 @@ from ..units import TWO_PI
 
 __all__ = ["POLE_CHANNELS", "band_mask", "band_run", "band_lines", "regions", "band_data", "band_influence", "band_peaks",
            "channel_weights", "strongest_channels", "band_noise", "line_weight", "line_whitening",
+           "weight_on_lines", "whitening_on_lines",
            "constants_at_poles"]
 
 #: half-power and circle fits: the pole comes from at most this many strongest channels;
@@ -139,10 +140,15 @@ def line_weight(frf, bands):
     of 2 degrees of freedom scatter by a factor of ten between lines, and the fit then trusts a few lines
     that came out quiet by chance.
     """
+    return weight_on_lines(frf, regions(bands, frf.frequency_hz)[0])
+
+
+def weight_on_lines(frf, keep):
+    """:func:`line_weight` of the lines ``keep`` (bool over the FRF's lines), for a fit over lines that are no
+    bands' (the global method's, every line of its band)."""
     line_noise = frf.noise_std
     if line_noise is None:
         return None
-    keep, _ = regions(bands, frf.frequency_hz)
     variance = np.mean(np.atleast_2d(np.asarray(line_noise, float)) ** 2, axis=0)
     model = frf.noise_model
     if model is not None and 0 < model.degrees_of_freedom < NOISE_DOF_TARGET:
@@ -181,10 +187,14 @@ def line_weight(frf, bands):
 def line_whitening(frf, bands):
     """:class:`modal.whitening.LineWhitening` of the bands' lines for an FRF whose noise model carries the
     correlation of neighbouring lines (an estimate from time data), else None."""
+    return whitening_on_lines(frf, regions(bands, frf.frequency_hz)[0])
+
+
+def whitening_on_lines(frf, keep):
+    """:func:`line_whitening` of the lines ``keep`` (bool over the FRF's lines)."""
     model = frf.noise_model
     if model is None or model.line_correlation is None or model.n_lags == 0 or frf.noise_std is None:
         return None
-    keep, _ = regions(bands, frf.frequency_hz)
     lines = np.flatnonzero(keep)
     key = (id(model), lines.size, hash(lines.tobytes()))
     cached = _WHITENINGS.get(key)
