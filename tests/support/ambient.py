@@ -44,3 +44,16 @@ def anchor_record(seed: int = 0, noise: float = 0.1, duration_s: float = 1000.0,
     return ambient_modal_response(FN, ZETA, anchor_shapes(n_sensors), sample_rate_hz, int(duration_s * sample_rate_hz),
                                   modal_force_std=FORCE, noise=noise, tones_hz=TONES if tones else None,
                                   tone_rms=tone_rms, seed=seed)
+
+
+def machine_tone(n_samples: int, sample_rate_hz: float, frequency_hz: float, wander: float = 0.0,
+                 seed: int = 0) -> np.ndarray:
+    """A unit-amplitude machine tone, ``n_samples`` long: a sinusoid of random phase whose frequency wanders
+    slowly (a random walk scaled to reach ±``wander`` of ``frequency_hz``, as a running machine's speed drifts),
+    or is constant (``wander`` = 0)."""
+    rng = np.random.default_rng(seed)
+    drift = np.cumsum(rng.standard_normal(n_samples))
+    drift = drift - drift.mean()
+    drift /= max(np.abs(drift).max(), 1e-300)
+    phase = 2 * np.pi * np.cumsum(frequency_hz * (1.0 + wander * drift)) / sample_rate_hz
+    return np.sin(phase + rng.uniform(0.0, 2 * np.pi))
