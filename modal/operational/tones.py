@@ -4,8 +4,9 @@ A running machine's harmonics are sinusoids in every channel: the identification
 poles of (nearly) zero damping, as stable over the orders as any mode. Three pieces of evidence
 say that a pole is a tone (Brincker, Andersen & Møller, IMAC 2000; Jacobsen 2006):
 
-* its damping is nearly zero: below :data:`TONE_DAMPING` (where few structures are) either with its
-  error (ζ + 3σ_ζ) or indistinguishable from zero (ζ < 3σ_ζ);
+* its damping is indistinguishable from zero (ζ < 3σ_ζ) and below :data:`TONE_DAMPING`, where few structures
+  are (for a method without error bars, below it). A small damping resolved from zero is measured decay: a
+  lightly damped mode's, or a line's beat or wander, which only the record's length tells apart (below);
 * the response band-passed around it is not Gaussian: a sinusoid's kurtosis is 1.5 where a
   structural mode driven by random forces gives 3 (:data:`KURTOSIS_LIMIT`). The band spans
   :data:`MIN_BANDWIDTH_TIME` lines around the strongest line the pole stands for: within its half-power
@@ -44,7 +45,7 @@ from ..flags import HARMONIC_SIGMAS, HARMONIC_TOLERANCE, KURTOSIS_LIMIT, MIN_DEC
 from .inputs import Prepared
 from .pole import PoleEstimate
 
-__all__ = ["separate_tones", "nearly_undamped", "resolved_decays", "band_kurtosis", "strongest_line_hz", "harmonic_of",
+__all__ = ["separate_tones", "nearly_undamped", "zero_damping", "resolved_decays", "band_kurtosis", "strongest_line_hz", "harmonic_of",
            "KURTOSIS_LIMIT", "TONE_DAMPING", "MIN_DECAYS", "flag_mains_hum", "line_ratio", "MAINS_HZ", "HUM_TOLERANCE", "HUM_LINE_RATIO"]
 
 #: a pole whose damping ratio is below this with its error (ζ + 3σ_ζ) has nearly zero damping
@@ -136,6 +137,18 @@ def nearly_undamped(estimate: PoleEstimate) -> bool:
     return bool(zeta < TONE_DAMPING and (zeta + margin < TONE_DAMPING or zeta < margin))
 
 
+def zero_damping(estimate: PoleEstimate) -> bool:
+    """Whether a pole's damping ratio is indistinguishable from zero (ζ < 3σ_ζ) and below :data:`TONE_DAMPING`
+    (where few structures are), the tone's evidence. A damping resolved from zero, however small, is measured
+    decay: a mode's, or a line's beat or wander, which only the record's length tells apart
+    (:func:`resolved_decays`). Where the method gives no error bars (EFDD), the damping ratio below
+    :data:`TONE_DAMPING` stands for it."""
+    zeta, std = estimate.damping_ratio, estimate.std_damping_ratio
+    if not np.isfinite(std):
+        return nearly_undamped(estimate)
+    return bool(zeta < min(ZERO_DAMPING_SIGMAS * std, TONE_DAMPING))
+
+
 def resolved_decays(estimate: PoleEstimate, duration_s: float) -> float:
     """The decay times (ζ − 3σ_ζ)·2πf·T a structural mode of the estimate's damping ratio, less three of its
     standard errors, holds in a record of ``duration_s`` (σ_ζ taken as 0 where the method gives none; NaN where
@@ -201,15 +214,16 @@ def separate_tones(estimates: list[PoleEstimate], prepared: Prepared, rotor_spee
     def is_peaky(k: int) -> bool:
         return peaky[k]
 
-    undamped = [nearly_undamped(e) for e in estimates]
+    undamped = [zero_damping(e) for e in estimates]
     # a pole whose damping the record resolves as a structure's would be Gaussian: its kurtosis alone decides
     resolving = [resolved_decays(e, prepared.duration_s) >= MIN_DECAYS for e in estimates]
     fundamental = rotor_speed_hz
     if fundamental is None:
-        # the tones the data show clearly: non-Gaussian and nearly undamped, or with a damping the record
-        # resolves (or non-Gaussian where the method measures no damping)
+        # the tones the data show clearly, whose comb is looked for: non-Gaussian and nearly undamped (below
+        # TONE_DAMPING), or with a damping the record resolves (or non-Gaussian where the method measures no
+        # damping); a comb is one more piece of evidence, never the only one
         clear = [(e.natural_frequency_hz, e.std_frequency_hz) for k, e in enumerate(estimates)
-                 if (undamped[k] or resolving[k] or not e.damping_known) and is_peaky(k)]
+                 if (nearly_undamped(e) or resolving[k] or not e.damping_known) and is_peaky(k)]
         fundamental = _fundamental([f for f, _ in clear], [s for _, s in clear])
     is_tone, out = [], []
     for k, estimate in enumerate(estimates):
