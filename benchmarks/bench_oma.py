@@ -23,8 +23,9 @@ over N records (seeds 5000+, as the stress test), the table of their means and S
 it on the anchor case with C sensors along the frame (32 or 64: the many-channel layout, 8 references
 chosen and fewer output block rows); ``--method plscf`` checks the cross-check estimator's errors instead.
 ``--tones N``: the tone test over N records of the anchor case (seeds 7000+; 5, 10 and 20 % noise in turn,
-1000 s and 200 s, with and without the tones): structural modes called tones (false calls), tones missed or
-listed as unflagged modes, and the lowest kurtosis any structural mode's band reached against the limit.
+1000 s and 200 s, with and without the tones): structural modes called tones (false calls) or flagged
+tone_like, tones missed or listed as modes flagged neither harmonic nor tone_like, and the lowest kurtosis any
+structural mode's band reached against the limit.
 ``--light N``: the same on lightly damped structures (every mode at ζ = 0.1, 0.2 or 0.5 %, seeds 7500+), the
 hard case for a rule on near-zero damping. ``--method`` chooses the estimator for all three (fdd and efdd,
 which give no error bars, for ``--tones`` and ``--light`` only).
@@ -206,20 +207,23 @@ def _structural_kurtosis(result, rec, band):
 
 
 def _tone_scores(result, fn, tones):
-    """(structural modes called tones, modes missing, tones missed, tones listed as unflagged modes)."""
+    """(structural modes called tones, modes missing, tones missed, tones listed as modes flagged neither harmonic
+    nor tone_like, structural modes flagged tone_like)."""
     found = np.array(result.harmonics_hz)
     called = sum(bool(np.any(np.abs(found / f - 1) < 0.005)) for f in fn)
     missing = sum(not any(abs(m.natural_frequency_hz / f - 1) < 0.005 for m in result) for f in fn)
     missed = sum(not np.any(np.abs(found / t - 1) < 0.005) for t in tones)
-    unflagged = sum(any(abs(m.natural_frequency_hz / t - 1) < 0.005 and "harmonic" not in m.flags for m in result)
-                    for t in tones)
-    return called, missing, missed, unflagged
+    unflagged = sum(any(abs(m.natural_frequency_hz / t - 1) < 0.005 and not {"harmonic", "tone_like"} & set(m.flags)
+                        for m in result) for t in tones)
+    flagged = sum(any(abs(m.natural_frequency_hz / f - 1) < 0.005 and "tone_like" in m.flags for m in result)
+                  for f in fn)
+    return called, missing, missed, unflagged, flagged
 
 
 def tone_calls(n_records: int, method: str = "ssi") -> str:
     from modal.operational.tones import KURTOSIS_LIMIT
 
-    false_calls = missed = listed_as_mode = records_with_tones = 0
+    false_calls = missed = listed_as_mode = records_with_tones = flagged = 0
     lowest = (np.inf, None)
     for r in range(n_records):
         noise = (0.05, 0.1, 0.2)[r % 3]
@@ -229,8 +233,9 @@ def tone_calls(n_records: int, method: str = "ssi") -> str:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             result = modal.oma(rec.signals, rec.sample_rate_hz, band_hz=BAND, method=method)
-        called, _, miss, unflagged = _tone_scores(result, FN, TONES if tones else [])
+        called, _, miss, unflagged, like = _tone_scores(result, FN, TONES if tones else [])
         false_calls += called
+        flagged += like
         if tones:
             records_with_tones += 1
             missed += miss
@@ -240,7 +245,8 @@ def tone_calls(n_records: int, method: str = "ssi") -> str:
                 lowest = (k, f"{f:.2f} Hz, seed {7000 + r}, {noise:.0%} noise, {duration:g} s")
     return "\n".join([f"tone test over {n_records} records ({method}; anchor case, seeds 7000+, 5/10/20 % noise, "
                       f"1000/200 s, tones in every other record)", "",
-                      f"structural modes called tones: {false_calls} of {n_records * FN.size}",
+                      f"structural modes called tones: {false_calls} of {n_records * FN.size}; flagged tone_like: "
+                      f"{flagged}",
                       f"tones missed: {missed} of {records_with_tones * TONES.size}; tones listed as unflagged modes: "
                       f"{listed_as_mode}",
                       f"lowest kurtosis of a structural mode's band: {lowest[0]:.2f} ({lowest[1]}); limit "
@@ -254,14 +260,14 @@ LIGHT_DAMPING = (0.001, 0.002, 0.005)
 def light_calls(n_records: int, method: str = "ssi") -> str:
     """The tone test on lightly damped structures (the hard case for a rule on near-zero damping): the anchor
     case's shapes with every mode at ζ = 0.1, 0.2 or 0.5 % in turn, 1000 s and 200 s, with and without the
-    tones (seeds 7500+). Per damping ratio: structural modes called tones, modes found neither as modes nor
-    as tones, tones missed and listed as unflagged modes, the lowest kurtosis of a structural mode's band and
-    the fewest decay times ζ·2πf·T a mode holds in its record."""
+    tones (seeds 7500+). Per damping ratio: structural modes called tones or flagged tone_like, modes found
+    neither as modes nor as tones, tones missed and listed as modes flagged neither harmonic nor tone_like, the
+    lowest kurtosis of a structural mode's band and the fewest decay times ζ·2πf·T a mode holds in its record."""
     from modal.operational.tones import KURTOSIS_LIMIT
     from modal.synthetic import ambient_modal_response
     from support.ambient import FORCE, anchor_shapes
 
-    table = {z: np.zeros(5) for z in LIGHT_DAMPING}
+    table = {z: np.zeros(6) for z in LIGHT_DAMPING}
     lowest = {z: (np.inf, "") for z in LIGHT_DAMPING}
     for r in range(n_records):
         zeta = LIGHT_DAMPING[r % 3]
@@ -273,19 +279,19 @@ def light_calls(n_records: int, method: str = "ssi") -> str:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             result = modal.oma(rec.signals, rec.sample_rate_hz, band_hz=BAND, method=method)
-        table[zeta][:4] += _tone_scores(result, FN, TONES if tones else [])
-        table[zeta][4] += 1
+        table[zeta][:5] += _tone_scores(result, FN, TONES if tones else [])
+        table[zeta][5] += 1
         for k, f in _structural_kurtosis(result, rec, BAND):
             if np.any(np.abs(f / FN - 1) < 0.005) and k < lowest[zeta][0]:
                 lowest[zeta] = (k, f"{f:.2f} Hz, seed {7500 + r}, {duration:g} s")
     lines = [f"lightly damped structures over {n_records} records ({method}; anchor shapes, every mode at one ζ, "
              "1000/200 s, tones in every other six; seeds 7500+)", "",
-             "| ζ | records | fewest decays ζ·2πf·T | modes called tones | modes missing | tones missed | "
-             "tones as unflagged modes | lowest kurtosis of a mode |", "|---|---|---|---|---|---|---|---|"]
+             "| ζ | records | fewest decays ζ·2πf·T | modes called tones | modes flagged tone_like | modes missing | "
+             "tones missed | tones as unflagged modes | lowest kurtosis of a mode |", "|---|---|---|---|---|---|---|---|---|"]
     for z in LIGHT_DAMPING:
-        called, missing, missed, unflagged, n = table[z]
+        called, missing, missed, unflagged, like, n = table[z]
         lines.append(f"| {100 * z:g} % | {n:.0f} | {z * 2 * np.pi * FN.min() * 200:.1f} (200 s) | {called:.0f} | "
-                     f"{missing:.0f} | {missed:.0f} | {unflagged:.0f} | {lowest[z][0]:.2f} ({lowest[z][1]}) |")
+                     f"{like:.0f} | {missing:.0f} | {missed:.0f} | {unflagged:.0f} | {lowest[z][0]:.2f} ({lowest[z][1]}) |")
     lines.append(f"\nkurtosis limit {KURTOSIS_LIMIT:g}")
     return "\n".join(lines)
 
