@@ -27,8 +27,9 @@ chosen and fewer output block rows); ``--method plscf`` checks the cross-check e
 tone_like, tones missed or listed as modes flagged neither harmonic nor tone_like, and the lowest kurtosis any
 structural mode's band reached against the limit.
 ``--light N``: the same on lightly damped structures (every mode at ζ = 0.1, 0.2 or 0.5 %, seeds 7500+), the
-hard case for a rule on near-zero damping. ``--method`` chooses the estimator for all three (fdd and efdd,
-which give no error bars, for ``--tones`` and ``--light`` only).
+hard case for a rule on near-zero damping. ``--lone N``: tones with no structural mode near them (between modes,
+at 50 Hz, above the highest mode; steady or wandering; running speed unknown or not theirs, seeds 7800+).
+``--method`` chooses the estimator for each (fdd and efdd, which give no error bars, not for ``--calibration``).
 ``--speed``: modalbal's CPU and wall time on larger records (samples × channels).
 """
 from __future__ import annotations
@@ -296,6 +297,44 @@ def light_calls(n_records: int, method: str = "ssi") -> str:
     return "\n".join(lines)
 
 
+def lone_calls(n_records: int, method: str = "ssi") -> str:
+    """Tones with no structural mode near them (``tests/support/ambient.py``'s lone-tone case, 100 s, seeds
+    7800+): a tone between modes far from any (55 Hz), at the mains frequency (50 Hz) or above the highest mode
+    (160 Hz) in turn, steady or wandering by up to ±0.2 % or ±1 %, the running speed unknown or given as one the
+    tone is no harmonic of (7.7 Hz). Per tone position: tones listed as tones, as modes flagged harmonic or
+    tone_like, as modes flagged neither, or not found; structural modes called tones or missing."""
+    from support.ambient import LONE_FN, lone_tone_record
+
+    positions = (55.0, 50.0, 160.0)
+    table = {p: np.zeros(7) for p in positions}
+    for r in range(n_records):
+        tone = positions[r % 3]
+        wander = (0.0, 0.002, 0.01)[(r // 3) % 3]
+        rotor = (None, 7.7)[(r // 9) % 2]
+        signals, fs = lone_tone_record(tone, wander, 7800 + r)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            result = modal.oma(signals, fs, band_hz=(5.0, 180.0), method=method, rotor_speed_hz=rotor)
+        tolerance = 0.02 if method == "fdd" else 0.01  # FDD's peaks lie on its lines
+        near = [m for m in result if abs(m.natural_frequency_hz / tone - 1) < tolerance]
+        listed = any(abs(h / tone - 1) < 0.005 for h in result.harmonics_hz)
+        flagged = bool(near) and all({"harmonic", "tone_like"} & set(m.flags) for m in near)
+        table[tone] += [listed, not listed and flagged, not listed and bool(near) and not flagged,
+                        not listed and not near,
+                        sum(any(abs(h / f - 1) < tolerance for h in result.harmonics_hz) for f in LONE_FN),
+                        sum(not any(abs(m.natural_frequency_hz / f - 1) < tolerance for m in result) for f in LONE_FN),
+                        1]
+    lines = [f"tones with no mode near them over {n_records} records ({method}; lone-tone case, 100 s, steady or "
+             "wandering ±0.2 %/±1 %, running speed unknown or 7.7 Hz; seeds 7800+)", "",
+             "| tone [Hz] | records | listed as tones | flagged modes | unflagged modes | not found | "
+             "structural modes called tones | structural modes missing |", "|---|---|---|---|---|---|---|---|"]
+    for p in positions:
+        listed, flagged, unflagged, lost, called, missing, n = table[p]
+        lines.append(f"| {p:g} | {n:.0f} | {listed:.0f} | {flagged:.0f} | {unflagged:.0f} | {lost:.0f} | {called:.0f} | "
+                     f"{missing:.0f} |")
+    return "\n".join(lines)
+
+
 def speed(runs: int = 3) -> str:
     """CPU and wall time of ``modal.oma`` per record size (median of ``runs`` after one warm-up call), SSI,
     band 1-30 Hz at 100 Hz. The header names the ``modal`` package measured: run this file with another
@@ -335,6 +374,7 @@ def main(argv=None) -> None:
                         help="the estimator --calibration, --tones and --light check")
     parser.add_argument("--tones", type=int, default=0)
     parser.add_argument("--light", type=int, default=0)
+    parser.add_argument("--lone", type=int, default=0)
     parser.add_argument("--speed", action="store_true")
     args = parser.parse_args(argv)
     if args.records:
@@ -348,6 +388,9 @@ def main(argv=None) -> None:
     if args.light:
         print()
         print(light_calls(args.light, args.method))
+    if args.lone:
+        print()
+        print(lone_calls(args.lone, args.method))
     if args.speed:
         print()
         print(speed())

@@ -14,7 +14,7 @@ from modal.operational.tones import (HUM_LINE_RATIO, HUM_TOLERANCE, KURTOSIS_LIM
                                     band_kurtosis, line_ratio, separate_tones, strongest_line_hz)
 from modal.synthetic import ambient_modal_response
 from modal.units import TWO_PI
-from support.ambient import machine_tone
+from support.ambient import LONE_FN, lone_tone_record
 
 
 def _gaussian_band_kurtosis(weights: np.ndarray, draws: int, seed: int) -> np.ndarray:
@@ -170,23 +170,8 @@ def test_a_random_mode_with_min_decays_in_the_record_is_gaussian_around_its_stro
 
 # -- tones with no structural mode near them ---------------------------------------------------------------
 
-#: four modes on six sensors at 400 Hz: room for a tone between modes far from any, at a mains frequency and
-#: above the highest mode
-LONE_FN = np.array([12.0, 31.0, 78.0, 117.0])
-LONE_ZETA = np.array([0.015, 0.01, 0.012, 0.02])
 #: a running speed none of the tones below lies on: they are a gear mesh or a blade pass
 OTHER_SPEED_HZ = 7.7
-
-
-def _lone_tone_record(tone_hz: float, wander: float, seed: int):
-    """100 s of the four modes' random response with a tone of RMS 0.25-0.5 of each channel's."""
-    fs, n = 400.0, 40_000
-    x = (np.arange(6) + 0.5) / 6
-    shapes = np.column_stack([np.sin(np.pi * x), np.sin(2 * np.pi * x), np.sin(3 * np.pi * x),
-                              np.sin(4 * np.pi * x) + 0.2 * x])
-    rec = ambient_modal_response(LONE_FN, LONE_ZETA, shapes, fs, n, noise=0.1, seed=seed)
-    size = np.random.default_rng(seed).uniform(0.5, 1.0, 6) * rec.signals.std(axis=1) / np.sqrt(2)
-    return rec.signals + size[:, None] * machine_tone(n, fs, tone_hz, wander, seed)[None, :], fs
 
 
 @pytest.mark.parametrize("method", ["ssi", "plscf", "fdd", "efdd"])
@@ -199,7 +184,7 @@ def test_a_tone_with_no_mode_near_it_is_a_tone_not_a_mode(tone_hz, method):
 
     tolerance = 0.02 if method == "fdd" else 0.01  # FDD's peaks lie on its lines, 0.2-0.4 Hz apart
     for wander, rotor_speed_hz, seed in ((0.0, None, 1), (0.002, OTHER_SPEED_HZ, 2)):
-        signals, fs = _lone_tone_record(tone_hz, wander, seed)
+        signals, fs = lone_tone_record(tone_hz, wander, seed)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             result = modal.oma(signals, fs, band_hz=(5.0, 180.0), method=method, rotor_speed_hz=rotor_speed_hz)
