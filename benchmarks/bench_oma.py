@@ -23,8 +23,13 @@ over N records (seeds 5000+, as the stress test), the table of their means and S
 it on the anchor case with C sensors along the frame (32 or 64: the many-channel layout, 8 references
 chosen and fewer output block rows); ``--method plscf`` checks the cross-check estimator's errors instead.
 ``--tones N``: the tone test over N records of the anchor case (seeds 7000+; 5, 10 and 20 % noise in turn,
-1000 s and 200 s, with and without the tones): structural modes called tones (false calls), tones missed, and
-the lowest kurtosis any structural mode's band reached against the limit.
+1000 s and 200 s, with and without the tones): structural modes called tones (false calls) or flagged
+tone_like, tones missed or listed as modes flagged neither harmonic nor tone_like, and the lowest kurtosis any
+structural mode's band reached against the limit.
+``--light N``: the same on lightly damped structures (every mode at ζ = 0.1, 0.2 or 0.5 %, seeds 7500+), the
+hard case for a rule on near-zero damping. ``--lone N``: tones with no structural mode near them (between modes,
+at 50 Hz, above the highest mode; steady or wandering; running speed unknown or not theirs, seeds 7800+).
+``--method`` chooses the estimator for each (fdd and efdd, which give no error bars, not for ``--calibration``).
 ``--speed``: modalbal's CPU and wall time on larger records (samples × channels).
 """
 from __future__ import annotations
@@ -184,11 +189,43 @@ def calibration(n_records: int, n_sensors: int = 8, method: str = "ssi", sample_
     return "\n".join(lines)
 
 
-def tone_calls(n_records: int) -> str:
+def _structural_kurtosis(result, rec, band):
+    """(kurtosis, frequency Hz) of every structural mode of ``result`` (within 0.5 % of one of ``FN`` or ``fn``) on
+    the band the tone test judges it on: 64 lines around the strongest line within its half-power band."""
     from modal.operational.inputs import prepare
-    from modal.operational.tones import KURTOSIS_LIMIT, MIN_BANDWIDTH_TIME, band_kurtosis
+    from modal.operational.tones import MIN_BANDWIDTH_TIME, band_kurtosis, strongest_line_hz
 
-    false_calls = missed = listed_as_mode = records_with_tones = 0
+    prepared = prepare(rec.signals, rec.sample_rate_hz, band)
+    out = []
+    for m in result:
+        channel = int(np.argmax(np.abs(m.mode_shape) / prepared.scale))  # as the test chooses it
+        spectrum = np.fft.rfft(prepared.channel(channel))
+        f, zeta = m.natural_frequency_hz, np.nan_to_num(m.damping_ratio)
+        search = max(zeta * f, 3 * np.nan_to_num(m.std.natural_frequency_hz), 2 / prepared.duration_s)
+        centre = strongest_line_hz(spectrum, prepared.n_samples, prepared.sample_rate_hz, f - search, f + search)
+        out.append((band_kurtosis(spectrum, prepared.n_samples, prepared.sample_rate_hz, centre,
+                                  MIN_BANDWIDTH_TIME / prepared.duration_s), f))
+    return out
+
+
+def _tone_scores(result, fn, tones):
+    """(structural modes called tones, modes missing, tones missed, tones listed as modes flagged neither harmonic
+    nor tone_like, structural modes flagged tone_like)."""
+    found = np.array(result.harmonics_hz)
+    called = sum(bool(np.any(np.abs(found / f - 1) < 0.005)) for f in fn)
+    missing = sum(not any(abs(m.natural_frequency_hz / f - 1) < 0.005 for m in result) for f in fn)
+    missed = sum(not np.any(np.abs(found / t - 1) < 0.005) for t in tones)
+    unflagged = sum(any(abs(m.natural_frequency_hz / t - 1) < 0.005 and not {"harmonic", "tone_like"} & set(m.flags)
+                        for m in result) for t in tones)
+    flagged = sum(any(abs(m.natural_frequency_hz / f - 1) < 0.005 and "tone_like" in m.flags for m in result)
+                  for f in fn)
+    return called, missing, missed, unflagged, flagged
+
+
+def tone_calls(n_records: int, method: str = "ssi") -> str:
+    from modal.operational.tones import KURTOSIS_LIMIT
+
+    false_calls = missed = listed_as_mode = records_with_tones = flagged = 0
     lowest = (np.inf, None)
     for r in range(n_records):
         noise = (0.05, 0.1, 0.2)[r % 3]
@@ -197,31 +234,106 @@ def tone_calls(n_records: int) -> str:
         rec = anchor_record(7000 + r, noise=noise, tones=tones, duration_s=duration)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            result = modal.oma(rec.signals, rec.sample_rate_hz, band_hz=BAND)
-        found = np.array(result.harmonics_hz)
-        false_calls += sum(bool(np.any(np.abs(found / fn - 1) < 0.005)) for fn in FN)
+            result = modal.oma(rec.signals, rec.sample_rate_hz, band_hz=BAND, method=method)
+        called, _, miss, unflagged, like = _tone_scores(result, FN, TONES if tones else [])
+        false_calls += called
+        flagged += like
         if tones:
             records_with_tones += 1
-            missed += sum(not np.any(np.abs(found / t - 1) < 0.005) for t in TONES)
-            listed_as_mode += sum(any(abs(m.natural_frequency_hz / t - 1) < 0.005 for m in result) for t in TONES)
-        # the structural modes' kurtosis on the band the test uses
-        prepared = prepare(rec.signals, rec.sample_rate_hz, BAND)
-        for m in result:
-            if not np.any(np.abs(m.natural_frequency_hz / FN - 1) < 0.005):
-                continue
-            channel = int(np.argmax(np.abs(m.mode_shape) / prepared.scale))  # as the test chooses it
-            width = max(4 * m.damping_ratio * m.natural_frequency_hz, MIN_BANDWIDTH_TIME / prepared.duration_s)
-            k = band_kurtosis(np.fft.rfft(prepared.channel(channel)), prepared.n_samples,
-                              prepared.sample_rate_hz, m.natural_frequency_hz, width)
-            if k < lowest[0]:
-                lowest = (k, f"{m.natural_frequency_hz:.2f} Hz, seed {7000 + r}, {noise:.0%} noise, {duration:g} s")
-    return "\n".join([f"tone test over {n_records} records (anchor case, seeds 7000+, 5/10/20 % noise, 1000/200 s, "
-                      f"tones in every other record)", "",
-                      f"structural modes called tones: {false_calls} of {n_records * FN.size}",
-                      f"tones missed: {missed} of {records_with_tones * TONES.size}; tones listed as modes: "
+            missed += miss
+            listed_as_mode += unflagged
+        for k, f in _structural_kurtosis(result, rec, BAND):
+            if np.any(np.abs(f / FN - 1) < 0.005) and k < lowest[0]:
+                lowest = (k, f"{f:.2f} Hz, seed {7000 + r}, {noise:.0%} noise, {duration:g} s")
+    return "\n".join([f"tone test over {n_records} records ({method}; anchor case, seeds 7000+, 5/10/20 % noise, "
+                      f"1000/200 s, tones in every other record)", "",
+                      f"structural modes called tones: {false_calls} of {n_records * FN.size}; flagged tone_like: "
+                      f"{flagged}",
+                      f"tones missed: {missed} of {records_with_tones * TONES.size}; tones listed as unflagged modes: "
                       f"{listed_as_mode}",
                       f"lowest kurtosis of a structural mode's band: {lowest[0]:.2f} ({lowest[1]}); limit "
                       f"{KURTOSIS_LIMIT:g}"])
+
+
+#: lightly damped cases: the anchor case's frames with every mode at one damping ratio
+LIGHT_DAMPING = (0.001, 0.002, 0.005)
+
+
+def light_calls(n_records: int, method: str = "ssi") -> str:
+    """The tone test on lightly damped structures (the hard case for a rule on near-zero damping): the anchor
+    case's shapes with every mode at ζ = 0.1, 0.2 or 0.5 % in turn, 1000 s and 200 s, with and without the
+    tones (seeds 7500+). Per damping ratio: structural modes called tones or flagged tone_like, modes found
+    neither as modes nor as tones, tones missed and listed as modes flagged neither harmonic nor tone_like, the
+    lowest kurtosis of a structural mode's band and the fewest decay times ζ·2πf·T a mode holds in its record."""
+    from modal.operational.tones import KURTOSIS_LIMIT
+    from modal.synthetic import ambient_modal_response
+    from support.ambient import FORCE, anchor_shapes
+
+    table = {z: np.zeros(6) for z in LIGHT_DAMPING}
+    lowest = {z: (np.inf, "") for z in LIGHT_DAMPING}
+    for r in range(n_records):
+        zeta = LIGHT_DAMPING[r % 3]
+        duration = (1000.0, 200.0)[(r // 3) % 2]
+        tones = (r // 6) % 2 == 0
+        rec = ambient_modal_response(FN, np.full(FN.size, zeta), anchor_shapes(), 100.0, int(duration * 100),
+                                     modal_force_std=FORCE, noise=0.1, tones_hz=TONES if tones else None,
+                                     tone_rms=0.5, seed=7500 + r)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            result = modal.oma(rec.signals, rec.sample_rate_hz, band_hz=BAND, method=method)
+        table[zeta][:5] += _tone_scores(result, FN, TONES if tones else [])
+        table[zeta][5] += 1
+        for k, f in _structural_kurtosis(result, rec, BAND):
+            if np.any(np.abs(f / FN - 1) < 0.005) and k < lowest[zeta][0]:
+                lowest[zeta] = (k, f"{f:.2f} Hz, seed {7500 + r}, {duration:g} s")
+    lines = [f"lightly damped structures over {n_records} records ({method}; anchor shapes, every mode at one ζ, "
+             "1000/200 s, tones in every other six; seeds 7500+)", "",
+             "| ζ | records | fewest decays ζ·2πf·T | modes called tones | modes flagged tone_like | modes missing | "
+             "tones missed | tones as unflagged modes | lowest kurtosis of a mode |", "|---|---|---|---|---|---|---|---|---|"]
+    for z in LIGHT_DAMPING:
+        called, missing, missed, unflagged, like, n = table[z]
+        lines.append(f"| {100 * z:g} % | {n:.0f} | {z * 2 * np.pi * FN.min() * 200:.1f} (200 s) | {called:.0f} | "
+                     f"{like:.0f} | {missing:.0f} | {missed:.0f} | {unflagged:.0f} | {lowest[z][0]:.2f} ({lowest[z][1]}) |")
+    lines.append(f"\nkurtosis limit {KURTOSIS_LIMIT:g}")
+    return "\n".join(lines)
+
+
+def lone_calls(n_records: int, method: str = "ssi") -> str:
+    """Tones with no structural mode near them (``tests/support/ambient.py``'s lone-tone case, 100 s, seeds
+    7800+): a tone between modes far from any (55 Hz), at the mains frequency (50 Hz) or above the highest mode
+    (160 Hz) in turn, steady or wandering by up to ±0.2 % or ±1 %, the running speed unknown or given as one the
+    tone is no harmonic of (7.7 Hz). Per tone position: tones listed as tones, as modes flagged harmonic or
+    tone_like, as modes flagged neither, or not found; structural modes called tones or missing."""
+    from support.ambient import LONE_FN, lone_tone_record
+
+    positions = (55.0, 50.0, 160.0)
+    table = {p: np.zeros(7) for p in positions}
+    for r in range(n_records):
+        tone = positions[r % 3]
+        wander = (0.0, 0.002, 0.01)[(r // 3) % 3]
+        rotor = (None, 7.7)[(r // 9) % 2]
+        signals, fs = lone_tone_record(tone, wander, 7800 + r)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            result = modal.oma(signals, fs, band_hz=(5.0, 180.0), method=method, rotor_speed_hz=rotor)
+        tolerance = 0.02 if method == "fdd" else 0.01  # FDD's peaks lie on its lines
+        near = [m for m in result if abs(m.natural_frequency_hz / tone - 1) < tolerance]
+        listed = any(abs(h / tone - 1) < 0.005 for h in result.harmonics_hz)
+        flagged = bool(near) and all({"harmonic", "tone_like"} & set(m.flags) for m in near)
+        table[tone] += [listed, not listed and flagged, not listed and bool(near) and not flagged,
+                        not listed and not near,
+                        sum(any(abs(h / f - 1) < tolerance for h in result.harmonics_hz) for f in LONE_FN),
+                        sum(not any(abs(m.natural_frequency_hz / f - 1) < tolerance for m in result) for f in LONE_FN),
+                        1]
+    lines = [f"tones with no mode near them over {n_records} records ({method}; lone-tone case, 100 s, steady or "
+             "wandering ±0.2 %/±1 %, running speed unknown or 7.7 Hz; seeds 7800+)", "",
+             "| tone [Hz] | records | listed as tones | flagged modes | unflagged modes | not found | "
+             "structural modes called tones | structural modes missing |", "|---|---|---|---|---|---|---|---|"]
+    for p in positions:
+        listed, flagged, unflagged, lost, called, missing, n = table[p]
+        lines.append(f"| {p:g} | {n:.0f} | {listed:.0f} | {flagged:.0f} | {unflagged:.0f} | {lost:.0f} | {called:.0f} | "
+                     f"{missing:.0f} |")
+    return "\n".join(lines)
 
 
 def speed(runs: int = 3) -> str:
@@ -269,11 +381,13 @@ def main(argv=None) -> None:
     parser.add_argument("--records", type=int, default=10)
     parser.add_argument("--calibration", type=int, default=0)
     parser.add_argument("--channels", type=int, default=8)
-    parser.add_argument("--method", choices=("ssi", "plscf"), default="ssi",
-                        help="the estimator whose errors --calibration checks")
+    parser.add_argument("--method", choices=("ssi", "plscf", "fdd", "efdd"), default="ssi",
+                        help="the estimator --calibration, --tones and --light check")
     parser.add_argument("--sample-rate", dest="sample_rate_hz", type=float, default=100.0,
                         help="the --calibration records' rate, Hz (above 120 Hz they are decimated to the band first)")
     parser.add_argument("--tones", type=int, default=0)
+    parser.add_argument("--light", type=int, default=0)
+    parser.add_argument("--lone", type=int, default=0)
     parser.add_argument("--speed", action="store_true")
     args = parser.parse_args(argv)
     if args.records:
@@ -283,7 +397,13 @@ def main(argv=None) -> None:
         print(calibration(args.calibration, args.channels, args.method, args.sample_rate_hz))
     if args.tones:
         print()
-        print(tone_calls(args.tones))
+        print(tone_calls(args.tones, args.method))
+    if args.light:
+        print()
+        print(light_calls(args.light, args.method))
+    if args.lone:
+        print()
+        print(lone_calls(args.lone, args.method))
     if args.speed:
         print()
         print(speed())

@@ -12,7 +12,7 @@ from .frf import line_spacing
 
 __all__ = ["FLAG_TEXT", "FLAG_ACTION", "CHI2_LIMIT", "RELATIVE_MISFIT", "REL_STD_LIMIT", "OVERLAP_LIMIT", "BIAS_LIMIT",
            "COMPLEX_PHASE_DEG", "MPC_LIMIT", "WEAK_FRACTION", "RIGID_BODY_RATIO", "HARMONIC_TOLERANCE",
-           "HARMONIC_SIGMAS", "MIN_SHIFT_SIGMAS", "MAX_SCALE_ERROR", "GRID_FLAGS", "RESOLUTION_FLAGS", "RULE_FLAGS",
+           "HARMONIC_SIGMAS", "KURTOSIS_LIMIT", "MIN_DECAYS", "MIN_SHIFT_SIGMAS", "MAX_SCALE_ERROR", "GRID_FLAGS", "RESOLUTION_FLAGS", "RULE_FLAGS",
            "INFORMATIONAL", "serious_flags", "DRIVING_POINT_ONLY", "TRANSFER_ONLY", "lines_near_mode", "model_inadequate", "overlap",
            "channel_flags", "contradictions", "flags_markdown"]
 
@@ -47,6 +47,20 @@ RIGID_BODY_RATIO = 0.1
 HARMONIC_TOLERANCE = 0.005
 #: ... or within this many of its frequency's standard errors (flag harmonic)
 HARMONIC_SIGMAS = 3.0
+#: operational: kurtosis of the response band-passed around a pole's strongest line below which it holds a
+#: sinusoid (a machine tone): 3 for Gaussian narrow-band response, 1.5 for a pure tone, 2.25 for two equal tones.
+#: The estimate (from the band's lines, never below 1.5) has a short lower tail: for Gaussian response over
+#: 64 lines (``modal.operational.tones.MIN_BANDWIDTH_TIME``) its 10⁻⁴ quantile is 2.27 with a flat spectrum and
+#: 2.18 with a mode's bell spanning the band (10⁵ draws each; ``tests/modal/operational/test_tones.py`` checks
+#: the margin)
+KURTOSIS_LIMIT = 1.95
+#: operational: a pole whose damping ratio, less three of its standard errors, gives at least this many decay
+#: times ζ·2πf·T in a record of T seconds would be Gaussian random response were it a structural mode: its
+#: kurtosis alone then tells a tone (flag tone_like below it). Random response of one mode (10 % noise)
+#: band-passed over 64 lines around its strongest line, 1000 records per case: kurtosis below
+#: :data:`KURTOSIS_LIMIT` in 16 % of them at ζωT = 2, 5 % at 4, 0.2 % at 8, none at 16 (smallest 2.05; 2.15 at
+#: 32); ``tests/modal/operational/test_tones.py`` checks it at this limit
+MIN_DECAYS = 16.0
 #: mass-change scaling: the frequency shift must exceed this many of its standard errors...
 MIN_SHIFT_SIGMAS = 3.0
 #: ... and the scale factor's relative standard error stay at or below this, else scaling_uncertain
@@ -114,6 +128,11 @@ FLAG_TEXT = {
     "mains_hum": ("operational: the mode lies within 1 % of a multiple of the mains frequency (50 or 60 Hz) where a "
                   "channel's spectrum holds a line far above its surroundings: electrical hum; frequency, damping and "
                   "shape may be the hum's"),
+    "tone_like": (f"operational: the response band-passed around the mode's strongest line is a sinusoid's "
+                  f"(kurtosis below {KURTOSIS_LIMIT:g}, where random response gives 3), but its damping, less three "
+                  f"standard errors, gives fewer than {MIN_DECAYS:g} decay times in the record: a machine tone or hum "
+                  f"the record cannot tell from a mode this lightly damped; frequency, damping and shape may be the "
+                  f"tone's"),
     "non_stationary": ("operational: the record is not stationary random response (its kurtosis lies far above a "
                        "Gaussian response's 3: hammer hits, shocks or bursts ringing down): frequency, damping and "
                        "their errors assume stationary random forces and are biased"),
@@ -188,6 +207,8 @@ FLAG_ACTION = {
     "missing_in_setup": "excite the mode better in that setup, or leave its channels out of the merged shape",
     "mains_hum": "ground the sensors' cables at one point (a ground loop) or shield them, and measure again; or "
                  "leave the humming channels out",
+    "tone_like": "give the running speed (--rotor-speed-hz) if the machine's; look for a line in the spectrum; "
+                 "measure longer (a structural mode's amplitude then varies at random, a tone's does not)",
     "non_stationary": "for a hammer test with a force channel use modal fit --impact; otherwise cut the transients "
                       "out of the record or measure while the machine runs steadily",
 }

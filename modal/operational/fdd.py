@@ -8,9 +8,13 @@ form the mode's "bell"; the bell projected onto the peak's vectors and transform
 domain is the mode's correlation function ``A e^{λτ}``, whose log-magnitude slope gives the decay
 rate and whose phase slope the damped frequency. The half-spectra come from the correlations with a
 known exponential lag window, whose decay is taken off exactly (a Hann-windowed Welch spectrum would
-add damping that no fit removes). No error bars (NaN, flagged ``high_uncertainty``).
+add damping that no fit removes). No error bars (NaN, flagged ``high_uncertainty``). Machine tones are told
+apart as for the other methods (:mod:`modal.operational.tones`), FDD's peaks too with the damping their bell's
+decay gives, which FDD does not report.
 """
 from __future__ import annotations
+
+from dataclasses import replace
 
 import numpy as np
 
@@ -95,27 +99,28 @@ def fdd(prepared: Prepared, refs, *, enhanced: bool, rotor_speed_hz=None, record
                                   f"{MIN_PROMINENCE_DB:g} dB in the band {prepared.band_hz[0]:g}-"
                                   f"{prepared.band_hz[1]:g} Hz")
     _, _, vh = np.linalg.svd(np.moveaxis(S, -1, 0)[peaks], full_matrices=False)
-    estimates = []
+    estimates, judged = [], []
     nan_shape = np.full(prepared.n_channels, np.nan)
     for j, p in enumerate(peaks):
         u_peak = u1[p]
         raw = u_peak * prepared.scale
         shape = raw / raw[np.argmax(np.abs(raw))]
-        pole, known = complex(0.0, 2 * np.pi * lines[p]), False
-        if enhanced:
-            mac = shape_mac(u1.T, u_peak[:, None])
-            bell = np.zeros(lines.size, bool)
-            lo = hi = p
-            while lo > 0 and mac[lo - 1] >= BELL_MAC:
-                lo -= 1
-            while hi < lines.size - 1 and mac[hi + 1] >= BELL_MAC:
-                hi += 1
-            bell[lo:hi + 1] = True
-            found = _decay(lines, S, u_peak, vh[j, 0].conj(), bell, fs, beta)
-            if found is not None:
-                pole, known = found, True
-        estimates.append(PoleEstimate(pole, shape, np.nan, np.nan, nan_shape, 1, 1, 0, damping_known=known))
-    is_tone, estimates = separate_tones(estimates, prepared, rotor_speed_hz, 4 * (lines[1] - lines[0]))
+        line = PoleEstimate(complex(0.0, 2 * np.pi * lines[p]), shape, np.nan, np.nan, nan_shape, 1, 1, 0,
+                            damping_known=False)
+        mac = shape_mac(u1.T, u_peak[:, None])
+        bell = np.zeros(lines.size, bool)
+        lo = hi = p
+        while lo > 0 and mac[lo - 1] >= BELL_MAC:
+            lo -= 1
+        while hi < lines.size - 1 and mac[hi + 1] >= BELL_MAC:
+            hi += 1
+        bell[lo:hi + 1] = True
+        found = _decay(lines, S, u_peak, vh[j, 0].conj(), bell, fs, beta)
+        decaying = line if found is None else PoleEstimate(found, shape, np.nan, np.nan, nan_shape, 1, 1, 0)
+        estimates.append(decaying if enhanced else line)
+        judged.append(decaying)  # FDD reports no damping, but its tones are told apart by the bell's decay too
+    is_tone, flagged = separate_tones(judged, prepared, rotor_speed_hz, 4 * (lines[1] - lines[0]))
+    estimates = [replace(e, flags=g.flags) for e, g in zip(estimates, flagged)]
     modes = flag_mains_hum([e for e, t in zip(estimates, is_tone) if not t], prepared)
     tones = [e.natural_frequency_hz for e, t in zip(estimates, is_tone) if t]
     method = "efdd" if enhanced else "fdd"

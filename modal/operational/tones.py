@@ -4,19 +4,31 @@ A running machine's harmonics are sinusoids in every channel: the identification
 poles of (nearly) zero damping, as stable over the orders as any mode. Three pieces of evidence
 say that a pole is a tone (Brincker, Andersen & Møller, IMAC 2000; Jacobsen 2006):
 
-* its damping is nearly zero: below :data:`TONE_DAMPING` (where few structures are) either with its
-  error (ζ + 3σ_ζ) or indistinguishable from zero (ζ < 3σ_ζ);
+* its damping is indistinguishable from zero (ζ < 3σ_ζ) and below :data:`TONE_DAMPING`, where few structures
+  are (for a method without error bars, below it). A small damping resolved from zero is measured decay: a
+  lightly damped mode's, or a line's beat or wander, which only the record's length tells apart (below);
 * the response band-passed around it is not Gaussian: a sinusoid's kurtosis is 1.5 where a
-  structural mode driven by random forces gives 3 (:data:`KURTOSIS_LIMIT`). The band is the pole's
-  own (4 half-power widths) or :data:`MIN_BANDWIDTH_TIME` lines, whichever is wider; a pole of nearly
-  zero damping stands for the strongest line within its resolution (a tone that wanders, or two close
-  lines the correlation lags cannot tell apart, give one pole between them), and the band is centred
-  on that line, so that the tone dominates it;
+  structural mode driven by random forces gives 3 (:data:`KURTOSIS_LIMIT`). The band spans
+  :data:`MIN_BANDWIDTH_TIME` lines around the strongest line the pole stands for: within its half-power
+  band, or, for a pole of nearly zero damping, within the lags' resolution (a tone that wanders, or two
+  close lines the correlation lags cannot tell apart, give one pole between them), so that one tone
+  dominates the band;
 * it lies on a harmonic ``k × f₀`` of the running speed (``rotor_speed_hz``, or the fundamental
   that the tones found by the first two pieces of evidence share).
 
 A pole with two of them is a tone; a mode on a harmonic without further evidence stays a mode,
 flagged ``harmonic``.
+
+The kurtosis alone makes a tone where the record resolves the pole's damping: a structural mode of damping
+ratio ζ at ω = 2πf holds ζωT decay times in a record of T seconds, and with at least
+:data:`MIN_DECAYS` of them (ζ less three of its standard errors) its response band-passed around its
+strongest line is Gaussian (a random mode with fewer looks like a slowly drifting sinusoid: its kurtosis
+falls below the limit in 16 % of records at 2 decay times, 5 % at 4, never in 1000 at 16). Such a pole
+whose band is a sinusoid's stands for a line whose apparent damping is not a structure's: two tones closer
+than the correlation lags resolve (one pole between them, damped by their beat, as the shipped record's
+181.7/182.8 Hz pair), or a tone whose frequency wanders. A pole with a sinusoid's band that the record does
+not resolve so and that has no second piece of evidence stays a mode, flagged ``tone_like``: a tone, or a
+mode so lightly damped that the record holds few of its decay times, which one record cannot tell apart.
 
 Mains hum (a ground loop, an unshielded cable: 50 or 60 Hz and its harmonics, often on a few channels
 only) is a line too, but it need not look undamped to the identification: a mode within
@@ -29,24 +41,22 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..flags import HARMONIC_SIGMAS, HARMONIC_TOLERANCE
+from ..flags import HARMONIC_SIGMAS, HARMONIC_TOLERANCE, KURTOSIS_LIMIT, MIN_DECAYS
 from .inputs import Prepared
 from .pole import PoleEstimate
 
-__all__ = ["separate_tones", "nearly_undamped", "band_kurtosis", "strongest_line_hz", "harmonic_of", "KURTOSIS_LIMIT",
-           "TONE_DAMPING", "flag_mains_hum", "line_ratio", "MAINS_HZ", "HUM_TOLERANCE", "HUM_LINE_RATIO"]
+__all__ = ["separate_tones", "nearly_undamped", "zero_damping", "resolved_decays", "band_kurtosis", "strongest_line_hz", "harmonic_of",
+           "KURTOSIS_LIMIT", "TONE_DAMPING", "MIN_DECAYS", "flag_mains_hum", "line_ratio", "MAINS_HZ", "HUM_TOLERANCE", "HUM_LINE_RATIO"]
 
 #: a pole whose damping ratio is below this with its error (ζ + 3σ_ζ) has nearly zero damping
 TONE_DAMPING = 0.002
 ZERO_DAMPING_SIGMAS = 3.0
-#: kurtosis of the band-passed response below which it holds a sinusoid: 3 for Gaussian narrow-band
-#: response, 1.5 for a pure tone, 2.25 for two equal tones. The estimate (from the band's lines, never
-#: below 1.5) has a short lower tail: for Gaussian response over :data:`MIN_BANDWIDTH_TIME` = 64 lines
-#: its 10⁻⁴ quantile is 2.27 with a flat spectrum and 2.18 with a mode's bell spanning the band
-#: (10⁵ draws each; ``tests/modal/operational/test_tones.py`` checks the margin)
-KURTOSIS_LIMIT = 1.95
 #: the band-pass spans at least this many lines, i.e. this bandwidth times the record's duration (Hz·s)
 MIN_BANDWIDTH_TIME = 64.0
+#: ... and, for a pole whose line is looked for over a wider range, this many times wider in turn up to that
+#: range: a tone whose frequency wanders (a machine's speed) over more than the narrowest band moves in and out
+#: of it (kurtosis above 3) but keeps one amplitude in a band that holds its wander (1.5)
+BAND_STEP = 4.0
 #: the mains frequencies (Hz); their harmonics up to :data:`MAINS_HARMONICS` are where hum lies
 MAINS_HZ = (50.0, 60.0)
 MAINS_HARMONICS = 6
@@ -127,63 +137,103 @@ def nearly_undamped(estimate: PoleEstimate) -> bool:
     return bool(zeta < TONE_DAMPING and (zeta + margin < TONE_DAMPING or zeta < margin))
 
 
+def zero_damping(estimate: PoleEstimate) -> bool:
+    """Whether a pole's damping ratio is indistinguishable from zero (ζ < 3σ_ζ) and below :data:`TONE_DAMPING`
+    (where few structures are), the tone's evidence. A damping resolved from zero, however small, is measured
+    decay: a mode's, or a line's beat or wander, which only the record's length tells apart
+    (:func:`resolved_decays`). Where the method gives no error bars (EFDD), the damping ratio below
+    :data:`TONE_DAMPING` stands for it."""
+    zeta, std = estimate.damping_ratio, estimate.std_damping_ratio
+    if not np.isfinite(std):
+        return nearly_undamped(estimate)
+    return bool(zeta < min(ZERO_DAMPING_SIGMAS * std, TONE_DAMPING))
+
+
+def resolved_decays(estimate: PoleEstimate, duration_s: float) -> float:
+    """The decay times (ζ − 3σ_ζ)·2πf·T a structural mode of the estimate's damping ratio, less three of its
+    standard errors, holds in a record of ``duration_s`` (σ_ζ taken as 0 where the method gives none; NaN where
+    it measures no damping)."""
+    if not estimate.damping_known or not np.isfinite(estimate.damping_ratio):
+        return float("nan")
+    std = estimate.std_damping_ratio if np.isfinite(estimate.std_damping_ratio) else 0.0
+    return float((estimate.damping_ratio - ZERO_DAMPING_SIGMAS * std) * abs(estimate.pole) * duration_s)
+
+
 def _band_is_peaky(estimate: PoleEstimate, prepared: Prepared, spectra: dict, resolution_hz: float | None) -> bool:
-    """Whether the response band-passed around one estimate is non-Gaussian (kurtosis below
-    :data:`KURTOSIS_LIMIT`); ``spectra`` caches each channel's FFT."""
+    """Whether the response band-passed around one estimate's strongest line is non-Gaussian (kurtosis below
+    :data:`KURTOSIS_LIMIT`); ``spectra`` caches each channel's FFT.
+
+    The band spans :data:`MIN_BANDWIDTH_TIME` lines around the strongest line of the channel where the pole is
+    strongest, looked for within the pole's half-power band ±ζf (or three of its frequency's standard errors, at
+    least 2 lines) or, for a pole of nearly zero (or unknown) damping, within the lags' resolution
+    ``resolution_hz``: a line there is what the pole stands for (two lines the lags cannot tell apart give one
+    pole between them, damped by their beat), and a band holding one line of them is a sinusoid's where a band
+    holding both beats (kurtosis 2.25). A line farther from a damped pole is not the pole's: a tone beside a
+    structural mode does not make the mode a tone. Bands :data:`BAND_STEP` times wider in turn, up to the
+    range searched, are judged too (a wandering tone)."""
     from scipy.fft import rfft
 
     zeta = estimate.damping_ratio if np.isfinite(estimate.damping_ratio) else 0.0
     f = estimate.natural_frequency_hz
     channel = int(np.argmax(np.abs(estimate.shape) / prepared.scale))  # where it is strongest against the rest
-    width = max(4 * max(zeta, 0.0) * f, MIN_BANDWIDTH_TIME / prepared.duration_s)
     n = prepared.n_samples
     if channel not in spectra:
         spectra[channel] = rfft(prepared.channel(channel))
-    centre = f
+    std_f = estimate.std_frequency_hz if np.isfinite(estimate.std_frequency_hz) else 0.0
+    search = max(max(zeta, 0.0) * f, ZERO_DAMPING_SIGMAS * std_f, 2.0 / prepared.duration_s)
     if (nearly_undamped(estimate) or not estimate.damping_known) and resolution_hz:
-        centre = strongest_line_hz(spectra[channel], n, prepared.sample_rate_hz, f - resolution_hz / 2,
-                                   f + resolution_hz / 2)
-    kurtosis = band_kurtosis(spectra[channel], n, prepared.sample_rate_hz, centre, width)
-    return bool(np.isfinite(kurtosis) and kurtosis < KURTOSIS_LIMIT)
+        search = max(search, resolution_hz / 2)
+    centre = strongest_line_hz(spectra[channel], n, prepared.sample_rate_hz, f - search, f + search)
+    width = MIN_BANDWIDTH_TIME / prepared.duration_s
+    while True:  # bands 4 times wider in turn, up to the search's: a tone that wanders fills the band that holds it
+        kurtosis = band_kurtosis(spectra[channel], n, prepared.sample_rate_hz, centre, width)
+        if np.isfinite(kurtosis) and kurtosis < KURTOSIS_LIMIT:
+            return True
+        width *= BAND_STEP
+        if width > 2 * search:
+            return False
 
 
 def separate_tones(estimates: list[PoleEstimate], prepared: Prepared, rotor_speed_hz: float | None,
                    resolution_hz: float | None = None):
-    """Which estimates are machine tones, and the modes left on a harmonic flagged ``harmonic``.
+    """Which estimates are machine tones; the modes left on a harmonic flagged ``harmonic``, those whose band is
+    a sinusoid's though the record cannot tell them from a lightly damped mode flagged ``tone_like``.
 
     ``resolution_hz``, the frequency resolution of the method's correlation lags (sample rate / lags):
     a pole of nearly zero damping (or unknown damping) is judged on the strongest line within half of it
-    on either side. None: on the pole's own frequency.
+    on either side. None: on the pole's own band.
 
     Returns
     -------
     (is_tone, estimates) : (list of bool, list of PoleEstimate)
-        The estimates in the same order, those on a harmonic that are not tones with the flag added.
+        The estimates in the same order, those that are not tones with their flags added.
     """
-    spectra: dict = {}
-    peaky: dict[int, bool] = {}
+    spectra: dict = {}  # a record-long FFT per channel judged on, shared by its poles
+    peaky = [_band_is_peaky(e, prepared, spectra, resolution_hz) for e in estimates]
 
-    def is_peaky(k: int) -> bool:  # the kurtosis costs a record-long FFT: taken only where it decides
-        if k not in peaky:
-            peaky[k] = _band_is_peaky(estimates[k], prepared, spectra, resolution_hz)
+    def is_peaky(k: int) -> bool:
         return peaky[k]
 
-    undamped = [nearly_undamped(e) for e in estimates]
+    undamped = [zero_damping(e) for e in estimates]
+    # a pole whose damping the record resolves as a structure's would be Gaussian: its kurtosis alone decides
+    resolving = [resolved_decays(e, prepared.duration_s) >= MIN_DECAYS for e in estimates]
     fundamental = rotor_speed_hz
     if fundamental is None:
-        # the tones the data show clearly: nearly undamped and non-Gaussian (or non-Gaussian where the method
-        # measures no damping)
+        # the tones the data show clearly, whose comb is looked for: non-Gaussian and nearly undamped (below
+        # TONE_DAMPING), or with a damping the record resolves (or non-Gaussian where the method measures no
+        # damping); a comb is one more piece of evidence, never the only one
         clear = [(e.natural_frequency_hz, e.std_frequency_hz) for k, e in enumerate(estimates)
-                 if (undamped[k] or not e.damping_known) and is_peaky(k)]
+                 if (nearly_undamped(e) or resolving[k] or not e.damping_known) and is_peaky(k)]
         fundamental = _fundamental([f for f, _ in clear], [s for _, s in clear])
     is_tone, out = [], []
     for k, estimate in enumerate(estimates):
         on_comb = fundamental is not None and harmonic_of(estimate.natural_frequency_hz,
                                                           estimate.std_frequency_hz, fundamental) > 0
         others = undamped[k] + on_comb  # two of the three pieces of evidence make a tone
-        tone = others == 2 or (others == 1 and is_peaky(k))
+        tone = others == 2 or ((others == 1 or resolving[k]) and is_peaky(k))
         is_tone.append(tone)
-        out.append(replace(estimate, flags=estimate.flags | {"harmonic"}) if on_comb and not tone else estimate)
+        added = set() if tone else {f for f, holds in (("harmonic", on_comb), ("tone_like", is_peaky(k))) if holds}
+        out.append(replace(estimate, flags=estimate.flags | added) if added else estimate)
     return is_tone, out
 
 
