@@ -25,6 +25,7 @@ from ..noise_model import (INPUT_NOISE_LIMIT, NoiseModel, input_noise_split, lag
                            window_line_correlation)
 from ..validate import finite_samples, one_of, per_line, positive_number
 from . import spectra
+from .excitation_noise import EXCITATION_NOISE_LIMIT, excitation_noise_share
 from .error_correlation import LEAKAGE_LAGS, MIN_RECORDS, measured_line_correlation
 from .record_influence import MAX_INFLUENCE_VALUES, overlapping_records, record_influence
 from .hits import find_hits, pulse_train
@@ -256,6 +257,18 @@ def _shared_variance(sums, frf: np.ndarray, power: np.ndarray) -> np.ndarray:
             a[o], b = input_noise_split(residual, h2, b * sums.n_records < INPUT_NOISE_LIMIT * power)
             holds &= b * sums.n_records < INPUT_NOISE_LIMIT * power
         return np.where(holds & (power > 0), np.mean(a) / power, np.nan)
+
+
+def _warn_excitation_noise(sums, name: str, source: str) -> None:
+    """Warn when the measured excitation holds content the responses do not follow: H1 is then low by that
+    share whatever the averages (:mod:`modal.estimate.excitation_noise`)."""
+    share = excitation_noise_share(sums.sxx[0, 0].real, sums.syx[:, 0], sums.syy, sums.n_records)
+    if share is not None and share > EXCITATION_NOISE_LIMIT:
+        warn(f"{source}: {name}: the responses do not follow about {100 * min(share, 1.0):.0f} % of its power "
+             "(median line): H1 reads the FRF that much low and masses and stiffnesses high, whatever the averages; "
+             "noise on the force channel (a force measured at the shaker's body rather than through the force cell "
+             "at the stinger's tip, a cable, a gain) or leakage of a very lightly damped mode: check the force "
+             "channel, or estimate with H2 (estimator='H2'; --estimator H2), or longer segments", QualityWarning)
 
 
 def _refuse_swapped_channels(force, response, sample_rate_hz, labels, source) -> None:
@@ -511,6 +524,8 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
     sums = spectra.accumulate(x, y, starts, length, in_w, out_w, lags=window_lags,
                               error_lags=max(window_lags, LEAKAGE_LAGS) if measured else 0,
                               keep_records=keep_records)
+    if not impact and estimator == "H1" and x.shape[0] == 1:
+        _warn_excitation_noise(sums, labels[0], source)
     factor = spectra.overlap_variance_factor(out_w, step) if not impact else 1.0
     estimate = {"H1": spectra.h1, "H2": spectra.h2, "Hv": spectra.hv}[estimator]
     frf3, coherence3, multiple, variance3 = estimate(sums, source)
