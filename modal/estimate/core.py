@@ -460,6 +460,10 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
             full_scale=full_scale, channel_names=labels, source=source)
         rejected = hits.rejected
         overloads = hits.overloads
+        # the force channel's offset (a charge amplifier's, an IEPE sensor settling) is no force the structure
+        # felt: under the force window it would add a rectangular pulse the width of the window, a bias at the
+        # lowest modes; the median of a hammer record, quiet but for its hits, is that offset
+        x = (force - np.median(force))[np.newaxis, :]
         hit_times = tuple(float(t) / fs for t in hits.trigger_index[hits.accepted])
         starts = hits.record_start[hits.accepted]
         if starts.size == 0:

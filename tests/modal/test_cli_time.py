@@ -427,3 +427,21 @@ def test_an_exponential_window_that_flattens_every_peak_is_named_as_the_cause(tm
     error = out.stderr.splitlines()[-1]
     assert "no resonance peak found" in error and "the exponential window (tau = 0.01 s)" in error
     assert "10 % or more below 159.2 Hz" in error  # 1/(0.2 π τ)
+
+
+def test_a_shaker_force_with_an_offset_is_not_called_hammer_hits(tmp_path):
+    # an offset of 5 standard deviations on a shaker's force (an amplifier's, a sensor settling) made `modal fit`
+    # call its upper tail "179 short pulses, as hammer hits are" and advise --impact; the offset is no pulse
+    from modal.io.timewrite import write_time
+    from modal.synthetic_time import random_record
+
+    record = random_record(PLANT, 30.0, force_rms_n=10.0, response_noise=0.02, names=["1+Z", "1+Z", "2+Z"],
+                           seed=3).record
+    signals = record.signals.copy()
+    signals[0] += 5 * signals[0].std()
+    path = tmp_path / "shaker_offset.csv"
+    from dataclasses import replace
+    write_time(replace(record, signals=signals), path)
+    out = run("fit", path)
+    assert out.returncode == 0, out.stderr
+    assert "warning" not in out.stderr, out.stderr
