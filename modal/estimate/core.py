@@ -267,8 +267,9 @@ def _warn_excitation_noise(sums, name: str, source: str) -> None:
         warn(f"{source}: {name}: the responses do not follow about {100 * min(share, 1.0):.0f} % of its power "
              "(median line): H1 reads the FRF that much low and masses and stiffnesses high, whatever the averages; "
              "noise on the force channel (a force measured at the shaker's body rather than through the force cell "
-             "at the stinger's tip, a cable, a gain) or leakage of a very lightly damped mode: check the force "
-             "channel, or estimate with H2 (estimator='H2'; --estimator H2), or longer segments", QualityWarning)
+             "at the stinger's tip, a cable, a gain), a delay between the channels, or leakage of a very lightly "
+             "damped mode: check the force channel, or estimate with H2 (estimator='H2'; --estimator H2), or "
+             "longer segments", QualityWarning)
 
 
 def _refuse_swapped_channels(force, response, sample_rate_hz, labels, source) -> None:
