@@ -31,6 +31,7 @@ from .record_influence import MAX_INFLUENCE_VALUES, overlapping_records, record_
 from .hits import find_hits, pulse_train
 from .levels import level_dependence, take_dependence
 from .overload import find_overloads
+from .periodic import repeats_every
 from .quiet import quiet_noise
 from .takes import find_hits_in_takes, segment_starts, take_bounds
 from .takes import take_names as _take_names
@@ -576,6 +577,9 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
                          overlapping=0 if impact else overlapping_records(length, step),
                          withheld=measured and not keep_records and n_in == 1 and n_out == 1)
 
+    if not impact and window == "rect" and repeats_every([x[i] for i in range(x.shape[0])]
+                                                         + [y[o] for o in range(y.shape[0])], length):
+        model = replace(model, lag_window=None)  # whole periods in every record: no leakage to take out
     if response_quantity is not None:
         delta = KIND_POWER[kind] - RESPONSE_QUANTITIES[response_quantity]
         if delta:
