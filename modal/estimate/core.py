@@ -31,7 +31,7 @@ from .record_influence import MAX_INFLUENCE_VALUES, overlapping_records, record_
 from .hits import find_hits, pulse_train
 from .levels import level_dependence, take_dependence
 from .overload import find_overloads
-from .periodic import repeats_every
+from .periodic import repeats_every, shortest_period
 from .quiet import quiet_noise
 from .takes import find_hits_in_takes, segment_starts, take_bounds
 from .takes import take_names as _take_names
@@ -262,6 +262,16 @@ def _shared_variance(sums, frf: np.ndarray, power: np.ndarray) -> np.ndarray:
             a[o], b = input_noise_split(residual, h2, b * sums.n_records < INPUT_NOISE_LIMIT * power)
             holds &= b * sums.n_records < INPUT_NOISE_LIMIT * power
         return np.where(holds & (power > 0), np.mean(a) / power, np.nan)
+
+
+def _warn_periods_per_record(excitation, length: int, sample_rate_hz: float, source: str) -> None:
+    """Warn when a periodic excitation repeats several times within a record: only every k-th line holds it."""
+    period = shortest_period(excitation, length)
+    if period < length:
+        count = length // period
+        warn(f"{source}: the excitation repeats every {period} samples ({period / sample_rate_hz:g} s), {count} times "
+             f"in each {length}-sample record: one line in {count} holds it and the lines between hold noise alone; "
+             f"make a record one period (segment_length {period}; --segment-length {period})", QualityWarning)
 
 
 def _warn_few_records(n_records: int, length: int, sample_rate_hz: float, source: str) -> None:
@@ -577,9 +587,10 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
                          overlapping=0 if impact else overlapping_records(length, step),
                          withheld=measured and not keep_records and n_in == 1 and n_out == 1)
 
-    if not impact and window == "rect" and repeats_every([x[i] for i in range(x.shape[0])]
-                                                         + [y[o] for o in range(y.shape[0])], length):
-        model = replace(model, lag_window=None)  # whole periods in every record: no leakage to take out
+    if not impact and repeats_every([x[i] for i in range(x.shape[0])], length):
+        _warn_periods_per_record([x[i] for i in range(x.shape[0])], length, fs, source)
+        if window == "rect" and repeats_every([y[o] for o in range(y.shape[0])], length):
+            model = replace(model, lag_window=None)  # whole periods in every record: no leakage to take out
     if response_quantity is not None:
         delta = KIND_POWER[kind] - RESPONSE_QUANTITIES[response_quantity]
         if delta:

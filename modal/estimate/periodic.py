@@ -8,13 +8,15 @@ the lag window ρ(τ) = 1 − τ/N and the decay cut off at the record's end, :m
 there. Modelling it anyway takes a bias out that the data do not hold: a periodic chirp measured exactly
 gave its modes' damping 15 % low, 36 of their standard errors.
 
-:func:`repeats_every` tells whether channels repeat with a period that divides the record.
+:func:`repeats_every` tells whether channels repeat with a period that divides the record;
+:func:`shortest_period` whether that period is a fraction of the record: then only every k-th line of the
+records' transform holds the excitation, and the lines between hold its noise alone.
 """
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["repeats_every", "REPEAT_LIMIT"]
+__all__ = ["repeats_every", "shortest_period", "REPEAT_LIMIT"]
 
 #: channels whose samples one record length apart differ by less than this fraction of twice their power
 #: repeat (a period dividing the record): white noise of 10 % of a channel's RMS leaves 0.01; samples of a
@@ -49,3 +51,14 @@ def repeats_every(signals, length: int, limit: float = REPEAT_LIMIT) -> bool:
         if power <= 0 or float(np.mean((x[length:] - x[:-length]) ** 2)) > limit * power:
             return False
     return True
+
+
+def shortest_period(signals, length: int, largest_count: int = 16) -> int:
+    """The fewest samples, ``length`` / k for k = 1 … ``largest_count`` dividing ``length``, after which every
+    channel repeats (:func:`repeats_every`); ``length`` when the channels repeat only after a whole record
+    (or not at all)."""
+    period = length
+    for count in range(2, largest_count + 1):
+        if length % count == 0 and repeats_every(signals, length // count):
+            period = length // count
+    return period
