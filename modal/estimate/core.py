@@ -512,8 +512,11 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
         overloads = hits.overloads
         # the force channel's offset (a charge amplifier's, an IEPE sensor settling) is no force the structure
         # felt: under the force window it would add a rectangular pulse the width of the window, a bias at the
-        # lowest modes; the median of a hammer record, quiet but for its hits, is that offset
+        # lowest modes; the median of a hammer record, quiet but for its hits, is that offset. A response's
+        # offset under the exponential window is a decaying pulse of its own, a pole at -1/τ
         x = (force - np.median(force))[np.newaxis, :]
+        y = np.asarray(y, dtype=float)
+        y = y - np.median(y, axis=1, keepdims=True)
         hit_times = tuple(float(t) / fs for t in hits.trigger_index[hits.accepted])
         starts = hits.record_start[hits.accepted]
         if starts.size == 0:

@@ -159,6 +159,22 @@ def test_a_hammer_force_offset_finds_the_same_hits_and_the_same_frf(offset_fract
     np.testing.assert_allclose(offset.response, clean.response, rtol=1e-9, atol=1e-12 * np.abs(clean.response).max())
 
 
+def test_a_response_offset_under_the_exponential_window_gives_the_same_frf():
+    # an accelerometer's offset of 1 % of its peak, times exp(−t/τ), is a decaying pulse of its own: on the
+    # shipped hammer record mode 1's mass read 1.148 ± 0.053 kg for 1.037 (5 %: every mode flagged, mode 1's
+    # mass 1.95). The response's median, its offset in a record quiet but for the hits' ringing, is taken off
+    record = impact_record(PLANT, 0.5 + 2.0 * np.arange(6), 12.0, force_noise=0.002, response_noise=0.002,
+                           seed=4).record
+    shifted = record.signals.copy()
+    shifted[1:] += 0.01 * np.max(np.abs(shifted[1:]), axis=1, keepdims=True)
+    def estimate(signals):
+        return modal.estimate_frf(signals[0], signals[1:], FS, impact=True, window="exponential",
+                                  exponential_decay_s=0.2, kind="accelerance", response_quantity="acceleration")
+
+    clean, offset = estimate(record.signals), estimate(shifted)
+    np.testing.assert_allclose(offset.response, clean.response, rtol=1e-9, atol=1e-12 * np.abs(clean.response).max())
+
+
 def test_hits_estimated_as_a_continuous_record_are_named_and_a_continuous_force_refuses_impact():
     import warnings
 
