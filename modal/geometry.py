@@ -21,7 +21,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from .errors import ParameterError
+from .errors import ParameterError, QualityWarning, warn
 
 __all__ = ["Geometry", "line_geometry", "direction_vector", "DIRECTIONS"]
 
@@ -178,16 +178,48 @@ class Geometry:
             if self.n_channels != n_channels:
                 raise ParameterError(f"{self.source}: the geometry places {self.n_channels} channel(s), the data have "
                                      f"{n_channels}")
+            if points is not None:
+                self._warn_map_disagrees(points)
             return self
         if points is None:
             raise ParameterError(f"{self.source}: the data carry no point ids and the geometry no channel map; "
                                  f"expected point ids such as '3+Z' in the FRF file or a [channels] table")
         return self.with_channels(points)
 
+    def _warn_map_disagrees(self, points: Sequence[str]) -> None:
+        """Warn when the data's point ids would place the channels on this geometry's nodes, but elsewhere than
+        its channel map does (a map written for another channel order, or a sensor's sign): the map is used.
+        Point ids that do not stand on the geometry's nodes are a deliberate renaming, not warned."""
+        try:
+            placed = [direction_vector(str(point)) for point in points]
+        except ValueError:
+            return
+        known = set(self.node_id.tolist())
+        if len(placed) != self.n_channels or any(node not in known for node, _ in placed):
+            return
+        for k, ((node, direction), point) in enumerate(zip(placed, points)):
+            if node != self.channel_node[k] or not np.allclose(direction, self.channel_direction[k]):
+                mapped = _point_text(int(self.channel_node[k]), self.channel_direction[k])
+                others = sum(node != self.channel_node[j] or not np.allclose(direction, self.channel_direction[j])
+                             for j, (node, direction) in enumerate(placed))
+                warn(f"{self.source}: the geometry's channel map places channel {k + 1} at {mapped}, the data's point "
+                     f"id says {point!r} ({others} of {len(placed)} channels disagree): the shapes are drawn where the "
+                     "map says; if the data's ids are right, remove the map's channel entries", QualityWarning)
+                return
+
     def extent_m(self) -> float:
         """Largest distance between two nodes along any axis, m (1 for a single point)."""
         span = float(np.max(np.ptp(self.coordinates_m, axis=0)))
         return span if span > 0 else 1.0
+
+
+def _point_text(node: int, direction: np.ndarray) -> str:
+    """A placed channel as a point id (``"3-X"``; a rotation, which draws nothing, as its node alone)."""
+    for axis, unit in DIRECTIONS.items():
+        for sign in (1.0, -1.0):
+            if np.any(unit) and np.allclose(direction, sign * np.array(unit)):
+                return f"{node}{'+' if sign > 0 else '-'}{axis}"
+    return str(node)
 
 
 def _id_range(ids: np.ndarray) -> str:

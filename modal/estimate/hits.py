@@ -120,9 +120,11 @@ def _noise_floor(centred: np.ndarray) -> np.ndarray:
 
 
 def trigger_threshold(force: np.ndarray) -> float:
-    """The default trigger level of a force record, in its unit: the larger of 5 % of the largest |force| and
-    8 robust standard deviations of its noise (median absolute deviation / 0.6745)."""
-    return _threshold(force, _centre_and_noise(force)[1])
+    """The default trigger level of a force record, in its unit, above its median (the channel's offset): the
+    larger of 5 % of the largest |force − median| and 8 robust standard deviations of its noise (median
+    absolute deviation / 0.6745)."""
+    centre, noise = _centre_and_noise(force)
+    return _threshold(force - centre, noise)
 
 
 def _centre_and_noise(force: np.ndarray) -> tuple[float, float]:
@@ -165,12 +167,12 @@ def pulse_train(force, sample_rate_hz: float) -> PulseTrain:
     if force.size == 0 or not np.any(force):
         return PulseTrain(0, 0.0, 0.0)
     centre, noise = _centre_and_noise(force)
-    above = np.abs(force) > _threshold(force, noise)
+    centred = force - centre  # a force channel's offset (an amplifier's, a drift) is no pulse
+    above = np.abs(centred) > _threshold(centred, noise)
     pulses = _pulses(above, max(2, int(round(0.0005 * float(sample_rate_hz)))))
     inside = np.zeros(force.size, bool)
     for first, last in pulses:
         inside[first:last + 1] = True
-    centred = force - centre
     noise_variance = noise**2
     # energies above the noise's (the noise's expected energy taken off both), so that a noisy force
     # channel still shows its hits
@@ -210,9 +212,9 @@ def find_hits(force, response, sample_rate_hz: float, *, threshold: float | None
     sample_rate_hz : float
         Samples per second, Hz.
     threshold : float, optional
-        Trigger level in the force's unit. Default: the larger of 5 % of the
-        largest |force| and 8 robust standard deviations of the force's noise
-        (median absolute deviation / 0.6745).
+        Trigger level in the force's unit, above the force's median (its offset). Default: the
+        larger of 5 % of the largest |force − median| and 8 robust standard deviations of the
+        force's noise (median absolute deviation / 0.6745).
     pretrigger_s : float, optional
         Time kept before each trigger, s. Default: 1/64 of the record, at least 2 samples.
     record_length : int, optional
@@ -252,7 +254,8 @@ def find_hits(force, response, sample_rate_hz: float, *, threshold: float | None
         raise ParameterError(f"{source}: field 'excitation' is zero everywhere: no hit to find (is it the force "
                              "channel?)")
     threshold = trigger_threshold(force) if threshold is None else float(threshold)
-    above = np.abs(force) > threshold
+    # the trigger counts from the force's median: an amplifier's offset is no hit
+    above = np.abs(force - np.median(force)) > threshold
     merge_gap = max(2, int(round(0.0005 * fs)))
     pulses = _pulses(above, merge_gap)
     if not pulses:

@@ -101,6 +101,24 @@ def test_a_geometry_that_lacks_a_channels_node_writes_no_archive(tmp_path):
     assert out.returncode == 1 and "give --archive" in out.stderr
 
 
+def test_a_geometry_whose_channel_map_swaps_two_channels_is_warned(plate_archive, tmp_path):
+    # the data say channel 1 stands at 8+Z and channel 2 at 9+Z; a CSV geometry's channel rows give them the
+    # other way round: the report drew the two swapped with no word
+    from modal.io.geometry import read_geometry
+
+    plate = read_geometry(PLATE_GEOMETRY)
+    points = list(read_archive(plate_archive)["frf"].response_points)
+    rows = [f"node, {i}, {x}, {y}, {z}" for i, (x, y, z) in zip(plate.node_id, plate.coordinates_m)]
+    rows += [f"line, {a}, {b}" for a, b in plate.lines]
+    rows += [f"channel, {p}" for p in [points[1], points[0], *points[2:]]]
+    geometry = tmp_path / "mapped.csv"
+    geometry.write_text("\n".join(rows) + "\n")
+    out = run("report", plate_archive, "--out", tmp_path / "r.html", "--geometry", geometry)
+    assert out.returncode == 0, out.stderr
+    assert (f"warning: {geometry}: the geometry's channel map places channel 1 at {points[1]}, the data's point id "
+            f"says '{points[0]}' (2 of {len(points)} channels disagree)") in out.stderr
+
+
 def test_uff_export_carries_the_geometry_before_the_shapes(tmp_path):
     import pyuff
 

@@ -2,7 +2,9 @@
 import numpy as np
 import pytest
 
-from modal.errors import ParameterError
+import warnings
+
+from modal.errors import ParameterError, QualityWarning
 from modal.geometry import Geometry, direction_vector, line_geometry
 
 
@@ -48,12 +50,27 @@ def test_without_a_geometry_channels_stand_on_a_line_in_file_order():
 def test_placed_for_uses_the_geometry_map_else_the_point_ids():
     square = _square()
     mapped = square.with_channels(["1+Z", "2+Z"])
-    assert mapped.placed_for(2, ["3+Z", "4+Z"]) is mapped  # the file's own map wins
+    with pytest.warns(QualityWarning, match=r"square: the geometry's channel map places channel 1 at 1\+Z, the data's "
+                                            r"point id says '3\+Z' \(2 of 2 channels disagree\)"):
+        assert mapped.placed_for(2, ["3+Z", "4+Z"]) is mapped  # the file's own map wins, and says so
     with pytest.raises(ParameterError, match="places 2 channel"):
         mapped.placed_for(3, None)
     assert square.placed_for(1, ["4-Z"]).channel_node.tolist() == [4]
     with pytest.raises(ParameterError, match="no point ids"):
         square.placed_for(2, None)
+
+
+def test_a_channel_map_that_disagrees_with_the_data_is_warned_naming_the_first_channel():
+    # a map written for another channel order, or with a sensor's sign flipped, placed the shapes where the
+    # map says with no word: a sign drawn wrong at one node looks like a real mode shape
+    mapped = _square().with_channels(["1+Z", "2+Z", "3-X"])
+    with pytest.warns(QualityWarning, match=r"places channel 3 at 3-X, the data's point id says '3\+X' \(1 of 3"):
+        mapped.placed_for(3, ["1+Z", "2+Z", "3+X"])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert mapped.placed_for(3, ["1+Z", "2+Z", "3-X"]) is mapped  # the same places: no word
+        assert mapped.placed_for(3, ["11+Z", "12+Z", "13+Z"]) is mapped  # ids on no node of it: a renaming
+        assert mapped.placed_for(3, None) is mapped
 
 
 def test_direction_vector_of_every_translation():
