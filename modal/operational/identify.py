@@ -202,7 +202,7 @@ check) are shared among ``workers`` threads instead, one contiguous share each (
         estimates, chosen, clusters, flat, stable, corr, settings = plscf(prepared, refs, max_order, workers)
     resolution_hz = corr.sample_rate_hz / corr.max_lag  # what the correlation lags tell apart
     estimates, tones, dropped, diagram = _sort_out(estimates, chosen, clusters, flat, stable, prepared,
-                                                   rotor_speed_hz, method, resolution_hz)
+                                                   rotor_speed_hz, method, resolution_hz, workers)
     estimates = flag_mains_hum(estimates, prepared)
     if not estimates and not tones:
         raise IdentificationError(f"{prepared.source}: no stable pole in the band {prepared.band_hz[0]:g}-"
@@ -221,7 +221,7 @@ check) are shared among ``workers`` threads instead, one contiguous share each (
 
 
 def _sort_out(estimates, chosen, clusters, flat, stable, prepared: Prepared, rotor_speed_hz, method: str,
-              resolution_hz: float):
+              resolution_hz: float, workers: int = 1):
     """Modes, tones (Hz), dropped noise poles (Hz) and the stabilisation diagram from the method's estimates.
 
     Noise poles (frequency not determined within their bandwidth) are dropped, except poles of nearly zero
@@ -231,7 +231,7 @@ def _sort_out(estimates, chosen, clusters, flat, stable, prepared: Prepared, rot
     keep = [resolved(e, prepared.duration_s) or nearly_undamped(e) for e in estimates]
     dropped = [e.natural_frequency_hz for e, k in zip(estimates, keep) if not k]
     estimates, clusters = ([x for x, k in zip(seq, keep) if k] for seq in (estimates, clusters))
-    is_tone, estimates = separate_tones(estimates, prepared, rotor_speed_hz, resolution_hz)
+    is_tone, estimates = separate_tones(estimates, prepared, rotor_speed_hz, resolution_hz, workers)
     keep = [t or resolved(e, prepared.duration_s) for e, t in zip(estimates, is_tone)]
     dropped = sorted(dropped + [e.natural_frequency_hz for e, k in zip(estimates, keep) if not k])
     estimates, clusters, is_tone = ([x for x, k in zip(seq, keep) if k] for seq in (estimates, clusters, is_tone))

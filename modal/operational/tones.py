@@ -42,6 +42,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..flags import HARMONIC_SIGMAS, HARMONIC_TOLERANCE, KURTOSIS_LIMIT, MIN_DECAYS
+from ..parallel import map_over_threads
 from .inputs import Prepared
 from .pole import PoleEstimate
 
@@ -159,6 +160,18 @@ def resolved_decays(estimate: PoleEstimate, duration_s: float) -> float:
     return float((estimate.damping_ratio - ZERO_DAMPING_SIGMAS * std) * abs(estimate.pole) * duration_s)
 
 
+def _judged_channel(estimate: PoleEstimate, prepared: Prepared) -> int:
+    """The channel an estimate's band is judged on: where it is strongest against the rest."""
+    return int(np.argmax(np.abs(estimate.shape) / prepared.scale))
+
+
+def _channel_spectrum(prepared: Prepared, channel: int) -> np.ndarray:
+    """A record-long FFT of one channel (centred, unit RMS)."""
+    from scipy.fft import rfft
+
+    return rfft(prepared.channel(channel))
+
+
 def _band_is_peaky(estimate: PoleEstimate, prepared: Prepared, spectra: dict, resolution_hz: float | None) -> bool:
     """Whether the response band-passed around one estimate's strongest line is non-Gaussian (kurtosis below
     :data:`KURTOSIS_LIMIT`); ``spectra`` caches each channel's FFT.
@@ -171,14 +184,12 @@ def _band_is_peaky(estimate: PoleEstimate, prepared: Prepared, spectra: dict, re
     holding both beats (kurtosis 2.25). A line farther from a damped pole is not the pole's: a tone beside a
     structural mode does not make the mode a tone. Bands :data:`BAND_STEP` times wider in turn, up to the
     range searched, are judged too (a wandering tone)."""
-    from scipy.fft import rfft
-
     zeta = estimate.damping_ratio if np.isfinite(estimate.damping_ratio) else 0.0
     f = estimate.natural_frequency_hz
-    channel = int(np.argmax(np.abs(estimate.shape) / prepared.scale))  # where it is strongest against the rest
+    channel = _judged_channel(estimate, prepared)
     n = prepared.n_samples
     if channel not in spectra:
-        spectra[channel] = rfft(prepared.channel(channel))
+        spectra[channel] = _channel_spectrum(prepared, channel)
     std_f = estimate.std_frequency_hz if np.isfinite(estimate.std_frequency_hz) else 0.0
     search = max(max(zeta, 0.0) * f, ZERO_DAMPING_SIGMAS * std_f, 2.0 / prepared.duration_s)
     if (nearly_undamped(estimate) or not estimate.damping_known) and resolution_hz:
@@ -195,7 +206,7 @@ def _band_is_peaky(estimate: PoleEstimate, prepared: Prepared, spectra: dict, re
 
 
 def separate_tones(estimates: list[PoleEstimate], prepared: Prepared, rotor_speed_hz: float | None,
-                   resolution_hz: float | None = None):
+                   resolution_hz: float | None = None, workers: int = 1):
     """Which estimates are machine tones; the modes left on a harmonic flagged ``harmonic``, those whose band is
     a sinusoid's though the record cannot tell them from a lightly damped mode flagged ``tone_like``.
 
@@ -203,12 +214,16 @@ def separate_tones(estimates: list[PoleEstimate], prepared: Prepared, rotor_spee
     a pole of nearly zero damping (or unknown damping) is judged on the strongest line within half of it
     on either side. None: on the pole's own band.
 
+    ``workers`` threads transform the channels judged on (a record-long FFT each).
+
     Returns
     -------
     (is_tone, estimates) : (list of bool, list of PoleEstimate)
         The estimates in the same order, those that are not tones with their flags added.
     """
-    spectra: dict = {}  # a record-long FFT per channel judged on, shared by its poles
+    # a record-long FFT per channel judged on, shared by its poles; the channels' on threads in turn
+    judged = sorted({_judged_channel(e, prepared) for e in estimates})
+    spectra = dict(zip(judged, map_over_threads(lambda ch: _channel_spectrum(prepared, ch), judged, workers)))
     peaky = [_band_is_peaky(e, prepared, spectra, resolution_hz) for e in estimates]
 
     def is_peaky(k: int) -> bool:
