@@ -152,12 +152,18 @@ def test_the_embedded_cluster_closes_without_a_traceback(tmp_path):
 def test_the_embedded_cluster_leaves_the_callers_environment_as_it_was(tmp_path):
     """Dask's nannies set their workers' variables (OMP_NUM_THREADS=1, PYTHONHASHSEED, ...) in their
     own process's environment: here the caller's, whose later subprocesses then ran with one BLAS
-    thread and another hash seed (tests/test_determinism.py's digests differed after such a run)."""
+    thread and another hash seed (tests/test_determinism.py's digests differed after such a run).
+    In the workers themselves OMP_NUM_THREADS=1 holds: each worker's computations (modal.oma's shares,
+    modal/parallel.py) use one thread, the cluster already running one file per worker."""
     import os
 
     from modal.batch import fit_files
+    from modal.batch.cluster import open_client
+    from modal.parallel import usable_cores
 
     before = dict(os.environ)
-    result = fit_files(write_inputs(tmp_path / "in", n=1), workers=1)
+    with open_client(workers=1) as client:
+        assert client.submit(usable_cores, pure=False).result() == 1
+        result = fit_files(write_inputs(tmp_path / "in", n=1), client=client)
     assert result.fitted == 1
     assert dict(os.environ) == before
