@@ -60,12 +60,18 @@ def _two_tone_record(fs: float = 400.0, duration_s: float = 70.0):
     return rec.signals + tones[None, :], fs
 
 
-def test_an_undamped_pole_between_two_close_tones_is_judged_on_the_stronger():
+@pytest.fixture(scope="module")
+def two_tones():
+    """The two-tone record prepared over 5-150 Hz, and its rate (Hz)."""
+    signals, fs = _two_tone_record()
+    return prepare(signals, fs, (5.0, 150.0)), fs
+
+
+def test_an_undamped_pole_between_two_close_tones_is_judged_on_the_stronger(two_tones):
     # the correlation lags cannot tell two lines 1.06 Hz apart, and SSI returns one undamped pole between
     # them; over a band holding both the kurtosis is 2.2 (two beating tones), over a band centred on the
     # stronger line it is a sinusoid's 1.5
-    signals, fs = _two_tone_record()
-    prepared = prepare(signals, fs, (5.0, 150.0))
+    prepared, fs = two_tones
     between = _estimate(82.23, 0.0004, 0.0006, 2)
     is_tone, _ = separate_tones([between], prepared, None, resolution_hz=fs / 80)
     assert is_tone == [True]
@@ -74,25 +80,23 @@ def test_an_undamped_pole_between_two_close_tones_is_judged_on_the_stronger():
     assert is_tone == [False]
 
 
-def test_a_damped_pole_between_two_close_tones_is_a_tone_where_the_record_resolves_its_damping():
+def test_a_damped_pole_between_two_close_tones_is_a_tone_where_the_record_resolves_its_damping(two_tones):
     # SSI and EFDD can return the pair as one pole damped by their beat (the shipped record: 0.3-0.5 % at 182 Hz,
     # reported as a mode). A mode of 1 % damping (less 3 σ: 0.7 %) would hold 0.007·2π·82.23·70 = 253 decay
     # times in the 70 s record and be Gaussian; the band around the stronger line within its half-power band is
     # a sinusoid's
-    signals, fs = _two_tone_record()
-    prepared = prepare(signals, fs, (5.0, 150.0))
+    prepared, fs = two_tones
     beat = _estimate(82.23, 0.01, 0.001, 2)
     is_tone, _ = separate_tones([beat], prepared, None, resolution_hz=fs / 80)
     assert is_tone == [True]
 
 
-def test_a_sinusoid_whose_damping_the_record_does_not_resolve_is_flagged_tone_like():
+def test_a_sinusoid_whose_damping_the_record_does_not_resolve_is_flagged_tone_like(two_tones):
     # a pole on the stronger tone with a small damping resolved from zero (0.12 ± 0.03 %) but not from a lightly
     # damped mode's: ζ - 3σ gives 0.0003·2π·81.7·70 = 11 decay times, too few for a random mode to be Gaussian
     # over the band. With no second piece of evidence it stays a mode, flagged; on the comb of a running speed
     # it is a tone
-    signals, fs = _two_tone_record()
-    prepared = prepare(signals, fs, (5.0, 150.0))
+    prepared, fs = two_tones
     pole = _estimate(81.70, 0.0012, 0.0003, 2)
     is_tone, out = separate_tones([pole], prepared, None, resolution_hz=fs / 80)
     assert is_tone == [False] and out[0].flags == {"tone_like"}
