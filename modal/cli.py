@@ -271,13 +271,14 @@ def _report(args) -> int:
         from .io.geometry import read_geometry
 
         geometry = read_geometry(args.geometry)
-    out = write_report(args.archive, args.out, geometry)
+    from .report.content import report_content
+
+    content = report_content(args.archive, geometry)  # read once: the page and the GIF, its warnings given once
+    out = write_report(args.archive, args.out, geometry, content=content)
     print(f"report: {out}", file=sys.stderr)
     if args.gif:
-        from .report.content import report_content
         from .shape_plots import write_gif
 
-        content = report_content(args.archive, geometry)
         available = [(r.method, s) for r, s in zip(content.results, content.shapes) if s is not None]
         if args.method is not None:
             available = [(m, s) for m, s in available if m == args.method]

@@ -204,7 +204,7 @@ def build_report(content: ReportContent) -> str:
             f"<script>{_asset('report.js')}</script></body></html>")
 
 
-def write_report(archive: str | os.PathLike, out: str | os.PathLike, geometry=None) -> Path:
+def write_report(archive: str | os.PathLike, out: str | os.PathLike, geometry=None, content=None) -> Path:
     """Write the HTML report of an archive, crash-safely (temporary file beside ``out``, renamed).
 
     Parameters
@@ -215,6 +215,9 @@ def write_report(archive: str | os.PathLike, out: str | os.PathLike, geometry=No
         The ``.html`` file to write.
     geometry : Geometry or path-like, optional
         Test geometry (a :class:`~modal.geometry.Geometry` or a geometry file); default the archive's own.
+    content : ReportContent, optional
+        The archive's content as :func:`~modal.report.content.report_content` read it with this geometry, when
+        the caller has it already (read once, its warnings given once).
 
     Returns
     -------
@@ -227,7 +230,7 @@ def write_report(archive: str | os.PathLike, out: str | os.PathLike, geometry=No
         from ..io.geometry import read_geometry
 
         geometry = read_geometry(geometry)
-    text = build_report(report_content(archive, geometry))
+    text = build_report(content if content is not None else report_content(archive, geometry))
     with atomic_path(out) as tmp:
         Path(tmp).write_text(text, encoding="utf-8")
     return Path(out)
