@@ -60,6 +60,8 @@ def _table(result, label: str) -> str:
         lines.append(f"{k:>4} {mode.natural_frequency_hz:>10.4f} {mode.std.natural_frequency_hz:>9.4f} "
                      f"{100 * mode.damping_ratio:>9.3f} {100 * mode.std.damping_ratio:>7.3f} {mode.mpc:>5.2f}  "
                      f"{','.join(mode.flags) or '-'}")
+    if not len(result):  # only machine tones: say so rather than print an empty table
+        lines[1] = "no structural mode in the band"
     tones = ", ".join(f"{f:.4f}" for f in result.harmonics_hz) or "none"
     lines.append(f"machine tones [Hz]: {tones}")
     return "\n".join(lines)

@@ -163,3 +163,12 @@ def test_bad_mass_change_and_channels_are_one_error_line(tmp_path, args, message
     path = _write(tmp_path / "ambient.h5", anchor_record(55, noise=0.1, tones=False, duration_s=300))
     done = _run("oma", path, "--band", 1, 30, *[a.format(path=path) for a in args])
     assert done.returncode == 1 and done.stderr.count("\n") == 1 and re.search(message, done.stderr), done.stderr
+
+
+def test_a_record_whose_band_holds_only_a_tone_says_so():
+    """The shipped record over 5-400 Hz with the quick look finds the 182 Hz tone and no structural mode: one line
+    says so, not the table's header over no rows."""
+    done = _run("oma", REAL, "--band", "5", "400", "--method", "fdd")
+    assert done.returncode == 0, done.stderr
+    lines = done.stdout.splitlines()
+    assert lines[1:] == ["no structural mode in the band", lines[2]] and lines[2].startswith("machine tones [Hz]: 18")
