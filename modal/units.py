@@ -7,6 +7,8 @@ import math
 import numpy as np
 
 TWO_PI = 2.0 * math.pi
+#: standard gravity, m/s² (the g of accelerometers' units and of weights)
+STANDARD_GRAVITY_M_S2 = 9.80665
 
 
 def hz_to_rad_s(frequency_hz):

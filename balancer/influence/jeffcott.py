@@ -22,13 +22,12 @@ from __future__ import annotations
 import numpy as np
 
 from modal.errors import ParameterError
-from modal.units import rpm_to_rad_s
+from modal.units import STANDARD_GRAVITY_M_S2, rpm_to_rad_s
 
 from .._checks import non_negative, positive
 
 __all__ = ["jeffcott_influence", "trial_mass_kg", "STANDARD_GRAVITY_M_S2"]
 
-STANDARD_GRAVITY_M_S2 = 9.80665
 
 
 def jeffcott_influence(k: float, c: float, M: float, omega, quantity: str = "displacement") -> np.ndarray:

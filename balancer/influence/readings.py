@@ -24,6 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from modal.errors import ParameterError
+from modal.units import STANDARD_GRAVITY_M_S2
 
 from .._checks import finite_array
 
@@ -38,7 +39,6 @@ __all__ = [
     "mass_angle",
 ]
 
-STANDARD_GRAVITY_M_S2 = 9.80665
 
 
 @dataclass(frozen=True, slots=True)

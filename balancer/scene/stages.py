@@ -13,7 +13,7 @@ import numpy as np
 
 import modal
 from modal.errors import SceneError, warn
-from modal.units import TWO_PI
+from modal.units import STANDARD_GRAVITY_M_S2, TWO_PI
 
 from ..adb import ADBParameters, ParameterStd, identified_std, stable_speed_intervals
 from ..adb.parameters import STD_ORDER, identified_correlation
@@ -589,10 +589,15 @@ MAX_MEAN_PISTON_SPEED_M_S = 30.0
 MIN_MEAN_PISTON_SPEED_M_S = 0.2
 
 
+def _mean_piston_speed_m_s(cfg) -> float:
+    """Mean piston speed of the [compressor] section's crank, m/s: two strokes of twice the radius a turn."""
+    return 4.0 * cfg["crank_radius_m"] * cfg["speed_rpm"] / 60.0
+
+
 def check_compressor(scene: Scene) -> None:
     """A crank whose mean piston speed no machine reaches: a radius in the wrong unit."""
     cfg = scene.section("compressor")
-    piston_speed = 4.0 * cfg["crank_radius_m"] * cfg["speed_rpm"] / 60.0  # mean piston speed: two strokes a turn
+    piston_speed = _mean_piston_speed_m_s(cfg)
     if piston_speed > MAX_MEAN_PISTON_SPEED_M_S:
         raise SceneError(f"{scene.source}: key 'compressor.crank_radius_m' = {cfg['crank_radius_m']:.6g} m at "
                          f"{cfg['speed_rpm']:.6g} rpm moves the piston at {piston_speed:.4g} m/s on average; expected "
@@ -611,8 +616,6 @@ def check_mounts(scene: Scene) -> None:
                          "body's mass: masses in g written as kg?")
 
 
-#: standard gravity (m/s²)
-STANDARD_GRAVITY_M_S2 = 9.80665
 #: largest static sag of the body on its mounts accepted (m): the softest spring isolators (near 0.7 Hz) sag about
 #: half a metre, a compressor's mounts a few millimetres
 MAX_MOUNT_SAG_M = 0.5
@@ -635,7 +638,7 @@ def stage_compressor(scene: Scene) -> CompressorStage:
     from ..compressor.crank import SliderCrank, counterweight_on_curve, optimal_counterweight
 
     cfg = scene.section("compressor")
-    piston_speed = 4.0 * cfg["crank_radius_m"] * cfg["speed_rpm"] / 60.0
+    piston_speed = _mean_piston_speed_m_s(cfg)
     if piston_speed < MIN_MEAN_PISTON_SPEED_M_S:  # (warned here, where the stage's warnings are kept with it)
         warn(f"{scene.source}: key 'compressor.speed_rpm' = {cfg['speed_rpm']:.6g} rpm with crank_radius_m = "
              f"{cfg['crank_radius_m']:.6g} m moves the piston at {piston_speed:.3g} m/s on average, slower than any "

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 from typing import Sequence
 
 from modal.errors import ParameterError
-from modal.units import rad_s_to_rpm
+from modal.units import STANDARD_GRAVITY_M_S2, rad_s_to_rpm
 
 from ..._checks import positive
 from .statics import STEEL_DENSITY_KG_M3, STEEL_YOUNGS_MODULUS_PA, ShaftGeometry, _check_position
@@ -72,8 +72,6 @@ class RotorHandover:
     margin: SpeedMargin
 
 
-#: standard gravity (m/s²)
-STANDARD_GRAVITY_M_S2 = 9.80665
 #: largest bending stress (Pa) the rotor's weight alone may put in the shaft: the strongest shaft steels yield near
 #: 1 GPa, and a running shaft is loaded far below its yield; everyday rotors stress it a few MPa
 MAX_WEIGHT_STRESS_PA = 1e9
