@@ -253,9 +253,14 @@ def find_hits(force, response, sample_rate_hz: float, *, threshold: float | None
     if peak == 0:
         raise ParameterError(f"{source}: field 'excitation' is zero everywhere: no hit to find (is it the force "
                              "channel?)")
-    threshold = trigger_threshold(force) if threshold is None else float(threshold)
     # the trigger counts from the force's median: an amplifier's offset is no hit
-    above = np.abs(force - np.median(force)) > threshold
+    if threshold is None:
+        centre, noise = _centre_and_noise(force)
+        centred = force - centre
+        threshold = _threshold(centred, noise)  # trigger_threshold's, the median taken once
+    else:
+        centred, threshold = force - np.median(force), float(threshold)
+    above = np.abs(centred) > threshold
     merge_gap = max(2, int(round(0.0005 * fs)))
     pulses = _pulses(above, merge_gap)
     if not pulses:

@@ -174,7 +174,8 @@ def _channel_spectrum(prepared: Prepared, channel: int) -> np.ndarray:
 
 def _band_is_peaky(estimate: PoleEstimate, prepared: Prepared, spectra: dict, resolution_hz: float | None) -> bool:
     """Whether the response band-passed around one estimate's strongest line is non-Gaussian (kurtosis below
-    :data:`KURTOSIS_LIMIT`); ``spectra`` caches each channel's FFT.
+    :data:`KURTOSIS_LIMIT`); ``spectra`` holds the FFT of each channel judged on
+    (:func:`_judged_channel`).
 
     The band spans :data:`MIN_BANDWIDTH_TIME` lines around the strongest line of the channel where the pole is
     strongest, looked for within the pole's half-power band ±ζf (or three of its frequency's standard errors, at
@@ -188,8 +189,6 @@ def _band_is_peaky(estimate: PoleEstimate, prepared: Prepared, spectra: dict, re
     f = estimate.natural_frequency_hz
     channel = _judged_channel(estimate, prepared)
     n = prepared.n_samples
-    if channel not in spectra:
-        spectra[channel] = _channel_spectrum(prepared, channel)
     std_f = estimate.std_frequency_hz if np.isfinite(estimate.std_frequency_hz) else 0.0
     search = max(max(zeta, 0.0) * f, ZERO_DAMPING_SIGMAS * std_f, 2.0 / prepared.duration_s)
     if (nearly_undamped(estimate) or not estimate.damping_known) and resolution_hz:

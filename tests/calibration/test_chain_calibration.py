@@ -63,6 +63,18 @@ def test_random_excitation_is_calibrated(quantity, mode):
 MULTI_CHANNEL_RECORDS = 40
 
 
+def _assert_pooled_rms_calibrated(cell: str) -> None:
+    """Every record of the bench_chain cell finds both modes, and the root mean square of z pooled over fn and ζ of
+    both modes (160 values; standard error 1/√320 = 0.056 when calibrated) lies within 0.75-1.25."""
+    from benchmarks.bench_chain import CELLS, z_scores
+
+    scores = z_scores(CELLS[cell], MULTI_CHANNEL_RECORDS)
+    assert np.all(scores["found"] == MULTI_CHANNEL_RECORDS)
+    pooled = np.concatenate([scores["z"][(q, r)] for q in ("fn", "zeta") for r in (0, 1)])
+    rms = float(np.sqrt(np.mean(pooled**2)))
+    assert 0.75 <= rms <= 1.25, rms
+
+
 def test_hammer_with_three_accelerometers_is_calibrated():
     # one force, three accelerometers, three hits: the fit weighs each channel scaled to its peak alike (not by its
     # noise), and a Fisher covariance that assumed otherwise, noise-shaped line weights holding the excitation
@@ -70,13 +82,7 @@ def test_hammer_with_three_accelerometers_is_calibrated():
     # (root mean square over fn and ζ of both modes, 40 records; 1.65 for fn of mode 1). Pooled over the four
     # quantities' 160 z-values (fn and ζ of a resonance fit barely correlate; the modes are apart), the root mean
     # square of calibrated z is 1 with standard error 1/√320 = 0.056: held within 0.75–1.25, 4.5 of those
-    from benchmarks.bench_chain import CELLS, z_scores
-
-    scores = z_scores(CELLS["hammer-exp-3-ch3"], MULTI_CHANNEL_RECORDS)
-    assert np.all(scores["found"] == MULTI_CHANNEL_RECORDS)
-    pooled = np.concatenate([scores["z"][(q, r)] for q in ("fn", "zeta") for r in (0, 1)])
-    rms = float(np.sqrt(np.mean(pooled**2)))
-    assert 0.75 <= rms <= 1.25, rms
+    _assert_pooled_rms_calibrated("hammer-exp-3-ch3")
 
 
 def test_global_method_on_a_hammer_with_exponential_window_is_calibrated():
@@ -85,10 +91,4 @@ def test_global_method_on_a_hammer_with_exponential_window_is_calibrated():
     # accelerance's factor ((iω + 1/τ)/(iω))² as misfit; z of fn and ζ spread 1.5-2.5 over 80 records (root mean
     # square over the four quantities 1.87 on these 40). Pooled as above (160 z-values, standard error of the
     # root mean square 1/√320 = 0.056), held within 0.75-1.25
-    from benchmarks.bench_chain import CELLS, z_scores
-
-    scores = z_scores(CELLS["hammer-exp-6-ch3-global"], MULTI_CHANNEL_RECORDS)
-    assert np.all(scores["found"] == MULTI_CHANNEL_RECORDS)
-    pooled = np.concatenate([scores["z"][(q, r)] for q in ("fn", "zeta") for r in (0, 1)])
-    rms = float(np.sqrt(np.mean(pooled**2)))
-    assert 0.75 <= rms <= 1.25, rms
+    _assert_pooled_rms_calibrated("hammer-exp-6-ch3-global")
