@@ -11,7 +11,8 @@ import pytest
 from modal.operational.inputs import prepare
 from modal.operational.pole import PoleEstimate
 from modal.operational.tones import (HUM_LINE_RATIO, HUM_TOLERANCE, KURTOSIS_LIMIT, MIN_BANDWIDTH_TIME, MIN_DECAYS,
-                                    band_kurtosis, line_ratio, separate_tones, strongest_line_hz)
+                                    _channel_spectrum, band_kurtosis, line_ratio, separate_tones,
+                                    strongest_line_hz)
 from modal.synthetic import ambient_modal_response
 from modal.units import TWO_PI
 from support.ambient import LONE_FN, lone_tone_record
@@ -78,6 +79,22 @@ def test_an_undamped_pole_between_two_close_tones_is_judged_on_the_stronger(two_
     # judged at its own frequency, the band (64 lines, 0.9 Hz) holds neither line's centre: not a tone
     is_tone, _ = separate_tones([between], prepared, None, resolution_hz=None)
     assert is_tone == [False]
+
+
+def test_a_record_of_prime_length_is_judged_on_a_fast_fft_length():
+    # 27 997 samples (a prime): a record-long FFT of that length runs through the slow generic radix (ten times
+    # the time at 10⁶ samples). The tone test transforms the longest stretch whose length has the factors
+    # 2, 3 and 5 only, here 27 648 samples (1.2 % shorter), and still judges the pole between the two tones one
+    signals, fs = _two_tone_record()
+    prepared = prepare(signals[:, :27_997], fs, (5.0, 150.0))
+    spectrum, n = _channel_spectrum(prepared, 0)
+    factors = n
+    for p in (2, 3, 5):
+        while factors % p == 0:
+            factors //= p
+    assert factors == 1 and 0.98 * 27_997 < n <= 27_997 and spectrum.size == n // 2 + 1
+    between = _estimate(82.23, 0.0004, 0.0006, 2)
+    assert separate_tones([between], prepared, None, resolution_hz=fs / 80)[0] == [True]
 
 
 def test_a_damped_pole_between_two_close_tones_is_a_tone_where_the_record_resolves_its_damping(two_tones):
