@@ -96,13 +96,14 @@ def decimation_filter(factor: int) -> np.ndarray:
     return firwin(2 * DECIMATION_HALF_LENGTH * factor + 1, 1.0 / factor, window=("kaiser", DECIMATION_KAISER_BETA))
 
 
-def decimate(signals: np.ndarray, factor: int) -> np.ndarray:
-    """Low-pass filter (:func:`decimation_filter`, linear phase, polyphase) and keep every ``factor``-th sample."""
+def decimate(signals: np.ndarray, factor: int, taps: np.ndarray | None = None) -> np.ndarray:
+    """Low-pass filter (``taps``, by default :func:`decimation_filter`; linear phase, polyphase) and keep every
+    ``factor``-th sample."""
     if factor <= 1:
         return signals
     from scipy.signal import resample_poly
 
-    return resample_poly(signals, 1, factor, axis=1, window=decimation_filter(factor))
+    return resample_poly(signals, 1, factor, axis=1, window=decimation_filter(factor) if taps is None else taps)
 
 
 def _segment_length(max_lag: int, n_samples: int) -> int:

@@ -12,7 +12,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..parallel import split_over_threads
-from .correlations import decimate, decimation_factor
+from .correlations import decimate, decimation_factor, decimation_filter
 from .screen import check_held, check_units, screen_samples
 
 __all__ = ["Prepared", "prepare", "check_band", "channel_statistics"]
@@ -298,15 +298,21 @@ def _refuse_non_finite(signals: np.ndarray, ch: int, src: str, names) -> None:
 def _centred_decimated(signals: np.ndarray, factor: int, src: str, names, workers=None) -> np.ndarray:
     """Each channel less its mean (in double precision), decimated by ``factor``: one channel at a time, so that
     no double-precision copy of the whole record is made (a 10⁶ × 64 record's would be 512 MB); the channels
-    shared among ``workers`` threads."""
+    shared among ``workers`` threads.
+
+    The filter is linear: a channel x less its mean μ decimates to D x − μ D 1, D 1 the decimated record of
+    ones (1 but at the filter's edges, where an offset would ring). So each channel is filtered as it is stored
+    and its mean taken off after, with no centred copy of it made, and the filter is designed once."""
     _check_shape(signals, src)
     n_channels, n = signals.shape
-    out = np.empty((n_channels, -(-n // factor)))  # resample_poly keeps ceil(n / factor) samples
+    taps = decimation_filter(factor)
+    ones = decimate(np.ones((1, n)), factor, taps)[0]  # D 1
+    out = np.empty((n_channels, ones.size))  # resample_poly keeps ceil(n / factor) samples
 
     def decimate_channels(first: int, stop: int) -> None:
         for ch in range(first, stop):
             mean = _finite_mean(signals, ch, src, names)
-            out[ch] = decimate((signals[ch] - mean)[None, :], factor)[0]
+            np.subtract(decimate(signals[ch:ch + 1], factor, taps)[0], mean * ones, out=out[ch])
 
     split_over_threads(decimate_channels, n_channels, workers)
     return out
