@@ -264,6 +264,11 @@ def _frf(args) -> int:
 
 
 def _report(args) -> int:
+    with kept_warnings():  # the page and the GIF place the shapes on the geometry alike: each warning shown once
+        return _write_report(args)
+
+
+def _write_report(args) -> int:
     from .report import write_report
 
     geometry = None
