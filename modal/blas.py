@@ -6,7 +6,9 @@ them spends more time waking its threads and waiting for them than computing: ``
 64 channels took 0.74 s with one thread and 1.09 s (1.86 s of CPU) with two on an idle 2-core machine, and
 8-12 s when other processes held the cores (benchmarks/REPORT.md, operational analysis, run 9).
 :func:`one_blas_thread` limits whichever BLAS numpy and scipy loaded (threadpoolctl finds them) for the call
-only, and gives the caller's setting back after it.
+only, and gives the caller's setting back after it. :func:`modal.identify` runs with it too: its fits (band
+by band, or the global method's) are small products as well; on 48 channels × 4000 lines a BLAS thread per
+core cost 3-6 times the CPU and wall time of one thread on a loaded 2-core machine.
 """
 from __future__ import annotations
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .blas import one_blas_thread
 from .errors import IdentificationError
 from .frf import FRF
 from .frf_units import withhold_physical
@@ -85,6 +86,7 @@ def _auto_choice(frf: FRF, bands_hz, min_prominence_db: float,
 GLOBAL_OPTIONS = ("modes_hz", "order", "max_order", "band_hz", "max_evaluations")
 
 
+@one_blas_thread()
 def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, driving_point=None,
              min_prominence_db: float = 6.0, max_modes: int | None = None, max_evaluations: int | None = None,
              **global_options) -> IdentificationResult:
@@ -130,6 +132,9 @@ def identify(frf: FRF, method: str = "auto", bands_hz=None, *, noise_std=None, d
         (:func:`modal.work_budget.default_max_evaluations`), never reached by ordinary files. Where they run
         out it stops, its modes flagged ``work_capped`` with a warning. ``result.settings`` gives the budget
         and the evaluations used.
+
+    Runs with one BLAS thread (:func:`modal.blas.one_blas_thread`): its fits are many small products, which a
+    BLAS thread per core makes slower (3-6 times the CPU on a 2-core machine, benchmarks/REPORT.md).
 
     Returns
     -------

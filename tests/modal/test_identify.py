@@ -254,3 +254,25 @@ def test_auto_fits_more_peaks_than_the_global_sweep_holds_band_wise_and_says_why
     assert result.method == "nls" and "42 peaks, more than the global method's default sweep holds" in \
         result.settings["method_choice"]
     assert "method_choice" not in ordinary.settings  # a few peaks: nls as always, nothing to explain
+
+
+@pytest.mark.parametrize("method", ["nls", "global"])
+def test_runs_with_one_blas_thread_and_gives_the_callers_setting_back(monkeypatch, method):
+    """identify's fits are many small products, slower with a BLAS thread per core (modal/blas.py): it limits
+    the BLAS to one thread for the call, whatever the caller set, and the caller's setting holds again after."""
+    from threadpoolctl import threadpool_info, threadpool_limits
+
+    seen = []
+    real = np.linalg.solve
+
+    def spy(*args, **kwargs):  # the normal equations every method's refinement solves
+        seen.append({lib["num_threads"] for lib in threadpool_info() if lib["user_api"] == "blas"})
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(np.linalg, "solve", spy)
+    frf = add_noise(modal_frf(np.linspace(5, 60, 800), THREE_FN, THREE_ZETA, THREE_A), 0.01, seed=1)
+    with threadpool_limits(2, user_api="blas"):
+        identify(frf, method=method)
+        after = {lib["num_threads"] for lib in threadpool_info() if lib["user_api"] == "blas"}
+    assert seen and all(threads == {1} for threads in seen)
+    assert after == {2}
