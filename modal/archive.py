@@ -13,7 +13,8 @@ Every node carries ``@__type__`` (``dataclass`` with ``@__class__``, ``ndarray``
 ``float``, ``str``, ``tuple``, ``dict``, ``none``, ``frf``…) so that
 :func:`read_archive` rebuilds the same Python objects; arrays come back bit for
 bit. Nothing is pickled, and only classes of ``modal`` and ``balancer`` are
-rebuilt. Files are written to a temporary file beside the target, closed,
+rebuilt, and a result's numbers are read only with the units they are written with
+(an archive of another tool under the same names, or edited, is refused). Files are written to a temporary file beside the target, closed,
 reopened and checked, then renamed over it.
 """
 from __future__ import annotations
@@ -238,8 +239,55 @@ def _class_from(path: str):
     return obj
 
 
+def _name_unit(name: str) -> str | None:
+    """The unit a field's name says by its suffix (``mass_kg`` → kg), or None (no suffix, or a name whose
+    unit is a convention that a result may override, as ``modal_constant`` in V/V)."""
+    lower = name.lower()
+    if lower in _NAMED_UNITS:
+        return None
+    for suffix, unit in sorted(_UNIT_SUFFIXES, key=lambda item: -len(item[0])):
+        if lower.endswith(suffix):
+            return unit
+    return None
+
+
+def _check_units(group, obj) -> None:
+    """Refuse a dataclass's number stored without the unit :func:`write_node` gives it (the class's
+    ``archive_units()``, else the unit its name's suffix says, as ``kg`` for ``mass_kg``): an archive of another
+    tool under the same names, or one edited by hand, would be read in the wrong unit."""
+    explicit = obj.archive_units() if callable(getattr(obj, "archive_units", None)) else {}
+    for name, node in group.items():
+        if not isinstance(node, h5py.Dataset) or _str_type(node) not in _NUMBER_TYPES:
+            continue
+        expected = explicit.get(name) if isinstance(explicit.get(name), str) else _name_unit(name)
+        if expected is None:
+            continue
+        unit = node.attrs.get("units")
+        unit = unit.decode() if isinstance(unit, bytes) else unit
+        if unit != expected:
+            said = "no units attribute" if unit is None else f"units {str(unit)!r}"
+            raise ArchiveError(f"{node.file.filename}: {node.name} has {said}; expected {expected!r} (an archive of "
+                               "another tool, or edited?): the toolkit reads numbers only in the units it wrote "
+                               "them in")
+
+
+_NUMBER_TYPES = ("int", "float", "complex", "npscalar", "ndarray")
+
+
+def _str_type(node) -> str | None:
+    kind = node.attrs.get("__type__")
+    return kind.decode() if isinstance(kind, bytes) else kind
+
+
 def read_node(node) -> Any:
-    """Rebuild the Python object stored at an HDF5 node by :func:`write_node`."""
+    """Rebuild the Python object stored at an HDF5 node by :func:`write_node`.
+
+    Raises
+    ------
+    ArchiveError
+        A result's number stored with another unit than the one the toolkit writes, or with none
+        (:func:`_check_units`).
+    """
     kind = node.attrs.get("__type__")
     if isinstance(kind, bytes):
         kind = kind.decode()
@@ -253,6 +301,7 @@ def read_node(node) -> Any:
         for f in dataclasses.fields(cls):
             if not f.init and f.name in values:
                 object.__setattr__(obj, f.name, values[f.name])
+        _check_units(node, obj)
         return obj
     if kind == "none":
         return None

@@ -1,0 +1,62 @@
+"""Archives read back: a result's numbers are read only in the units the toolkit wrote them in.
+
+An archive written by another tool under the same group names, or edited by hand (masses in g, frequencies in
+rad/s, no units at all), used to be read as if in SI and reported with exit 0.
+"""
+import subprocess
+import sys
+
+import h5py
+import numpy as np
+import pytest
+
+from modal import identify
+from modal.archive import read_archive, write_archive
+from modal.errors import ArchiveError
+from modal.synthetic import add_noise, modal_frf
+
+
+@pytest.fixture(scope="module")
+def archive(tmp_path_factory):
+    frf = add_noise(modal_frf(np.linspace(10, 400, 801), [50.0, 120.0], [0.01, 0.02], np.array([[1.0, 0.5]]),
+                              response_points=["1"], reference_points="1"), 0.001, seed=3)
+    path = tmp_path_factory.mktemp("archive") / "fit.h5"
+    write_archive(path, {"frf": frf, "identify_nls": identify(frf)})
+    return path
+
+
+def _edited(archive, tmp_path, field, unit):
+    path = tmp_path / "edited.h5"
+    path.write_bytes(archive.read_bytes())
+    with h5py.File(path, "r+") as f:
+        node = f[f"identify_nls/modes/0/{field}"]
+        if unit is None:
+            del node.attrs["units"]
+        else:
+            node.attrs["units"] = unit
+    return path
+
+
+def test_the_toolkits_own_archive_reads_back(archive):
+    assert read_archive(archive)["identify_nls"].modes[0].natural_frequency_hz == pytest.approx(50.0, abs=0.1)
+
+
+@pytest.mark.parametrize("field, unit, said", [
+    ("mass_kg", "g", "has units 'g'; expected 'kg'"),
+    ("natural_frequency_hz", "rad/s", "has units 'rad/s'; expected 'Hz'"),
+    ("std/stiffness_n_per_m", None, "has no units attribute; expected 'N/m'"),
+])
+def test_a_number_in_another_unit_or_none_is_refused_naming_the_field(archive, tmp_path, field, unit, said):
+    path = _edited(archive, tmp_path, field, unit)
+    with pytest.raises(ArchiveError) as err:
+        read_archive(path)
+    assert f"/identify_nls/modes/0/{field} {said}" in str(err.value) and str(path) in str(err.value)
+
+
+def test_modal_report_on_an_archive_in_grams_is_one_line_and_exit_1(archive, tmp_path):
+    path = _edited(archive, tmp_path, "mass_kg", "g")
+    out = subprocess.run([sys.executable, "-m", "modal", "report", str(path), "--out", str(tmp_path / "r.html")],
+                         capture_output=True, text=True, timeout=120)
+    assert out.returncode == 1 and out.stderr.count("\n") == 1 and out.stderr.startswith("error: "), out.stderr
+    assert "mass_kg has units 'g'; expected 'kg'" in out.stderr
+    assert not (tmp_path / "r.html").exists()
