@@ -107,6 +107,15 @@ def _not_swapped(before: IdentificationResult, after: IdentificationResult) -> N
                              "masses and 'after' with them (are the records swapped?)")
 
 
+def _channels(result: IdentificationResult, dm) -> str:
+    """The channels holding masses, by name where the record names them (else by 0-based index)."""
+    names = list(result.settings.get("channel_names") or [])
+    held = np.flatnonzero(dm)
+    if len(names) == dm.size:
+        return "channel(s) " + ", ".join(str(names[i]) for i in held)
+    return "channel index(es) " + ", ".join(map(str, held)) + " (0-based)"
+
+
 def _source(result: IdentificationResult) -> str:
     return str(result.settings.get("source", "<array>"))
 
@@ -144,7 +153,8 @@ def _location_misfit(pairs, dm) -> float:
     shifts alone fit any channel, the shape changes only the right one. ``pairs`` holds (mode, partner, α²,
     φ₀, φ₁) of the modes scaled; returns the RMS over mode pairs of the misfit of the observed bᵣₛ (φ₁,ᵣ
     projected on the φ₀'s, its component on φ₀,ᵣ one) in its errors: the shapes' noise and 20 % of the
-    prediction (the perturbation's truncation). NaN with fewer than two modes, or more modes than channels.
+    prediction (the perturbation's truncation), and the part of φ₁,ᵣ outside the φ₀'s (modes not identified,
+    whose changes leak into the projection). NaN with fewer than two modes, or more modes than channels.
     """
     if len(pairs) < 2 or len(pairs) > pairs[0][3].size:
         return float("nan")
@@ -158,13 +168,15 @@ def _location_misfit(pairs, dm) -> float:
         coef = inverse @ p1
         if coef[r] == 0:
             return float("nan")
+        outside = np.linalg.norm(p1 - basis @ coef) / abs(coef[r])  # the change along modes not identified
         coef = coef / coef[r]
         noise = np.hypot(_shape_std(mode, n), _shape_std(other, n))
         for s in range(len(pairs)):
             if s == r:
                 continue
             predicted = w0[r] ** 2 * alpha2[s] * np.sum(dm * basis[:, s] * p0) / (w0[s] ** 2 - w0[r] ** 2)
-            error = np.hypot(np.linalg.norm(inverse[s] * noise), 0.2 * abs(predicted))
+            error = np.linalg.norm([np.linalg.norm(inverse[s] * noise), 0.2 * abs(predicted),
+                                    np.linalg.norm(inverse[s]) * outside])
             misfits.append((coef[s] - predicted) / error if error > 0 else 0.0)
     return float(np.sqrt(np.mean(np.square(misfits))))
 
@@ -241,8 +253,8 @@ def scale_by_mass_change(before: IdentificationResult, after: IdentificationResu
     if misfit > MAX_LOCATION_MISFIT:
         import warnings
 
-        warnings.warn(f"{_source(after)}: the modes' shape changes disagree with masses at channels "
-                      f"{', '.join(map(str, added_mass_kg))} (misfit {misfit:.3g} of its errors, above "
+        warnings.warn(f"{_source(after)}: the modes' shape changes disagree with masses at {_channels(before, dm)} "
+                      f"(misfit {misfit:.3g} of its errors, above "
                       f"{MAX_LOCATION_MISFIT:g}): were the masses added at other channels? every mode's scaling is "
                       "flagged scaling_uncertain", QualityWarning, stacklevel=2)
         scaled = [(psi, psi_std, cov, True) for psi, psi_std, cov, _ in scaled]

@@ -111,7 +111,7 @@ def test_a_mass_given_at_another_channel_than_where_it_was_added_is_flagged(reco
     with warnings.catch_warnings(record=True) as said:
         warnings.simplefilter("always")
         wrong = modal.scale_by_mass_change(before, after, {0: 0.3})
-    assert any("shape changes disagree with masses at channels 0 (misfit" in str(w.message) for w in said)
+    assert any("shape changes disagree with masses at channel(s) 0 (misfit" in str(w.message) for w in said)
     assert len(wrong) == 4 and all("scaling_uncertain" in m.flags for m in wrong)
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # where it was added: no warning, no flag
