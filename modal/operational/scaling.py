@@ -13,6 +13,8 @@ frequencies, damping and shapes (independent records).
 """
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
 from ..errors import ParameterError, QualityWarning
@@ -251,8 +253,6 @@ def scale_by_mass_change(before: IdentificationResult, after: IdentificationResu
         scaled.append((psi, psi_std, cov, uncertain))
     misfit = _location_misfit(pairs, dm)
     if misfit > MAX_LOCATION_MISFIT:
-        import warnings
-
         warnings.warn(f"{_source(after)}: the modes' shape changes disagree with masses at {_channels(before, dm)} "
                       f"(misfit {misfit:.3g} of its errors, above "
                       f"{MAX_LOCATION_MISFIT:g}): were the masses added at other channels? every mode's scaling is "
