@@ -297,7 +297,16 @@ def read_node(node) -> Any:
         cls = _class_from(str(node.attrs["__class__"]))
         values = {name: read_node(node[name]) for name in node.keys()}
         init = {f.name: values[f.name] for f in dataclasses.fields(cls) if f.init and f.name in values}
-        obj = cls(**init)
+        missing = [f.name for f in dataclasses.fields(cls) if f.init and f.name not in values
+                   and f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING]
+        if missing:
+            raise ArchiveError(f"{node.file.filename}: {node.name} ({cls.__name__}) has no field {', '.join(missing)}; "
+                               "expected every field the toolkit writes (an archive of another tool, or edited?)")
+        try:
+            obj = cls(**init)
+        except (TypeError, ValueError) as exc:
+            raise ArchiveError(f"{node.file.filename}: {node.name} ({cls.__name__}) cannot be rebuilt from its fields "
+                               f"({' '.join(str(exc).split())}); expected an archive written by the toolkit") from None
         for f in dataclasses.fields(cls):
             if not f.init and f.name in values:
                 object.__setattr__(obj, f.name, values[f.name])

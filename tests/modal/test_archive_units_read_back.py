@@ -1,4 +1,5 @@
-"""Archives read back: a result's numbers are read only in the units the toolkit wrote them in.
+"""Archives read back: a result's numbers are read only in the units the toolkit wrote them in, and a result missing
+a field is named.
 
 An archive written by another tool under the same group names, or edited by hand (masses in g, frequencies in
 rad/s, no units at all), used to be read as if in SI and reported with exit 0.
@@ -60,3 +61,15 @@ def test_modal_report_on_an_archive_in_grams_is_one_line_and_exit_1(archive, tmp
     assert out.returncode == 1 and out.stderr.count("\n") == 1 and out.stderr.startswith("error: "), out.stderr
     assert "mass_kg has units 'g'; expected 'kg'" in out.stderr
     assert not (tmp_path / "r.html").exists()
+
+
+def test_a_result_missing_a_field_is_one_line_naming_it(archive, tmp_path):
+    # a group of another tool's (or an edited archive) without mass_kg: modal report ended in a TypeError traceback
+    path = tmp_path / "lacking.h5"
+    path.write_bytes(archive.read_bytes())
+    with h5py.File(path, "r+") as f:
+        del f["identify_nls/modes/0/mass_kg"]
+    out = subprocess.run([sys.executable, "-m", "modal", "report", str(path), "--out", str(tmp_path / "r.html")],
+                         capture_output=True, text=True, timeout=120)
+    assert out.returncode == 1 and out.stderr.count("\n") == 1, out.stderr
+    assert "/identify_nls/modes/0 (ModeResult) has no field mass_kg" in out.stderr
