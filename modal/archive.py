@@ -279,6 +279,17 @@ def _str_type(node) -> str | None:
     return kind.decode() if isinstance(kind, bytes) else kind
 
 
+def _check_number(node, kind: str) -> None:
+    """Refuse a number node whose data is not what its ``__type__`` says: text, or an array for one number."""
+    if not isinstance(node, h5py.Dataset) or node.dtype.kind not in "biufc":
+        what = "a group" if not isinstance(node, h5py.Dataset) else f"data of type {node.dtype}"
+        raise ArchiveError(f"{node.file.filename}: {node.name} holds {what}; expected numbers (an archive of another "
+                           "tool, or edited?)")
+    if kind != "ndarray" and node.shape != ():
+        raise ArchiveError(f"{node.file.filename}: {node.name} holds an array of shape {node.shape}; expected one "
+                           "number (an archive of another tool, or edited?)")
+
+
 def read_node(node) -> Any:
     """Rebuild the Python object stored at an HDF5 node by :func:`write_node`.
 
@@ -316,6 +327,8 @@ def read_node(node) -> Any:
         return None
     if kind in ("bool",):
         return bool(node[()])
+    if kind in ("int", "float", "complex", "ndarray", "npscalar"):
+        _check_number(node, kind)
     if kind in ("int", "float", "complex"):
         return {"int": int, "float": float, "complex": complex}[kind](node[()])
     if kind == "npscalar":

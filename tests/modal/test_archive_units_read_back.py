@@ -4,6 +4,7 @@ a field is named.
 An archive written by another tool under the same group names, or edited by hand (masses in g, frequencies in
 rad/s, no units at all), used to be read as if in SI and reported with exit 0.
 """
+import re
 import subprocess
 import sys
 
@@ -73,3 +74,23 @@ def test_a_result_missing_a_field_is_one_line_naming_it(archive, tmp_path):
                          capture_output=True, text=True, timeout=120)
     assert out.returncode == 1 and out.stderr.count("\n") == 1, out.stderr
     assert "/identify_nls/modes/0 (ModeResult) has no field mass_kg" in out.stderr
+
+
+@pytest.mark.parametrize("data, said", [
+    (np.array([b"1.0", b"2.0"]), "/identify_nls/modes/0/mass_kg holds data of type |S3; expected numbers"),
+    (np.arange(3.0), None),
+])
+def test_a_field_holding_text_or_the_wrong_shape_is_refused(archive, tmp_path, data, said):
+    # masses stored as text were reported as if numbers (exit 0); a frequency stored as an array ended in a
+    # TypeError traceback
+    path = tmp_path / "odd.h5"
+    path.write_bytes(archive.read_bytes())
+    field = "mass_kg" if said else "natural_frequency_hz"
+    with h5py.File(path, "r+") as f:
+        group = f["identify_nls/modes/0"]
+        attrs = dict(group[field].attrs)
+        del group[field]
+        group.create_dataset(field, data=data).attrs.update(attrs)
+    said = said or "/identify_nls/modes/0/natural_frequency_hz holds an array of shape (3,); expected one number"
+    with pytest.raises(ArchiveError, match=re.escape(said)):
+        read_archive(path)
