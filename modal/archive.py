@@ -239,35 +239,37 @@ def _class_from(path: str):
     return obj
 
 
-def _name_unit(name: str) -> str | None:
-    """The unit a field's name says by its suffix (``mass_kg`` → kg), or None (no suffix, or a name whose
-    unit is a convention that a result may override, as ``modal_constant`` in V/V)."""
+def _name_units(name: str) -> tuple[str, ...]:
+    """The units a field's name says by its suffixes (``mass_kg`` → kg), longest suffix first; empty for no
+    suffix, or for a name whose unit is a convention that a result may override (``modal_constant`` in V/V).
+    Every suffix the name ends with counts: the label an earlier version derived from a shorter suffix (``m`` for
+    ``..._kg_per_m``) is one of them, never a unit of another scale (g for ``_kg``)."""
     lower = name.lower()
     if lower in _NAMED_UNITS:
-        return None
-    for suffix, unit in sorted(_UNIT_SUFFIXES, key=lambda item: -len(item[0])):
-        if lower.endswith(suffix):
-            return unit
-    return None
+        return ()
+    return tuple(unit for suffix, unit in sorted(_UNIT_SUFFIXES, key=lambda item: -len(item[0]))
+                 if lower.endswith(suffix))
 
 
 def _check_units(group, obj) -> None:
     """Refuse a dataclass's number stored without the unit :func:`write_node` gives it (the class's
     ``archive_units()``, else the unit its name's suffix says, as ``kg`` for ``mass_kg``): an archive of another
-    tool under the same names, or one edited by hand, would be read in the wrong unit."""
+    tool under the same names, or one edited by hand, would be read in the wrong unit. A field named with a unit
+    suffix must carry it; one whose unit the class gives may carry none (archives of earlier versions)."""
     explicit = obj.archive_units() if callable(getattr(obj, "archive_units", None)) else {}
     for name, node in group.items():
         if not isinstance(node, h5py.Dataset) or _str_type(node) not in _NUMBER_TYPES:
             continue
-        expected = explicit.get(name) if isinstance(explicit.get(name), str) else _name_unit(name)
-        if expected is None:
-            continue
         unit = node.attrs.get("units")
         unit = unit.decode() if isinstance(unit, bytes) else unit
-        if unit != expected:
+        if isinstance(explicit.get(name), str):  # a unit the name cannot say: earlier versions wrote none
+            expected = (explicit[name], *_name_units(name)) if unit is not None else ()
+        else:
+            expected = _name_units(name)
+        if expected and unit not in expected:
             said = "no units attribute" if unit is None else f"units {str(unit)!r}"
-            raise ArchiveError(f"{node.file.filename}: {node.name} has {said}; expected {expected!r} (an archive of "
-                               "another tool, or edited?): the toolkit reads numbers only in the units it wrote "
+            raise ArchiveError(f"{node.file.filename}: {node.name} has {said}; expected {expected[0]!r} (an archive "
+                               "of another tool, or edited?): the toolkit reads numbers only in the units it wrote "
                                "them in")
 
 
