@@ -40,7 +40,7 @@ _COMPRESS_BYTES = 16384  # gzip+shuffle only where it pays: arrays above 16 kB
 
 # longest suffix first
 _UNIT_SUFFIXES = [
-    ("_per_s", "1/s"), ("_per_m", "1/m"),
+    ("_per_s", "1/s"), ("_kg_per_m", "kg/m"), ("_per_m", "1/m"),
     ("_n_s_per_m", "N s/m"), ("_n_m_s", "N m s"), ("_n_per_m", "N/m"), ("_kg_m2", "kg m^2"), ("_kg_m", "kg m"),
     ("_rad_s", "rad/s"), ("_m_s", "m/s"), ("_hz", "Hz"), ("_rpm", "rpm"), ("_kg", "kg"), ("_rad", "rad"),
     ("_deg", "deg"), ("_mm", "mm"), ("_pa", "Pa"), ("_mpa", "MPa"), ("_n_m", "N m"), ("_w", "W"), ("_kw", "kW"),

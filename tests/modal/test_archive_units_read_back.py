@@ -94,3 +94,10 @@ def test_a_field_holding_text_or_the_wrong_shape_is_refused(archive, tmp_path, d
     said = said or "/identify_nls/modes/0/natural_frequency_hz holds an array of shape (3,); expected one number"
     with pytest.raises(ArchiveError, match=re.escape(said)):
         read_archive(path)
+
+
+def test_a_mass_per_length_is_labelled_kg_per_m():
+    from modal.archive import units_of
+
+    # the belt's centrifugal factor (kg/m) was archived as '1/m' (the '_per_m' suffix alone)
+    assert units_of("centrifugal_factor_kg_per_m") == "kg/m" and units_of("stiffness_n_per_m") == "N/m"
