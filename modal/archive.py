@@ -13,7 +13,8 @@ Every node carries ``@__type__`` (``dataclass`` with ``@__class__``, ``ndarray``
 ``float``, ``str``, ``tuple``, ``dict``, ``none``, ``frf``…) so that
 :func:`read_archive` rebuilds the same Python objects; arrays come back bit for
 bit. Nothing is pickled, and only classes of ``modal`` and ``balancer`` are
-rebuilt. Files are written to a temporary file beside the target, closed,
+rebuilt, and a result's numbers are read only with the units they are written with
+(an archive of another tool under the same names, or edited, is refused). Files are written to a temporary file beside the target, closed,
 reopened and checked, then renamed over it.
 """
 from __future__ import annotations
@@ -39,7 +40,7 @@ _COMPRESS_BYTES = 16384  # gzip+shuffle only where it pays: arrays above 16 kB
 
 # longest suffix first
 _UNIT_SUFFIXES = [
-    ("_per_s", "1/s"), ("_per_m", "1/m"),
+    ("_per_s", "1/s"), ("_kg_per_m", "kg/m"), ("_per_m", "1/m"),
     ("_n_s_per_m", "N s/m"), ("_n_m_s", "N m s"), ("_n_per_m", "N/m"), ("_kg_m2", "kg m^2"), ("_kg_m", "kg m"),
     ("_rad_s", "rad/s"), ("_m_s", "m/s"), ("_hz", "Hz"), ("_rpm", "rpm"), ("_kg", "kg"), ("_rad", "rad"),
     ("_deg", "deg"), ("_mm", "mm"), ("_pa", "Pa"), ("_mpa", "MPa"), ("_n_m", "N m"), ("_w", "W"), ("_kw", "kW"),
@@ -238,8 +239,68 @@ def _class_from(path: str):
     return obj
 
 
+def _name_units(name: str) -> tuple[str, ...]:
+    """The units a field's name says by its suffixes (``mass_kg`` → kg), longest suffix first; empty for no
+    suffix, or for a name whose unit is a convention that a result may override (``modal_constant`` in V/V).
+    Every suffix the name ends with counts: the label an earlier version derived from a shorter suffix (``m`` for
+    ``..._kg_per_m``) is one of them, never a unit of another scale (g for ``_kg``)."""
+    lower = name.lower()
+    if lower in _NAMED_UNITS:
+        return ()
+    return tuple(unit for suffix, unit in sorted(_UNIT_SUFFIXES, key=lambda item: -len(item[0]))
+                 if lower.endswith(suffix))
+
+
+def _check_units(group, obj) -> None:
+    """Refuse a dataclass's number stored without the unit :func:`write_node` gives it (the class's
+    ``archive_units()``, else the unit its name's suffix says, as ``kg`` for ``mass_kg``): an archive of another
+    tool under the same names, or one edited by hand, would be read in the wrong unit. A field named with a unit
+    suffix must carry it; one whose unit the class gives may carry none (archives of earlier versions)."""
+    explicit = obj.archive_units() if callable(getattr(obj, "archive_units", None)) else {}
+    for name, node in group.items():
+        if not isinstance(node, h5py.Dataset) or _str_type(node) not in _NUMBER_TYPES:
+            continue
+        unit = node.attrs.get("units")
+        unit = unit.decode() if isinstance(unit, bytes) else unit
+        if isinstance(explicit.get(name), str):  # a unit the name cannot say: earlier versions wrote none
+            expected = (explicit[name], *_name_units(name)) if unit is not None else ()
+        else:
+            expected = _name_units(name)
+        if expected and unit not in expected:
+            said = "no units attribute" if unit is None else f"units {str(unit)!r}"
+            raise ArchiveError(f"{node.file.filename}: {node.name} has {said}; expected {expected[0]!r} (an archive "
+                               "of another tool, or edited?): the toolkit reads numbers only in the units it wrote "
+                               "them in")
+
+
+_NUMBER_TYPES = ("int", "float", "complex", "npscalar", "ndarray")
+
+
+def _str_type(node) -> str | None:
+    kind = node.attrs.get("__type__")
+    return kind.decode() if isinstance(kind, bytes) else kind
+
+
+def _check_number(node, kind: str) -> None:
+    """Refuse a number node whose data is not what its ``__type__`` says: text, or an array for one number."""
+    if not isinstance(node, h5py.Dataset) or node.dtype.kind not in "biufc":
+        what = "a group" if not isinstance(node, h5py.Dataset) else f"data of type {node.dtype}"
+        raise ArchiveError(f"{node.file.filename}: {node.name} holds {what}; expected numbers (an archive of another "
+                           "tool, or edited?)")
+    if kind != "ndarray" and node.shape != ():
+        raise ArchiveError(f"{node.file.filename}: {node.name} holds an array of shape {node.shape}; expected one "
+                           "number (an archive of another tool, or edited?)")
+
+
 def read_node(node) -> Any:
-    """Rebuild the Python object stored at an HDF5 node by :func:`write_node`."""
+    """Rebuild the Python object stored at an HDF5 node by :func:`write_node`.
+
+    Raises
+    ------
+    ArchiveError
+        A result's number stored with another unit than the one the toolkit writes, or with none
+        (:func:`_check_units`).
+    """
     kind = node.attrs.get("__type__")
     if isinstance(kind, bytes):
         kind = kind.decode()
@@ -249,15 +310,27 @@ def read_node(node) -> Any:
         cls = _class_from(str(node.attrs["__class__"]))
         values = {name: read_node(node[name]) for name in node.keys()}
         init = {f.name: values[f.name] for f in dataclasses.fields(cls) if f.init and f.name in values}
-        obj = cls(**init)
+        missing = [f.name for f in dataclasses.fields(cls) if f.init and f.name not in values
+                   and f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING]
+        if missing:
+            raise ArchiveError(f"{node.file.filename}: {node.name} ({cls.__name__}) has no field {', '.join(missing)}; "
+                               "expected every field the toolkit writes (an archive of another tool, or edited?)")
+        try:
+            obj = cls(**init)
+        except (TypeError, ValueError) as exc:
+            raise ArchiveError(f"{node.file.filename}: {node.name} ({cls.__name__}) cannot be rebuilt from its fields "
+                               f"({' '.join(str(exc).split())}); expected an archive written by the toolkit") from None
         for f in dataclasses.fields(cls):
             if not f.init and f.name in values:
                 object.__setattr__(obj, f.name, values[f.name])
+        _check_units(node, obj)
         return obj
     if kind == "none":
         return None
     if kind in ("bool",):
         return bool(node[()])
+    if kind in ("int", "float", "complex", "ndarray", "npscalar"):
+        _check_number(node, kind)
     if kind in ("int", "float", "complex"):
         return {"int": int, "float": float, "complex": complex}[kind](node[()])
     if kind == "npscalar":

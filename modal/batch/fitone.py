@@ -22,8 +22,10 @@ def fit_one(path: str, options: FitOptions, sha256: str | None = None) -> FileFi
     path : str
     options : FitOptions
     sha256 : str, optional
-        The hash the caller computed; the file is hashed again here and that hash is recorded
-        (a file replaced in between is keyed by what was fitted).
+        The hash the caller computed when it found the file; the file is hashed again here, before and
+        after the fit. A file whose bytes differ from the caller's hash, or change during the fit, is
+        still being written (a recorder or a copy not finished) or was replaced: it fails, to be tried
+        again by a rerun, rather than fitting a record cut short.
 
     Returns
     -------
@@ -32,11 +34,31 @@ def fit_one(path: str, options: FitOptions, sha256: str | None = None) -> FileFi
     """
     settings, settings_hash = options.settings_json(), options.settings_hash()
     start = time.perf_counter()
+    found = sha256
     try:
         sha256 = file_sha256(path)
     except OSError as exc:
         return FileFit(source=path, sha256=sha256 or "", settings=settings, settings_hash=settings_hash,
                        error=one_line(exc), retry=True)
+    if found and found != sha256:
+        return _changed(path, sha256, settings, settings_hash, "since the batch found it")
+    fitted = _fit(path, options, sha256, settings, settings_hash, start)
+    try:
+        after = file_sha256(path)
+    except OSError as exc:
+        return FileFit(source=path, sha256=sha256, settings=settings, settings_hash=settings_hash,
+                       error=one_line(exc), retry=True)
+    return fitted if after == sha256 else _changed(path, sha256, settings, settings_hash, "while it was fitted")
+
+
+def _changed(path, sha256, settings, settings_hash, when) -> FileFit:
+    return FileFit(source=path, sha256=sha256, settings=settings, settings_hash=settings_hash, retry=True,
+                   error=f"{path}: its bytes changed {when} (still being written, or replaced?); expected a "
+                         "finished file: run the batch again once it is (the rerun fits it)")
+
+
+def _fit(path: str, options: FitOptions, sha256: str, settings, settings_hash, start) -> FileFit:
+    """The fit of a file of bytes ``sha256`` (see :func:`fit_one`)."""
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:

@@ -13,10 +13,12 @@ frequencies, damping and shapes (independent records).
 """
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
-from ..errors import ParameterError
-from ..flags import MAX_SCALE_ERROR, MIN_SHIFT_SIGMAS
+from ..errors import ParameterError, QualityWarning
+from ..flags import MAX_LOCATION_MISFIT, MAX_SCALE_ERROR, MIN_SHIFT_SIGMAS
 from ..results import IdentificationResult
 from .result import scaled_result
 from .selection import shape_mac
@@ -107,6 +109,15 @@ def _not_swapped(before: IdentificationResult, after: IdentificationResult) -> N
                              "masses and 'after' with them (are the records swapped?)")
 
 
+def _channels(result: IdentificationResult, dm) -> str:
+    """The channels holding masses, by name where the record names them (else by 0-based index)."""
+    names = list(result.settings.get("channel_names") or [])
+    held = np.flatnonzero(dm)
+    if len(names) == dm.size:
+        return "channel(s) " + ", ".join(str(names[i]) for i in held)
+    return "channel index(es) " + ", ".join(map(str, held)) + " (0-based)"
+
+
 def _source(result: IdentificationResult) -> str:
     return str(result.settings.get("source", "<array>"))
 
@@ -134,6 +145,42 @@ def _scale(mode, other, dm):
 def _shape_std(mode, n):
     s = mode.std.mode_shape
     return np.zeros(n) if s is None else np.nan_to_num(np.asarray(s, float))
+
+
+def _location_misfit(pairs, dm) -> float:
+    """How far the modes' shape changes are from what masses ``dm`` at the channels given make them.
+
+    To first order, masses ΔM turn mode r's shape into φ₀,r + Σₛ bᵣₛ φ₀,ₛ with
+    bᵣₛ = ωᵣ² αₛ² (φ₀,ₛᵀ ΔM φ₀,ᵣ) / (ωₛ² − ωᵣ²) (αₛ² the scale of mode s from its own shift): the frequency
+    shifts alone fit any channel, the shape changes only the right one. ``pairs`` holds (mode, partner, α²,
+    φ₀, φ₁) of the modes scaled; returns the RMS over mode pairs of the misfit of the observed bᵣₛ (φ₁,ᵣ
+    projected on the φ₀'s, its component on φ₀,ᵣ one) in its errors: the shapes' noise and 20 % of the
+    prediction (the perturbation's truncation), and the part of φ₁,ᵣ outside the φ₀'s (modes not identified,
+    whose changes leak into the projection). NaN with fewer than two modes, or more modes than channels.
+    """
+    if len(pairs) < 2 or len(pairs) > pairs[0][3].size:
+        return float("nan")
+    basis = np.column_stack([p0 for _, _, _, p0, _ in pairs])
+    inverse = np.linalg.pinv(basis)
+    w0 = np.array([2 * np.pi * mode.natural_frequency_hz for mode, *_ in pairs])
+    alpha2 = np.array([a2 for _, _, a2, _, _ in pairs])
+    n = basis.shape[0]
+    misfits = []
+    for r, (mode, other, _, p0, p1) in enumerate(pairs):
+        coef = inverse @ p1
+        if coef[r] == 0:
+            return float("nan")
+        outside = np.linalg.norm(p1 - basis @ coef) / abs(coef[r])  # the change along modes not identified
+        coef = coef / coef[r]
+        noise = np.hypot(_shape_std(mode, n), _shape_std(other, n))
+        for s in range(len(pairs)):
+            if s == r:
+                continue
+            predicted = w0[r] ** 2 * alpha2[s] * np.sum(dm * basis[:, s] * p0) / (w0[s] ** 2 - w0[r] ** 2)
+            error = np.linalg.norm([np.linalg.norm(inverse[s] * noise), 0.2 * abs(predicted),
+                                    np.linalg.norm(inverse[s]) * outside])
+            misfits.append((coef[s] - predicted) / error if error > 0 else 0.0)
+    return float(np.sqrt(np.mean(np.square(misfits))))
 
 
 def _driving_points(psi, jac_psi, inputs_sd):
@@ -178,7 +225,7 @@ def scale_by_mass_change(before: IdentificationResult, after: IdentificationResu
     _same_channels(before, after)
     dm = _masses(added_mass_kg, before)
     _not_swapped(before, after)
-    scaled = []
+    scaled, pairs = [], []
     for mode in before:
         other = _pair(mode, after)
         if other is None:
@@ -188,6 +235,7 @@ def scale_by_mass_change(before: IdentificationResult, after: IdentificationResu
         if not (np.isfinite(alpha2) and alpha2 > 0):
             scaled.append((None, None, None, True))
             continue
+        pairs.append((mode, other, alpha2, p0, _aligned(p0, np.asarray(other.mode_shape, complex)).real))
         n = p0.size
         var_alpha2 = float(np.sum((grad * sd) ** 2))
         shift_sd = np.hypot(mode.std.natural_frequency_hz, other.std.natural_frequency_hz)
@@ -203,6 +251,13 @@ def scale_by_mass_change(before: IdentificationResult, after: IdentificationResu
         uncertain = (not shift > MIN_SHIFT_SIGMAS * np.nan_to_num(shift_sd)
                      or not np.sqrt(var_alpha2) / alpha2 / 2 <= MAX_SCALE_ERROR)
         scaled.append((psi, psi_std, cov, uncertain))
+    misfit = _location_misfit(pairs, dm)
+    if misfit > MAX_LOCATION_MISFIT:
+        warnings.warn(f"{_source(after)}: the modes' shape changes disagree with masses at {_channels(before, dm)} "
+                      f"(misfit {misfit:.3g} of its errors, above "
+                      f"{MAX_LOCATION_MISFIT:g}): were the masses added at other channels? every mode's scaling is "
+                      "flagged scaling_uncertain", QualityWarning, stacklevel=2)
+        scaled = [(psi, psi_std, cov, True) for psi, psi_std, cov, _ in scaled]
     settings = {**before.settings, "added_mass_kg": {str(k): float(v) for k, v in added_mass_kg.items()},
                 "scaled_by": "mass_change"}
     return scaled_result(before, scaled, settings)

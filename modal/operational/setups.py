@@ -10,9 +10,11 @@ inverse-variance weighted means over the setups that hold the mode.
 """
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
-from ..errors import ParameterError
+from ..errors import ParameterError, QualityWarning
 from ..results import IdentificationResult
 from .result import merged_result
 from .selection import shape_mac
@@ -58,7 +60,8 @@ def _check_references(results, refs) -> None:
     """Refuse a setup whose reference entries disagree with the first setup's in most of the modes both hold.
 
     A mode found at the same frequency in both setups whose reference entries have a MAC below
-    :data:`REF_MAC` is left out of the merge (``missing_in_setup``); when that is so for most modes, the
+    :data:`REF_MAC` is left out of the merge (``missing_in_setup``), with a warning that it was found (the
+    flag alone reads as a mode the setup lacks); when that is so for most modes, the
     references are not the same channels (another order, another sensor, a dead reference, a reference in
     another unit) and the modes that pass do so by chance: the merged shapes would be wrong.
     """
@@ -74,8 +77,14 @@ def _check_references(results, refs) -> None:
             best = max(shape_mac(mode.mode_shape[refs[0]], other.mode_shape[ref]) for other in near)
             if best < REF_MAC:
                 disagree.append(f"{mode.natural_frequency_hz:.4g} Hz (MAC {best:.2f})")
+        src = result.settings.get("source", "<array>")
+        if disagree and not (len(disagree) >= 2 and 2 * len(disagree) > matched):
+            warnings.warn(f"setup {k} ({src}) holds modes at the frequencies of setup 1's {', '.join(disagree)} whose "
+                          f"reference entries {_named(result, ref)} disagree with setup 1's {_named(results[0], refs[0])} "
+                          f"(MAC below {REF_MAC:g}): left out of the merge and flagged missing_in_setup, though found; "
+                          "a reference moved between setups, or near a node of these modes?", QualityWarning,
+                          stacklevel=3)
         if len(disagree) >= 2 and 2 * len(disagree) > matched:
-            src = result.settings.get("source", "<array>")
             raise ParameterError(f"setup {k} ({src}): the reference channels {_named(result, ref)} disagree with setup "
                                  f"1's {_named(results[0], refs[0])} in {len(disagree)} of the {matched} modes both hold: "
                                  f"{', '.join(disagree)}; expected the same reference sensors, in the same order and "

@@ -96,3 +96,24 @@ def test_a_mass_too_small_to_move_the_modes_is_flagged(records):
     with pytest.warns(modal.QualityWarning, match="scaling_uncertain"):
         scaled = modal.scale_by_mass_change(before, small, {0: 0.01})
     assert len(scaled) == 4 and all("scaling_uncertain" in m.flags for m in scaled)
+
+
+def test_a_mass_given_at_another_channel_than_where_it_was_added_is_flagged(records):
+    # 300 g added at channel 3 and given at channel 0: the shifts fit any channel (each mode has its own scale),
+    # so the scaling came out unflagged with psi' M psi of 15.0, 1.42, 0.30, 0.80 (masses 15x off); the modes'
+    # shape changes tell the channel (misfit 8 of its errors given at 0, 1.0 at 3: the limit is 3)
+    M, C, K = chain_matrices(MASSES, SPRINGS, 0.01)
+    _, _, before, _ = records
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        after = modal.oma(ambient_response(M + np.diag([0, 0, 0, 0.3]), C, K, 200.0, 300_000, noise=0.1,
+                                           seed=4).signals, 200.0, band_hz=(1.0, 60.0))
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        wrong = modal.scale_by_mass_change(before, after, {0: 0.3})
+    assert any("shape changes disagree with masses at channel(s) 0 (misfit" in str(w.message) for w in said)
+    assert len(wrong) == 4 and all("scaling_uncertain" in m.flags for m in wrong)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # where it was added: no warning, no flag
+        right = modal.scale_by_mass_change(before, after, {3: 0.3})
+    assert all(abs(m.mode_shape.real @ M @ m.mode_shape.real - 1) < 0.25 for m in right)

@@ -1,6 +1,7 @@
 """Merging setups: roving sensors with shared references."""
 from __future__ import annotations
 
+import re
 import warnings
 
 import numpy as np
@@ -109,3 +110,21 @@ def test_merged_entries_carry_the_scale_factors_error():
     error = np.abs(mode2.mode_shape[5:] - a * true[5:])
     assert error.max() > 0.01 * np.abs(true[5:]).max()  # the case is one of a poorly determined factor
     assert np.all(error < 3 * np.asarray(mode2.std.mode_shape)[5:])  # within three of the stated errors
+
+
+def test_a_mode_left_out_for_its_references_is_said_to_be_found_not_missing():
+    # setup 2's second reference put on channel 2 instead of 5 (a reference moved between setups): the 7.4 Hz mode,
+    # whose entries there have the other sign, is found at its frequency but its reference entries disagree (MAC
+    # 0.5); the merge leaves it out (missing_in_setup), and the flag alone said "not found in every setup"
+    one = anchor_record(52, noise=0.1, tones=False, duration_s=300)
+    two = anchor_record(53, noise=0.1, tones=False, duration_s=300)
+    first, moved = _oma(one.signals[SETUP1]), _oma(two.signals[[0, 2, 4, 6, 7]])
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        merged = modal.merge_setups([first, moved], reference_channels=[0, 1])
+    texts = [str(w.message) for w in said]
+    assert any(re.search(r"setup 2 \(<array>\) holds modes at the frequencies of setup 1's 7\.\d+ Hz \(MAC 0\.\d\d\) "
+                         r"whose reference entries \[0, 1\] disagree .*a reference moved between setups", t)
+               for t in texts), texts
+    mode2 = [m for m in merged if abs(m.natural_frequency_hz / FN[1] - 1) < 0.005]
+    assert len(mode2) == 1 and "missing_in_setup" in mode2[0].flags
