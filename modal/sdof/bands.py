@@ -14,7 +14,8 @@ from ..whitening import LineWhitening
 from ..peaks import ModeBand
 from ..units import TWO_PI
 
-__all__ = ["POLE_CHANNELS", "band_mask", "band_run", "band_lines", "regions", "band_data", "band_influence", "band_peaks",
+__all__ = ["POLE_CHANNELS", "band_mask", "band_run", "band_lines", "regions", "band_data", "band_influence",
+           "band_common_error", "band_peaks",
            "channel_weights", "strongest_channels", "band_noise", "line_weight", "line_whitening",
            "weight_on_lines", "whitening_on_lines",
            "constants_at_poles"]
@@ -216,6 +217,16 @@ def band_influence(frf, bands):
         return None, 0
     keep, _ = regions(bands, frf.frequency_hz)
     return model.record_influence[:, keep], model.overlapping_records
+
+
+def band_common_error(frf, bands):
+    """The factor of the error the channels share relative to their FRF on the bands' lines, (n_factors, n_lines),
+    for a several-channel FRF whose noise model carries it (:mod:`modal.estimate.common_error`); else None."""
+    model = frf.noise_model
+    if model is None or model.common_error is None or frf.n_channels < 2:
+        return None
+    keep, _ = regions(bands, frf.frequency_hz)
+    return model.common_error[:, keep]
 
 
 #: the last whitenings made (the fits of one identification share them), by noise model and lines
