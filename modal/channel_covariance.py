@@ -8,13 +8,13 @@ cost (:func:`channel_sandwich`), and the residual's lag covariance only widens i
 An error every channel shares relative to its FRF (a hammer's force noise, H_o η: one η for every output,
 smooth across the lines) is no independent noise: carried as a factor of η's covariance
 (:mod:`modal.estimate.common_error`), it enters the sandwich's middle as its own term
-(:func:`common_error_terms`, :func:`channel_sandwich`'s ``common``).
+(:func:`relative_error_terms`, :func:`channel_sandwich`'s ``common``).
 """
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["channel_sandwich", "common_error_terms", "common_in_fit_units", "sandwich_product", "widened"]
+__all__ = ["channel_sandwich", "relative_error_terms", "relative_in_fit_units", "sandwich_product", "widened"]
 
 
 def sandwich_product(bread: np.ndarray, middle: np.ndarray) -> np.ndarray:
@@ -48,7 +48,7 @@ def channel_sandwich(bread: np.ndarray, gram: np.ndarray, Cm: np.ndarray, noise_
     unequal ones the Fisher inverse is the covariance of a fit weighing the channels by 1/σ², which this one is
     not (a channel twice as noisy as its scale says counts as much as a quiet one).
 
-    ``common`` (:func:`common_error_terms`): the shared error's scores G and each channel's residual power it
+    ``common`` (:func:`relative_error_terms`): the shared error's scores G and each channel's residual power it
     accounts for; the middle is then 2 Re(G Gᴴ) plus the independent term with each σ² less that power."""
     if common is not None:
         scores, shared_power = common
@@ -59,7 +59,7 @@ def channel_sandwich(bread: np.ndarray, gram: np.ndarray, Cm: np.ndarray, noise_
     return sandwich_product(bread, meat)
 
 
-def common_error_terms(E: np.ndarray, Q: np.ndarray, Cm: np.ndarray, shared: np.ndarray,
+def relative_error_terms(E: np.ndarray, Q: np.ndarray, Cm: np.ndarray, shared: np.ndarray,
                        dof: float) -> tuple[np.ndarray, np.ndarray]:
     """The scores of an error every channel shares, and the residual power it leaves in each channel.
 
@@ -91,14 +91,16 @@ def common_error_terms(E: np.ndarray, Q: np.ndarray, Cm: np.ndarray, shared: np.
     return scores, shared_power
 
 
-def common_in_fit_units(common_error: np.ndarray, response: np.ndarray, inverse_scale: np.ndarray,
+def relative_in_fit_units(relative_error: np.ndarray, response: np.ndarray, inverse_scale: np.ndarray,
                         weight: np.ndarray | None, whitening) -> np.ndarray:
-    """The shared relative error's factor ``common_error`` (n_factors, n_freq; η = Pᵀ ξ) carried into each
-    channel as the fit sees it: H_c η scaled by the channel's ``inverse_scale``, times the line ``weight``
+    """The relative error's factor ``relative_error`` (n_factors, n_freq, one η = Pᵀ ξ for every channel; or
+    (n_ch, n_factors, n_freq), each channel's own over one ξ) carried into each channel as the fit sees it: H_c η scaled by the channel's ``inverse_scale``, times the line ``weight``
     (n_freq, 1) and whitened as the data were; (n_ch, n_freq, n_factors). ``response`` (n_ch, n_freq) stands
     for H (its noise changes the term by its own relative size)."""
     rows = np.atleast_2d(np.asarray(response, complex)) * inverse_scale[:, None]
-    shared = rows[:, :, None] * np.asarray(common_error, complex).T[None, :, :]
+    factor = np.asarray(relative_error, complex)
+    factor = factor.T[None, :, :] if factor.ndim == 2 else factor.transpose(0, 2, 1)  # (1 or n_ch, n_freq, r)
+    shared = rows[:, :, None] * factor
     if weight is not None:
         shared = shared * weight[None, :, :]
     if whitening is not None:

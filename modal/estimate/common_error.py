@@ -18,11 +18,14 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["common_error_factor", "MAX_SUPPORT_ROWS", "FACTOR_TOLERANCE"]
+__all__ = ["common_error_factor", "MAX_SUPPORT_ROWS", "MAX_SUPPORT_FRACTION", "FACTOR_TOLERANCE"]
 
-#: records × window samples at most (a window over the whole record, a continuous estimate's, is no short
-#: support: its excitation noise is left to the line correlation)
-MAX_SUPPORT_ROWS = 4096
+#: records × window samples at most (the factor's Gram matrix is this square: 1024 rows, 20 ms)
+MAX_SUPPORT_ROWS = 1024
+#: the excitation window keeps at most this fraction of a record (a force window's few dozen samples); a window
+#: over the whole record (a hammer test without a force window, a continuous estimate) is no short support: its
+#: excitation noise is left to the line correlation
+MAX_SUPPORT_FRACTION = 1 / 8
 #: singular values of the factor below this fraction of the largest are dropped (their variance is 1e-8 of it)
 FACTOR_TOLERANCE = 1e-4
 
@@ -48,13 +51,14 @@ def common_error_factor(excitation: np.ndarray, starts: np.ndarray, length: int,
     Returns
     -------
     ndarray or None
-        None where the window's support over the records exceeds :data:`MAX_SUPPORT_ROWS` rows, the noise
-        power is not positive, or a line holds no excitation.
+        None where the window's support over the records exceeds :data:`MAX_SUPPORT_ROWS` rows or
+        :data:`MAX_SUPPORT_FRACTION` of a record, the noise power is not positive, or a line holds no excitation.
     """
     window = np.asarray(input_window, float)
     support = np.flatnonzero(window != 0)
     starts = np.asarray(starts, np.int64)
-    if not excitation_noise_power > 0 or support.size * starts.size > MAX_SUPPORT_ROWS or support.size == 0:
+    if (not excitation_noise_power > 0 or support.size * starts.size > MAX_SUPPORT_ROWS or support.size == 0
+            or support.size > MAX_SUPPORT_FRACTION * length):
         return None
     records = np.stack([excitation[s:s + length] for s in starts]) * window  # (n_records, length)
     spectra = np.fft.rfft(records, axis=-1)

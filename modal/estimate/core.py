@@ -183,9 +183,11 @@ def _noise_model(sums, output_correlation, input_window, output_window, sample_r
     excitation's term above, and the model's variance per line, (a + b|H_k|²)/S_xx,k, is the noise level's
     shape (``variance_model``). A hammer test's force noise, over the force window's few dozen samples, is
     nearly the same on every line of a band: at the peaks it is most of the error. Several outputs of one input,
-    more than one record: the variance model is the shape the outputs share (:func:`_shared_variance`), and with
-    ``excitation`` (its samples, the records' starts and length) the error they share, H_o η, is carried as a
-    factor of η's covariance (:func:`~modal.estimate.common_error.common_error_factor`).
+    more than one record: the variance model is the shape the outputs share (:func:`_shared_variance`). With
+    ``excitation`` (its samples, the records' starts and length; a hammer's) the excitation noise's error H_o η
+    (one η for every output) is carried as a factor of η's covariance
+    (:func:`~modal.estimate.common_error.common_error_factor`): nls takes it into several channels' errors, and
+    a roving join of one-output estimates keeps each point's apart from its response noise.
 
     Continuous records (``sums.error_products`` summed): the correlation measured over the records
     (:func:`~modal.estimate.error_correlation.measured_line_correlation`) replaces the window's model.
@@ -225,6 +227,8 @@ def _noise_model(sums, output_correlation, input_window, output_window, sample_r
             response_part = np.where(holds, np.sqrt(a / np.where(holds, total, 1.0)), 1.0)
             input_part = np.where(holds, np.sqrt(b / np.where(holds, total, 1.0)) * h, 0.0)
             variance = np.where(holds, total / power * overlap_factor, np.nan)
+            if excitation is not None:
+                common = common_error_factor(*excitation, input_window, b)
     elif frf is not None and frf.shape[1] == 1 and frf.shape[0] > 1 and sums.n_records > 1:
         variance, excitation_noise = _shared_variance(sums, frf[:, 0], power)
         variance = variance * overlap_factor
@@ -617,7 +621,7 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
                          frf=frf3 if estimator == "H1" else None, quiet=quiet,
                          overlapping=0 if impact else overlapping_records(length, step),
                          withheld=measured and not keep_records and n_in == 1 and n_out == 1,
-                         excitation=(x[0], starts, length) if impact and n_in == 1 and n_out > 1 else None)
+                         excitation=(x[0], starts, length) if impact and n_in == 1 else None)
 
     if not impact and repeats_every([x[i] for i in range(x.shape[0])], length):
         _warn_periods_per_record([x[i] for i in range(x.shape[0])], length, fs, source)

@@ -271,7 +271,7 @@ def test_pole_errors_of_channels_sharing_an_error_match_their_scatter():
         xi = (rng.standard_normal(factor.shape[0]) + 1j * rng.standard_normal(factor.shape[0])) / np.sqrt(2)
         noise = (rng.standard_normal(clean.shape) + 1j * rng.standard_normal(clean.shape)) * sigma[:, None] / np.sqrt(2)
         data = clean * (1 + factor.T @ xi) + noise
-        fit = fit_modes(w, data, 0, [wn], [zeta], common_error=factor)
+        fit = fit_modes(w, data, 0, [wn], [zeta], relative_error=factor)
         estimates.append([fit.omega_n[0], fit.damping_ratio[0]])
         reported.append([fit.mode_cov[0, 0, 0, 0], fit.mode_cov[0, 0, 1, 1]])
         if draw == 0:
