@@ -173,7 +173,7 @@ def _noise_model(sums, output_correlation, input_window, output_window, sample_r
     One input: the errors of lines k and k + m correlate by c_out(m) Σ conj(X_k) X_{k+m} / √(S_xx,k S_xx,k+m)
     (the response noise's window correlation times the excitation's own, over the records), and the lag window
     follows from the excitation's mean square per sample; an exponential window's decay is divided out of it
-    (identification removes that damping exactly). Several inputs: the averages only.
+    (identification removes that damping exactly). Several inputs: the averages and the lag window.
 
     One input and one output with ``frf`` (H1, shape (1, 1, n_lines)) and more than one record: the
     excitation's own noise enters the estimate as −H N_x X*/S_xx, an error in proportion to H that correlates
@@ -203,7 +203,13 @@ def _noise_model(sums, output_correlation, input_window, output_window, sample_r
     dof = max(sums.n_records - n_in, 0) / overlap_factor
     interval = 1.0 / sample_rate_hz
     if sums.sxx_lag is None:
-        return NoiseModel(sums.n_records, dof, None, None, interval)
+        # several inputs: no line correlation; the lag window from the inputs' summed mean square per sample (each
+        # input's estimate is the transform of its impulse response times its own lag window, one for all where the
+        # inputs share one profile: stationary random, bursts in step)
+        lags = lag_window(input_window, output_window, sums.excitation_square / sums.n_records)
+        if decay_s is not None:
+            lags = lags * np.exp(np.arange(lags.size) * interval / decay_s)
+        return NoiseModel(sums.n_records, dof, None, lags, interval)
     power = sums.sxx[0, 0].real
     n_lags, n_lines = sums.sxx_lag.shape
     correlation = np.zeros((n_lags, n_lines), complex)
