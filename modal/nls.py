@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .channel_covariance import channel_sandwich, sandwich_product, widened
+from .channel_covariance import channel_sandwich, relative_error_terms, relative_in_fit_units, sandwich_product, widened
 from .record_variance import misfit_ratio, projected_scores, record_covariance
 from .whitening import LineWhitening
 
@@ -329,7 +329,7 @@ def _project(Phi, Y, y_energy=None):
 
 
 def _fill_covariance(mode_cov, dphi, Q, R, Cm, noise_var, correlated_lags=0, residual=None, region=None,
-                     inverse_scale=None, records=None) -> bool:
+                     inverse_scale=None, records=None, common=None) -> bool:
     """Covariance of (ωn, ζ, Re c, Im c) per mode and channel, in the fit's units, into ``mode_cov``
     (n_modes, n_ch, 4, 4): the poles' from their Fisher information (the Schur complement, by the projected
     Jacobian), the constants' from the linear fit's plus their sensitivity to the poles.
@@ -339,7 +339,7 @@ def _fill_covariance(mode_cov, dphi, Q, R, Cm, noise_var, correlated_lags=0, res
     the Newey–West sandwich F⁻¹ B F⁻¹ instead (see :func:`fit_modes`). ``records`` (one channel: the records'
     influences in the fit's units, (n_freq, n_records), and the records each overlaps): the poles' covariance
     measured over the records where it can be (:func:`modal.record_variance.record_covariance`); returns
-    whether it was."""
+    whether it was. ``common``: an error the channels share (:func:`modal.channel_covariance.relative_error_terms`)."""
     n_theta = dphi.shape[1]
     n_modes = n_theta // 2
     from_records = False
@@ -356,7 +356,9 @@ def _fill_covariance(mode_cov, dphi, Q, R, Cm, noise_var, correlated_lags=0, res
         # several channels: the fit weighs every scaled channel alike, not by its noise, so its poles' covariance
         # is the sandwich of that unweighted cost (equal to F⁻¹ where the channels' noise is equal)
         bread = _pole_covariance(2 * np.real(gram * (Cm.conj() @ Cm.T))) if several else None
-        cov_theta = channel_sandwich(bread, gram, Cm, noise_var) if several else _pole_covariance(F)
+        shared = None if common is None else relative_error_terms(
+            E, Q, Cm, common, dphi.shape[0] - Q.shape[1] - n_theta / (2 * Cm.shape[1]))
+        cov_theta = channel_sandwich(bread, gram, Cm, noise_var, shared) if several else _pole_covariance(F)
         measured = None
         if records is not None and np.all(np.isfinite(cov_theta)):
             measured = record_covariance(np.real((E.conj().T @ E) * (Cm.conj() @ Cm.T)),
@@ -409,7 +411,8 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
               max_damping: float | None = None, errors: bool = True,
               whitening: LineWhitening | None = None, correlated_lags: int = 0,
               decrement_tol: float = 0.0, max_evaluations: int | None = None,
-              record_influence: np.ndarray | None = None, overlapping_records: int = 0) -> NLSFit:
+              record_influence: np.ndarray | None = None, overlapping_records: int = 0,
+              relative_error: np.ndarray | None = None) -> NLSFit:
     """Fit poles and modal constants of several modes to many channels at once.
 
     Parameters
@@ -483,6 +486,9 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
         can be, in place of the one above.
     overlapping_records : int
         See ``record_influence``.
+    relative_error : ndarray, shape (n_factors, n_freq), complex, optional
+        Several channels: an error they share relative to their FRF (:mod:`modal.estimate.common_error`), in
+        the poles' covariance with the channels' own noise (:func:`modal.channel_covariance.channel_sandwich`).
     """
     omega = np.asarray(omega, float)
     rows = np.ascontiguousarray(np.atleast_2d(np.asarray(response, complex)))  # (n_ch, n_freq), the FRF's unit
@@ -667,8 +673,10 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
             influence = np.asarray(record_influence, complex).T * inverse_scale[0]
             influence = influence if weight is None else influence * weight
             records = (influence if whitening is None else whitening(influence), overlapping_records)
+        common = None if relative_error is None or n_ch == 1 else relative_in_fit_units(
+            relative_error, response, inverse_scale, weight, whitening)
         record_errors = _fill_covariance(mode_cov, dphi, Q, R, Cm, noise_var, correlated_lags, residual, region,
-                                         inverse_scale, records)
+                                         inverse_scale, records, common)
     # back to physical units: x → ω = x w_ref; c → A = c · ch_scale · w_ref^(2−p)
     a_scale = ch_scale * w_ref ** (2 - power)  # (n_ch,)
     unit = np.empty((n_ch, 4))  # each channel's (ωn, ζ, Re A, Im A) per fitted unit

@@ -86,6 +86,12 @@ class NoiseModel:
     influence_withheld : bool
         The records' influences would have been kept but exceed the memory budget
         (:data:`MAX_INFLUENCE_VALUES`).
+    relative_error : ndarray, shape (n_factors, n_freq) or (n_channels, n_factors, n_freq), complex, or None
+        A short excitation window (a hammer's): the excitation noise's error, H_o η with η relative
+        (dimensionless, whatever the FRF's kind), as a factor P of its covariance, η = Pᵀ ξ with ξ standard
+        complex: E[η_k η*_l] = Σ_r P_rk conj(P_rl) (:mod:`modal.estimate.common_error`). 2-D: one η for every
+        output; 3-D: each channel's own factor over one ξ (a joined estimate: channels from independent
+        records take disjoint factors, :mod:`modal.roving`). None otherwise.
     """
 
     averages: int
@@ -97,6 +103,7 @@ class NoiseModel:
     record_influence: np.ndarray | None = None
     overlapping_records: int = 0
     influence_withheld: bool = False
+    relative_error: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         if self.line_correlation is not None:
@@ -126,6 +133,13 @@ class NoiseModel:
                 raise FRFValidationError("field 'record_influence' must be a finite 2-D array (records × lines)")
             influence.setflags(write=False)
             object.__setattr__(self, "record_influence", influence)
+        if self.relative_error is not None:
+            common = np.array(self.relative_error, dtype=complex)
+            if common.ndim not in (2, 3) or not np.all(np.isfinite(common)):
+                raise FRFValidationError("field 'relative_error' must be a finite array of factors × lines "
+                                         "(or channels × factors × lines)")
+            common.setflags(write=False)
+            object.__setattr__(self, "relative_error", common)
         if not (isinstance(self.overlapping_records, (int, np.integer)) and self.overlapping_records >= 0):
             raise FRFValidationError(f"field 'overlapping_records' is {self.overlapping_records!r}; "
                                      "expected an integer >= 0")
@@ -153,15 +167,18 @@ class NoiseModel:
         """
         variance = None if self.variance_model is None else self.variance_model[keep]
         influence = None if self.record_influence is None else self.record_influence[:, keep]
+        common = None if self.relative_error is None else self.relative_error[..., keep]
         if self.line_correlation is None:
-            return replace(self, variance_model=variance, record_influence=influence)
+            return replace(self, variance_model=variance, record_influence=influence, relative_error=common)
         lines = np.flatnonzero(keep)
         if lines.size and np.any(np.diff(lines) != 1):
-            return replace(self, line_correlation=None, variance_model=variance, record_influence=influence)
+            return replace(self, line_correlation=None, variance_model=variance, record_influence=influence,
+                           relative_error=common)
         corr = self.line_correlation[:, keep].copy()
         for m in range(1, corr.shape[0] + 1):  # the last m lines have no neighbour m lines on
             corr[m - 1, max(corr.shape[1] - m, 0):] = 0
-        return replace(self, line_correlation=corr, variance_model=variance, record_influence=influence)
+        return replace(self, line_correlation=corr, variance_model=variance, record_influence=influence,
+                       relative_error=common)
 
     def scaled(self, factor: np.ndarray, frf_factor: np.ndarray | None = None) -> "NoiseModel":
         """The model of the FRF times a factor per line whose phase is the same on every line (a change of

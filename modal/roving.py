@@ -164,7 +164,8 @@ def join_estimates(estimates: Sequence[EstimatedFRF], point_sources,
         values = [getattr(e, name) for e in estimates]
         return None if any(v is None for v in values) else tuple(i for v in values for i in v)
 
-    model, dropped = _joined_noise_model([e.noise_model for e in estimates])
+    model, dropped = _joined_noise_model([e.noise_model for e in estimates],
+                                         [np.atleast_2d(e.response) for e in estimates])
     rejected = [dict(item, take_name=item.get("take_name", e.source)) for e in estimates for item in e.rejected]
     overloads = [dict(item, channel=f"{e.source}: {item['channel']}") for e in estimates for item in e.overloads]
     points = ", ".join(f"{point} ({', '.join(files)})" for point, files in point_sources)
@@ -183,8 +184,14 @@ def join_estimates(estimates: Sequence[EstimatedFRF], point_sources,
         point_sources=tuple((p, tuple(f)) for p, f in point_sources), join_note=note)
 
 
-def _joined_noise_model(models) -> tuple[NoiseModel | None, list[str]]:
-    """The noise model the estimates share, and a sentence for each part dropped (why)."""
+def _joined_noise_model(models, responses) -> tuple[NoiseModel | None, list[str]]:
+    """The noise model the estimates share, and a sentence for each part dropped (why).
+
+    Where every estimate carries its excitation noise's error apart (``relative_error``, a hammer's), the points'
+    response noise is what they share (one window, one kind of accelerometer noise): its line correlation and
+    variance are joined as the outputs of one file share theirs, and each point's excitation noise is carried as
+    its channels' own (:func:`_response_part`, :func:`_joined_relative_error`), independent of the other points'.
+    """
     if any(m is None for m in models):
         return None, ["no noise model (not every point's estimate has one)"] if any(models) else []
     first, dropped = models[0], []
@@ -202,9 +209,11 @@ def _joined_noise_model(models) -> tuple[NoiseModel | None, list[str]]:
                            "the window's bias is not taken out")
         else:
             lag = np.mean(lags, axis=0)
+    relative = _joined_relative_error(models, responses)
+    parts = [_response_part(m, h) for m, h in zip(models, responses)] if relative is not None else None
     correlation = None
     if all(m.line_correlation is not None for m in models):
-        corrs = [m.line_correlation for m in models]
+        corrs = [m.line_correlation for m in models] if parts is None else [p[1] for p in parts]
         spread = _spread(corrs)
         if spread is not None and spread <= CORRELATION_TOLERANCE:
             correlation = np.mean(corrs, axis=0)
@@ -215,14 +224,66 @@ def _joined_noise_model(models) -> tuple[NoiseModel | None, list[str]]:
     variance = None
     if all(m.variance_model is not None for m in models):
         # the line weights use the channels' mean variance: the models' mean is its shape
-        variance = np.mean([m.variance_model for m in models], axis=0)
+        variance = np.mean([m.variance_model for m in models] if parts is None else [p[0] for p in parts], axis=0)
     if any(m.record_influence is not None for m in models):
         dropped.append("each point's records' influences describe its own channel only: the errors of the joint "
                        "fit come from the lines")
     joined = NoiseModel(averages=min(m.averages for m in models),
                         degrees_of_freedom=min(m.degrees_of_freedom for m in models), line_correlation=correlation,
-                        lag_window=lag, sample_interval_s=first.sample_interval_s, variance_model=variance)
+                        lag_window=lag, sample_interval_s=first.sample_interval_s, variance_model=variance,
+                        relative_error=relative)
     return joined, dropped
+
+
+#: channels × factors × lines of a joined relative error at most (64 MiB); above, none is carried
+MAX_RELATIVE_VALUES = 1 << 22
+
+
+def _joined_relative_error(models, responses) -> np.ndarray | None:
+    """Each joined channel's excitation-noise factor over one ξ, (n_channels, n_factors, n_lines): a point's
+    factor in its own block of factors (the points' records are independent), zero in the others'; None unless
+    every point carries one (and a variance model and line correlation), or above :data:`MAX_RELATIVE_VALUES`."""
+    if any(m.relative_error is None or m.relative_error.ndim != 2 or m.variance_model is None
+           or m.line_correlation is None for m in models):
+        return None
+    n_factors = sum(m.relative_error.shape[0] for m in models)
+    n_channels = sum(h.shape[0] for h in responses)
+    n_lines = models[0].relative_error.shape[1]
+    if n_channels * n_factors * n_lines > MAX_RELATIVE_VALUES:
+        return None
+    out = np.zeros((n_channels, n_factors, n_lines), complex)
+    channel = factor = 0
+    for model, response in zip(models, responses):
+        rows = model.relative_error.shape[0]
+        out[channel:channel + response.shape[0], factor:factor + rows] = model.relative_error
+        channel, factor = channel + response.shape[0], factor + rows
+    return out
+
+
+def _response_part(model, response) -> tuple[np.ndarray, np.ndarray]:
+    """The response noise's share of a point's variance model and line correlation.
+
+    Several outputs: the estimate carries only that already (its excitation noise is ``relative_error``). One
+    output: its model mixes both, variance (a + b|H|²)/S_xx and covariance of lines k, k + m
+    ρ_m,k σ_k σ_k+m, of which the excitation noise's is H_k conj(H_k+m) Σ_r P_rk conj(P_r,k+m); what is left
+    is the response noise's (on lines where the mixed model does not hold, NaN variance, the correlation is
+    the response noise's already; a variance left not positive is NaN, which line weights take as unknown)."""
+    if response.shape[0] > 1:
+        return model.variance_model, model.line_correlation
+    h, factor, total = response[0], model.relative_error, model.variance_model
+    with np.errstate(invalid="ignore", divide="ignore"):
+        own = total - np.abs(h) ** 2 * np.sum(np.abs(factor) ** 2, axis=0)
+        own = np.where(own > 0, own, np.nan)
+        corr = np.array(model.line_correlation, complex)
+        for m in range(1, corr.shape[0] + 1):
+            mixed = corr[m - 1, :-m] * np.sqrt(total[:-m] * total[m:])
+            excitation = h[:-m] * np.conj(h[m:]) * np.sum(factor[:, :-m] * np.conj(factor[:, m:]), axis=0)
+            value = (mixed - excitation) / np.sqrt(own[:-m] * own[m:])
+            held = np.isfinite(total[:-m]) & np.isfinite(total[m:])
+            corr[m - 1, :-m] = np.where(held, np.where(np.isfinite(value), value, 0.0), corr[m - 1, :-m])
+    magnitude = np.abs(corr)
+    corr = np.where(magnitude > 1, corr / np.maximum(magnitude, 1e-300), corr)
+    return own, corr
 
 
 def _spread(arrays) -> float | None:

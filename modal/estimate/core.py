@@ -26,6 +26,7 @@ from ..noise_model import (INPUT_NOISE_LIMIT, NoiseModel, input_noise_split, lag
 from ..validate import finite_samples, one_of, per_line, positive_number
 from . import spectra
 from .excitation_noise import EXCITATION_NOISE_LIMIT, excitation_noise_share
+from .common_error import common_error_factor
 from .error_correlation import LEAKAGE_LAGS, MIN_RECORDS, measured_line_correlation
 from .record_influence import MAX_INFLUENCE_VALUES, overlapping_records, record_influence
 from .hits import find_hits, pulse_train
@@ -166,13 +167,13 @@ def _as_signals(value, name: str, source: str):
 
 
 def _noise_model(sums, output_correlation, input_window, output_window, sample_rate_hz, overlap_factor,
-                 decay_s=None, frf=None, quiet=None, overlapping=0, withheld=False) -> NoiseModel:
+                 decay_s=None, frf=None, quiet=None, overlapping=0, withheld=False, excitation=None) -> NoiseModel:
     """The estimate's :class:`~modal.noise_model.NoiseModel` from its sums and windows.
 
     One input: the errors of lines k and k + m correlate by c_out(m) Σ conj(X_k) X_{k+m} / √(S_xx,k S_xx,k+m)
     (the response noise's window correlation times the excitation's own, over the records), and the lag window
     follows from the excitation's mean square per sample; an exponential window's decay is divided out of it
-    (identification removes that damping exactly). Several inputs: the averages only.
+    (identification removes that damping exactly). Several inputs: the averages and the lag window.
 
     One input and one output with ``frf`` (H1, shape (1, 1, n_lines)) and more than one record: the
     excitation's own noise enters the estimate as −H N_x X*/S_xx, an error in proportion to H that correlates
@@ -182,7 +183,11 @@ def _noise_model(sums, output_correlation, input_window, output_window, sample_r
     excitation's term above, and the model's variance per line, (a + b|H_k|²)/S_xx,k, is the noise level's
     shape (``variance_model``). A hammer test's force noise, over the force window's few dozen samples, is
     nearly the same on every line of a band: at the peaks it is most of the error. Several outputs of one input,
-    more than one record: the variance model is the shape the outputs share (:func:`_shared_variance`).
+    more than one record: the variance model is the shape the outputs share (:func:`_shared_variance`). With
+    ``excitation`` (its samples, the records' starts and length; a hammer's) the excitation noise's error H_o η
+    (one η for every output) is carried as a factor of η's covariance
+    (:func:`~modal.estimate.common_error.common_error_factor`): nls takes it into several channels' errors, and
+    a roving join of one-output estimates keeps each point's apart from its response noise.
 
     Continuous records (``sums.error_products`` summed): the correlation measured over the records
     (:func:`~modal.estimate.error_correlation.measured_line_correlation`) replaces the window's model.
@@ -198,11 +203,17 @@ def _noise_model(sums, output_correlation, input_window, output_window, sample_r
     dof = max(sums.n_records - n_in, 0) / overlap_factor
     interval = 1.0 / sample_rate_hz
     if sums.sxx_lag is None:
-        return NoiseModel(sums.n_records, dof, None, None, interval)
+        # several inputs: no line correlation; the lag window from the inputs' summed mean square per sample (each
+        # input's estimate is the transform of its impulse response times its own lag window, one for all where the
+        # inputs share one profile: stationary random, bursts in step)
+        lags = lag_window(input_window, output_window, sums.excitation_square / sums.n_records)
+        if decay_s is not None:
+            lags = lags * np.exp(np.arange(lags.size) * interval / decay_s)
+        return NoiseModel(sums.n_records, dof, None, lags, interval)
     power = sums.sxx[0, 0].real
     n_lags, n_lines = sums.sxx_lag.shape
     correlation = np.zeros((n_lags, n_lines), complex)
-    response_part, input_part, variance = np.ones(n_lines), np.zeros(n_lines, complex), None
+    response_part, input_part, variance, common = np.ones(n_lines), np.zeros(n_lines, complex), None, None
     one_record = quiet is not None and sums.n_records == 1
     if frf is not None and frf.shape[:2] == (1, 1) and (sums.n_records > 1 or one_record):
         h = frf[0, 0]
@@ -222,8 +233,13 @@ def _noise_model(sums, output_correlation, input_window, output_window, sample_r
             response_part = np.where(holds, np.sqrt(a / np.where(holds, total, 1.0)), 1.0)
             input_part = np.where(holds, np.sqrt(b / np.where(holds, total, 1.0)) * h, 0.0)
             variance = np.where(holds, total / power * overlap_factor, np.nan)
+            if excitation is not None:
+                common = common_error_factor(*excitation, input_window, b)
     elif frf is not None and frf.shape[1] == 1 and frf.shape[0] > 1 and sums.n_records > 1:
-        variance = _shared_variance(sums, frf[:, 0], power) * overlap_factor
+        variance, excitation_noise = _shared_variance(sums, frf[:, 0], power)
+        variance = variance * overlap_factor
+        if excitation is not None:
+            common = common_error_factor(*excitation, input_window, excitation_noise)
     input_correlation = window_line_correlation(input_window)
     for m in range(1, n_lags + 1):
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -246,26 +262,26 @@ def _noise_model(sums, output_correlation, input_window, output_window, sample_r
     if sums.record_cross is not None and frf is not None and frf.shape[:2] == (1, 1):
         influence = record_influence(sums.record_cross, sums.record_power, frf[0, 0], power)
     return NoiseModel(sums.n_records, dof, correlation, lags, interval, variance, influence,
-                      overlapping if influence is not None else 0, withheld)
+                      overlapping if influence is not None else 0, withheld, common)
 
 
-def _shared_variance(sums, frf: np.ndarray, power: np.ndarray) -> np.ndarray:
+def _shared_variance(sums, frf: np.ndarray, power: np.ndarray) -> tuple[np.ndarray, float]:
     """Several outputs of one input: the part of each line's error variance whose shape every channel shares,
-    a/S_xx with a the outputs' mean response-noise power (:func:`~modal.noise_model.input_noise_split` of each
+    a/S_xx with a the outputs' mean response-noise power, and the excitation noise's power b (their mean) (:func:`~modal.noise_model.input_noise_split` of each
     output's residual; NaN on lines where an output's excitation-noise part does not hold). The excitation's noise
     enters output o as H_o times one common error, a different shape in every channel and, over the few samples
     a force window keeps, nearly one complex gain across a mode's band, which its modal constants take up."""
     n_out = frf.shape[0]
-    a = np.zeros(n_out)
+    a, b_out = np.zeros(n_out), np.zeros(n_out)
     holds = np.ones(power.size, bool)
     with np.errstate(divide="ignore", invalid="ignore"):
         for o in range(n_out):
             residual = (sums.syy[o] - np.abs(sums.syx[o, 0]) ** 2 / power) / (sums.n_records - 1)
             h2 = np.abs(frf[o]) ** 2
             _, b = input_noise_split(residual, h2)
-            a[o], b = input_noise_split(residual, h2, b * sums.n_records < INPUT_NOISE_LIMIT * power)
-            holds &= b * sums.n_records < INPUT_NOISE_LIMIT * power
-        return np.where(holds & (power > 0), np.mean(a) / power, np.nan)
+            a[o], b_out[o] = input_noise_split(residual, h2, b * sums.n_records < INPUT_NOISE_LIMIT * power)
+            holds &= b_out[o] * sums.n_records < INPUT_NOISE_LIMIT * power
+        return np.where(holds & (power > 0), np.mean(a) / power, np.nan), float(np.mean(b_out))
 
 
 def _warn_periods_per_record(excitation, length: int, sample_rate_hz: float, source: str) -> None:
@@ -610,7 +626,8 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
     model = _noise_model(sums, output_correlation, in_w, out_w, fs, factor, decay_s=exponential_decay_s,
                          frf=frf3 if estimator == "H1" else None, quiet=quiet,
                          overlapping=0 if impact else overlapping_records(length, step),
-                         withheld=measured and not keep_records and n_in == 1 and n_out == 1)
+                         withheld=measured and not keep_records and n_in == 1 and n_out == 1,
+                         excitation=(x[0], starts, length) if impact and n_in == 1 else None)
 
     if not impact and repeats_every([x[i] for i in range(x.shape[0])], length):
         _warn_periods_per_record([x[i] for i in range(x.shape[0])], length, fs, source)

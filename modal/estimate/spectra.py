@@ -39,7 +39,7 @@ class SpectralSums:
     sxx_lag : ndarray, shape (n_lags, n_lines), optional
         One input: ``Σ conj(X_k) X_{k+m}`` for m = 1 … n_lags (zero past the last line).
     excitation_square : ndarray, shape (length,), optional
-        One input: Σ x[n]² over the records at each sample n of a record (unwindowed).
+        Σ x[n]² over the records at each sample n of a record (unwindowed); several inputs: summed over them.
     error_products : ndarray, shape (4, n_lags + 1, n_lines), optional
         One input and one output: with p = Y conj(X) and q = |X|² per record and line, the sums over the
         records of p_k conj(p_{k+m}), p_k q_{k+m}, q_k conj(p_{k+m}) and q_k q_{k+m} for m = 0 … n_lags
@@ -100,7 +100,7 @@ def accumulate(excitation, response, starts, length: int, input_window: np.ndarr
     syy = np.zeros((n_out, n_lines))
     one_input = n_in == 1
     sxx_lag = np.zeros((lags, n_lines), complex) if one_input else None
-    square = np.zeros(length) if one_input else None
+    square = np.zeros(length)
     error_lags = min(error_lags, n_lines - 1) if one_input and n_out == 1 else 0
     products = np.zeros((4, error_lags + 1, n_lines), complex) if error_lags > 0 else None
     keep_records = keep_records and one_input and n_out == 1
@@ -121,6 +121,8 @@ def accumulate(excitation, response, starts, length: int, input_window: np.ndarr
             square += np.einsum("sn,sn->n", raw[0], raw[0])
             for m in range(1, min(lags, n_lines - 1) + 1):
                 sxx_lag[m - 1, :-m] += np.einsum("sf,sf->f", xc[0, :, :-m], x[0, :, m:])
+        else:
+            square += np.einsum("isn,isn->n", raw, raw)
         if products is not None or keep_records:
             cross, power = y[0] * xc[0], (x[0] * xc[0]).real
             if products is not None:

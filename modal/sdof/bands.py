@@ -14,7 +14,8 @@ from ..whitening import LineWhitening
 from ..peaks import ModeBand
 from ..units import TWO_PI
 
-__all__ = ["POLE_CHANNELS", "band_mask", "band_run", "band_lines", "regions", "band_data", "band_influence", "band_peaks",
+__all__ = ["POLE_CHANNELS", "band_mask", "band_run", "band_lines", "regions", "band_data", "band_influence",
+           "band_relative_error", "band_peaks",
            "channel_weights", "strongest_channels", "band_noise", "line_weight", "line_whitening",
            "weight_on_lines", "whitening_on_lines",
            "constants_at_poles"]
@@ -216,6 +217,19 @@ def band_influence(frf, bands):
         return None, 0
     keep, _ = regions(bands, frf.frequency_hz)
     return model.record_influence[:, keep], model.overlapping_records
+
+
+def band_relative_error(frf, bands, channels=None):
+    """The factor of the channels' errors relative to their FRF (the excitation noise's) on the bands' lines,
+    (n_factors, n_lines) or, per channel, (n_channels, n_factors, n_lines) of the ``channels`` fitted, for a
+    several-channel FRF whose noise model carries it (:class:`~modal.noise_model.NoiseModel`'s
+    ``relative_error``); else None."""
+    model = frf.noise_model
+    if model is None or model.relative_error is None or frf.n_channels < 2:
+        return None
+    keep, _ = regions(bands, frf.frequency_hz)
+    factor = model.relative_error[..., keep]
+    return factor if factor.ndim == 2 or channels is None else factor[channels]
 
 
 #: the last whitenings made (the fits of one identification share them), by noise model and lines

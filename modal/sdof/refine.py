@@ -15,7 +15,7 @@ from ..leakage import bias_matters, window_bias
 from ..nls import fit_modes, truncation_shift
 from ..units import TWO_PI
 from . import starts
-from .bands import band_data, band_influence, line_weight, line_whitening
+from .bands import band_data, band_influence, band_relative_error, line_weight, line_whitening
 from .checks import residual_structure, restart_pole
 
 __all__ = ["STRUCTURED_RATIO", "doubtful", "nls_fit", "fit_cost", "fit_bands", "truncation", "with_shift",
@@ -100,11 +100,12 @@ def fit_bands(frf, bands, power, omega_n0, damping_ratio0, channels=None, data=N
     whitening = line_whitening(frf, bands)
     lags = correlated_lags(frf, omega, damping_ratio0, omega_n0)
     influence, overlapping = band_influence(frf, bands)
+    common = band_relative_error(frf, bands, channels)
     scale = None if band_peak is None else band_peak.max(axis=0)  # max |H| of each channel on the lines
     with np.errstate(all="ignore"):
         fit = fit_modes(omega, response, power, omega_n0, damping_ratio0, region=region, line_weight=weight,
                         channel_scale=scale, whitening=whitening, correlated_lags=lags,
-                        record_influence=influence, overlapping_records=overlapping,
+                        record_influence=influence, overlapping_records=overlapping, relative_error=common,
                         max_evaluations=None if budget is None else budget.for_fit())
     if budget is not None:
         budget.spend(fit)
@@ -130,7 +131,7 @@ def fit_bands(frf, bands, power, omega_n0, damping_ratio0, channels=None, data=N
             restart = fit_modes(omega, response, power, start_wn, start_zeta, region=region, line_weight=weight,
                                 channel_scale=scale, whitening=whitening, correlated_lags=lags,
                                 record_influence=influence, overlapping_records=overlapping,
-                                max_evaluations=None if budget is None else budget.for_fit())
+                                relative_error=common, max_evaluations=None if budget is None else budget.for_fit())
         if budget is not None:
             budget.spend(restart)
         if fit_cost(restart) < fit_cost(fit):

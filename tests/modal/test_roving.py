@@ -5,6 +5,7 @@ import json
 import os
 import subprocess
 import sys
+import warnings
 from dataclasses import replace
 from types import SimpleNamespace
 
@@ -13,7 +14,8 @@ import pytest
 
 from modal.errors import FormatError
 from modal.fitting import FitOptions, fit_path
-from modal.roving import RovingEstimate, join_estimates
+import modal
+from modal.roving import CORRELATION_TOLERANCE, RovingEstimate, _response_part, join_estimates
 from modal.synthetic_time import random_record
 from modal.time_frf import frf_from_time
 from support.paths import ROOT
@@ -125,21 +127,56 @@ def frf_from_time_record(record, args):
     return estimate_time_frf(record, plan_time_frf(record, args), args)
 
 
-def test_line_correlations_that_differ_between_points_are_dropped_and_said():
-    # an exponential window correlates neighbouring lines, each point's estimate with its own force noise in
-    # proportion to its own |H|: no one correlation is every channel's
+def test_the_points_response_noise_correlation_is_kept_and_their_force_noise_carried_apart():
+    # an exponential window correlates neighbouring lines; each point's estimate mixes its response noise's
+    # correlation with its own force noise's, in proportion to its own |H|. The response noise's part is one
+    # for every point (one window, alike hits): the join keeps it, and carries each point's force noise as its
+    # channel's own factor, independent of the other point's
     first, second = _estimate(0, "exponential", 0.5), _estimate(1, "exponential", 0.5, seed=1)
+    mixed = [e.noise_model.line_correlation for e in (first, second)]
+    assert np.max(np.abs(mixed[0] - mixed[1])) > CORRELATION_TOLERANCE  # as mixed, the points' differ
     joined = join_estimates([first, second], [("1+Z", ["p1.csv"]), ("2+Z", ["p2.csv"])])
-    assert joined.noise_model.line_correlation is None
-    assert "line correlations differ" in joined.join_note
-    assert joined.exponential_decay_s == 0.5 and joined.noise_model.averages == 3
+    model = joined.noise_model
+    assert model.line_correlation is not None and "line correlations differ" not in joined.join_note
+    parts = [_response_part(e.noise_model, np.atleast_2d(e.response)) for e in (first, second)]
+    np.testing.assert_allclose(model.line_correlation, (parts[0][1] + parts[1][1]) / 2)
+    np.testing.assert_allclose(model.variance_model, (parts[0][0] + parts[1][0]) / 2)
+    # each channel's factor in its own block: channel 1 the first point's, channel 2 the second's
+    rows = first.noise_model.relative_error.shape[0]
+    assert model.relative_error.shape == (2, rows + second.noise_model.relative_error.shape[0], first.n_freq)
+    np.testing.assert_array_equal(model.relative_error[0, :rows], first.noise_model.relative_error)
+    assert not np.any(model.relative_error[0, rows:]) and not np.any(model.relative_error[1, :rows])
+    assert joined.exponential_decay_s == 0.5 and model.averages == 3
+    # without the force noise carried apart, the mixed correlations differ: dropped, and said
+    bare = [replace(e, noise_model=replace(e.noise_model, relative_error=None)) for e in (first, second)]
+    dropped = join_estimates(bare, [("1+Z", ["p1.csv"]), ("2+Z", ["p2.csv"])])
+    assert dropped.noise_model.line_correlation is None and "line correlations differ" in dropped.join_note
     # the same estimate twice: one correlation, kept, as are the lag window and the variance model
-    same = join_estimates([first, replace(first, reference_points=("2+Z",))],
+    same = join_estimates([bare[0], replace(bare[0], reference_points=("2+Z",))],
                           [("1+Z", ["p1.csv"]), ("2+Z", ["p2.csv"])])
     np.testing.assert_array_equal(same.noise_model.line_correlation, first.noise_model.line_correlation)
     np.testing.assert_array_equal(same.noise_model.lag_window, first.noise_model.lag_window)
     np.testing.assert_array_equal(same.noise_model.variance_model, first.noise_model.variance_model)
     assert "differ" not in same.join_note
+
+
+def test_a_single_output_estimates_response_noise_part_is_what_two_outputs_carry():
+    # one output's noise model mixes response and force noise; an estimate of the same record with the output
+    # twice carries the response noise's part alone (its force noise is the factor): the part taken out of the
+    # mixed model is that, to rounding, where the mixed model holds
+    record = _hits(0, seed=4)
+    force, response = record.signals[0], record.signals[1]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        one, two = (modal.estimate_frf(force, outputs, record.sample_rate_hz, impact=True, window="exponential",
+                                       exponential_decay_s=0.5, kind="accelerance")
+                    for outputs in (response, np.vstack([response, response])))
+    variance, correlation = _response_part(one.noise_model, np.atleast_2d(one.response))
+    held = np.isfinite(variance)
+    assert held.sum() > 100
+    np.testing.assert_allclose(variance[held], two.noise_model.variance_model[held], rtol=1e-6)
+    lines = np.flatnonzero(held)[:-64]
+    np.testing.assert_allclose(correlation[:, lines], two.noise_model.line_correlation[:, lines], atol=1e-6)
 
 
 def test_lag_windows_that_differ_are_dropped_and_close_ones_averaged():

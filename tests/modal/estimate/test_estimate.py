@@ -141,6 +141,26 @@ def test_mimo_h1_recovers_both_columns(plant):
     assert est.multiple_coherence.shape == (4, est.n_freq)
 
 
+def test_mimo_estimate_carries_the_windows_lag_window(plant):
+    # each input's column is, in expectation, the transform of its impulse response times the lag window of the
+    # windows and that input's mean square per sample: stationary inputs share it, and the estimate carries it so
+    # that identification takes the window's bias out of the damping (without it, two shakers' damping came out
+    # +2.3 to +3.0 standard errors high on average over 40 records of 120 s with the default Hann segments). It is
+    # the one-input estimate's of either force alone, to the scatter of the forces' mean square per sample over
+    # 255 half-overlapping records (a few 1e-3)
+    rng = np.random.default_rng(4)
+    forces = rng.standard_normal((2, 2**17))
+    second = DigitalModes(plant.natural_frequency_hz, plant.damping_ratio, 0.5 * plant.modal_constant[::-1], FS)
+    clean = plant.respond(forces[0]) + second.respond(forces[1])
+    mimo = modal.estimate_frf(forces, clean, FS, segment_length=1024)
+    assert mimo.noise_model.line_correlation is None and mimo.noise_model.lag_window is not None
+    for force in forces:
+        with warnings.catch_warnings():  # one force alone: the other's response is warned of as its noise
+            warnings.simplefilter("ignore", QualityWarning)
+            single = modal.estimate_frf(force, clean[0], FS, segment_length=1024).noise_model.lag_window
+        np.testing.assert_allclose(mimo.noise_model.lag_window, single, atol=0.01)
+
+
 def test_impact_double_hit_is_rejected_and_named(plant):
     n = int(8 * FS)
     hits = [0.5, 2.5, 2.51, 4.5, 6.5]  # the second hit bounces after 10 ms: a double hit
