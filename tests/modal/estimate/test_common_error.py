@@ -73,3 +73,25 @@ def test_a_hammer_without_a_force_window_carries_none():
     noisy = force + 0.005 * force.max() * rng.standard_normal(force.size)
     assert _estimate(noisy, response + 1e-4 * rng.standard_normal(response.shape), "rect").noise_model.relative_error \
         is None
+
+
+def _rank(n_rows: int, n_lines: int, rank: int, seed: int) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    left = rng.standard_normal((n_rows, rank)) * np.geomspace(1.0, 1e-3, rank)
+    return left @ (rng.standard_normal((rank, n_lines)) + 1j * rng.standard_normal((rank, n_lines)))
+
+
+def test_the_compressed_factor_carries_the_rows_covariance():
+    # the factor's covariance Pᴴ P is the rows' rowsᴴ rows, but for singular values below FACTOR_TOLERANCE of the
+    # largest (the bound below: what they could carry at most, relative): whether the random sketch holds the
+    # rows' range at once (rank 40), has to double (rank 150 > 64, 128 columns), or is as wide as the rows (the
+    # Gram matrix's exact path)
+    from modal.estimate.common_error import FACTOR_TOLERANCE, compressed_factor
+
+    for n_rows, rank in ((504, 40), (504, 150), (60, 30)):
+        rows = _rank(n_rows, 1025, rank, seed=rank)
+        factor = compressed_factor(rows)
+        exact = rows.conj().T @ rows
+        assert factor.shape[0] == rank
+        error = np.linalg.norm(factor.conj().T @ factor - exact) / np.linalg.norm(exact)
+        assert error < FACTOR_TOLERANCE**2 * n_rows
