@@ -21,14 +21,32 @@ from .io import read_frf, write_frf  # noqa: E402
 from .estimate import EstimatedFRF, estimate_frf  # noqa: E402
 from .flags import FLAG_TEXT  # noqa: E402
 from .results import IdentificationResult, ModeResult, ModeStd, physical_parameters  # noqa: E402
-from .synthetic import (  # noqa: E402
-    DigitalModes, add_noise, impact_record, matrix_frf, modal_frf, random_record, sdof_frf,
-)
 from .geometry import Geometry, line_geometry  # noqa: E402
 from .io.geometry import read_geometry  # noqa: E402
-# operational (output-only) analysis: the package is modal.operational, so that the name modal.oma is the
-# function (a package modal/oma/ would be bound to that attribute on its first import, over the function)
-from .operational import merge_setups, oma, scale_by_mass_change  # noqa: E402
+
+#: names whose module is imported when the name is first used (PEP 562): the synthesisers (modal.synthetic
+#: with its time-record and ambient generators) and operational analysis (the package is modal.operational, so
+#: that the name modal.oma is the function: a package modal/oma/ would be bound to that attribute on its first
+#: import, over the function) are not used by a fit, a scene run, a plotting process or a Dask worker, each of
+#: which imported them with ``import modal``
+_HOME = {**dict.fromkeys(("DigitalModes", "add_noise", "impact_record", "matrix_frf", "modal_frf", "random_record",
+                          "sdof_frf"), "synthetic"),
+         **dict.fromkeys(("merge_setups", "oma", "scale_by_mass_change"), "operational")}
+
+
+def __getattr__(name: str):
+    if name not in _HOME:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    import importlib
+
+    value = getattr(importlib.import_module(f".{_HOME[name]}", __name__), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted({*globals(), *_HOME})
+
 
 __all__ = [
     "FRF", "FRF_KINDS", "identify", "oma", "scale_by_mass_change", "merge_setups", "estimate_frf", "EstimatedFRF", "read_frf", "write_frf", "METHODS", "IdentificationResult", "ModeResult", "ModeStd",

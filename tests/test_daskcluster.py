@@ -47,3 +47,22 @@ def test_the_session_cluster_starts_on_demand_and_again_after_a_stop(monkeypatch
     assert not holder.running and events == ["start", "stop"]
     holder.get()
     assert events == ["start", "stop", "start"] and holder.starts == 2
+
+
+def test_the_cluster_processes_run_without_the_dashboard_diagnostics(dask_cluster):
+    # the settings reach the real scheduler and workers (and a setting of the user's own is kept)
+    import dask
+    from distributed import Client
+
+    from support.daskcluster import quiet_environment
+
+    def settings():
+        return (dask.config.get("distributed.worker.profile.enabled"),
+                dask.config.get("distributed.admin.tick.interval"),
+                dask.config.get("distributed.admin.system-monitor.interval"))
+
+    with Client(dask_cluster[0], timeout="30s", set_as_default=False) as client:
+        seen = [client.run_on_scheduler(settings), *client.run(settings).values()]
+    assert len(seen) == 3 and all(s == (False, "1s", "5s") for s in seen), seen
+    mine = {"DASK_DISTRIBUTED__ADMIN__TICK__INTERVAL": "50ms"}
+    assert quiet_environment(mine)["DASK_DISTRIBUTED__ADMIN__TICK__INTERVAL"] == "50ms"

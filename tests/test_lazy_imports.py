@@ -12,7 +12,7 @@ ROOT = Path(__file__).resolve().parent.parent
 def _modules_after(code: str) -> dict:
     script = (f"import sys, json\nsys.path.insert(0, {str(ROOT)!r})\n{code}\n"
               "print(json.dumps({m: m in sys.modules for m in ('balancer.influence', 'matplotlib.figure', 'scipy.optimize',"
-              "'scipy.integrate', 'scipy.linalg', 'scipy.special', 'h5py')}))")
+              "'scipy.integrate', 'scipy.linalg', 'scipy.special', 'h5py', 'modal.synthetic', 'modal.operational')}))")
     proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, proc.stderr[-2000:]
     return json.loads(proc.stdout.strip().splitlines()[-1])
@@ -76,3 +76,14 @@ def test_the_modal_command_line_leaves_the_batch_runner_and_h5py_until_a_batch_o
     fitted, batch = (json.loads(line) for line in proc.stdout.strip().splitlines()[-2:])
     assert fitted == [False, False]
     assert batch == [True, True, True]  # the package's names still there, imported when used
+
+
+def test_importing_the_toolkit_leaves_the_synthesisers_and_operational_analysis_until_a_name_is_used():
+    # every scene run, plotting process, batch fitting process and Dask worker imports modal; none of them
+    # synthesises records or runs operational analysis, whose modules it loaded with it
+    loaded = _modules_after("import modal, balancer.cli, balancer.scene.runner, modal.batch.fitproc")
+    assert loaded["modal.synthetic"] is False and loaded["modal.operational"] is False
+    used = ("import modal\nassert all(hasattr(modal, name) for name in modal.__all__)\n"
+            "from modal import oma, add_noise\nassert modal.oma is oma and 'DigitalModes' in dir(modal)")
+    loaded = _modules_after(used)
+    assert loaded["modal.synthetic"] is True and loaded["modal.operational"] is True  # there when used

@@ -2,12 +2,27 @@
 ``dask`` command on 127.0.0.1 (free ports; stopped at the end of the session)."""
 from __future__ import annotations
 
+import os
 import socket
 import subprocess
 import sys
 from pathlib import Path
 
 DASK = Path(sys.executable).with_name("dask")
+
+#: Dask settings of the test cluster's processes (environment variables, a user's own setting kept): its
+#: diagnostics for a dashboard nobody opens, the profiler sampling every worker's threads every 10 ms, the
+#: event-loop health check every 20 ms, the system monitor every 0.5 s, made an idle scheduler with two
+#: nanny workers burn 5.8 CPU-s a minute (1.6 without them), taken from the tests running beside it; the
+#: tests of dashboards and of ``modal batch``'s own cluster start theirs without these
+QUIET = {"DASK_DISTRIBUTED__WORKER__PROFILE__ENABLED": "False",
+         "DASK_DISTRIBUTED__ADMIN__TICK__INTERVAL": "1s",
+         "DASK_DISTRIBUTED__ADMIN__SYSTEM_MONITOR__INTERVAL": "5s"}
+
+
+def quiet_environment(environ=os.environ) -> dict[str, str]:
+    """``environ`` with :data:`QUIET`'s settings where it has none of its own."""
+    return {**QUIET, **environ}
 
 
 def free_port() -> int:
@@ -22,7 +37,7 @@ def start_worker(address: str, name: str, folder: Path, nanny: bool = False) -> 
     return subprocess.Popen([str(DASK), "worker", address, "--name", name, "--nthreads", "1",
                              "--nanny" if nanny else "--no-nanny", "--no-dashboard", "--host", "127.0.0.1",
                              "--local-directory", str(folder)],
-                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, cwd=folder)
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, cwd=folder, env=quiet_environment())
 
 
 def wait_for_workers(address: str, n: int, timeout: float = 60.0) -> None:
@@ -52,7 +67,7 @@ def cluster(tmp_path_factory):
     port = free_port()
     address = f"tcp://127.0.0.1:{port}"
     procs = [subprocess.Popen([str(DASK), "scheduler", "--host", "127.0.0.1", "--port", str(port), "--no-dashboard"],
-                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, cwd=folder)]
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, cwd=folder, env=quiet_environment())]
     try:
         procs += [start_worker(address, f"w{i}", folder, nanny=True) for i in range(2)]
         wait_for_workers(address, 2)

@@ -12,6 +12,7 @@ import urllib.request
 from pathlib import Path
 
 import psutil
+import pytest
 
 from modal.io import write_frf
 
@@ -67,10 +68,11 @@ def speaks_http(port: int) -> bool:
         return False
 
 
-def watch(args: list[str], dashboard: int | None = None) -> tuple[subprocess.CompletedProcess, set[int], set[int]]:
-    """Run ``modal batch ARGS``; the ports its processes listened on while it ran, and those of them
-    that were not Dask's (silent on accepting), the ``dashboard`` port if it answered HTTP."""
-    proc = subprocess.Popen([sys.executable, "-m", "modal", "batch", *args], stdout=subprocess.PIPE,
+def watch(args: list[str], dashboard: int | None = None,
+          command: tuple[str, ...] = ("-m", "modal", "batch")) -> tuple[subprocess.CompletedProcess, set[int], set[int]]:
+    """Run ``modal batch ARGS`` (``python COMMAND ARGS``); the ports its processes listened on while it ran,
+    and those of them that were not Dask's (silent on accepting), the ``dashboard`` port if it answered HTTP."""
+    proc = subprocess.Popen([sys.executable, *command, *args], stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True)
     seen, other = set(), set()
     try:
@@ -91,7 +93,12 @@ def watch(args: list[str], dashboard: int | None = None) -> tuple[subprocess.Com
     return subprocess.CompletedProcess(proc.args, proc.returncode, out, err), seen, other
 
 
-def test_no_web_server_unless_asked_and_no_word_of_a_taken_port(tmp_path):
+@pytest.fixture(scope="module")
+def default_run(tmp_path_factory):
+    """One ``modal batch`` with its embedded cluster (two workers) and no --dashboard, watched, the
+    dashboard's port taken, the scheduler answering heartbeats late (:data:`_SLOW_HEARTBEATS`): the run
+    both tests of a default run read (each run starts a scheduler and two nanny workers, ~4.5 CPU-s)."""
+    tmp_path = tmp_path_factory.mktemp("default_run")
     folder = write_inputs(tmp_path / "in")
     with socket.socket() as holder:
         try:  # the dashboard's port taken (by this test, or by whatever else holds it)
@@ -99,7 +106,12 @@ def test_no_web_server_unless_asked_and_no_word_of_a_taken_port(tmp_path):
             holder.listen()
         except OSError:
             pass
-        done, seen, other = watch([str(folder), "--out", str(tmp_path / "r.h5"), "--workers", "2"])
+        return watch([str(folder), "--out", str(tmp_path / "r.h5"), "--workers", "2"],
+                     command=("-c", textwrap.dedent(_SLOW_HEARTBEATS)))
+
+
+def test_no_web_server_unless_asked_and_no_word_of_a_taken_port(default_run):
+    done, seen, other = default_run
     assert done.returncode == 0, done.stderr
     assert len(seen) >= 3  # the watch saw the cluster: a scheduler and two workers listen (Dask's protocol)
     assert other == set() and DASHBOARD_PORT not in seen  # nothing but Dask's comms
@@ -140,10 +152,8 @@ sys.exit(main(["batch", *sys.argv[1:]]))
 """
 
 
-def test_the_embedded_cluster_closes_without_a_traceback(tmp_path):
-    folder = write_inputs(tmp_path / "in", n=2)
-    done = subprocess.run([sys.executable, "-c", textwrap.dedent(_SLOW_HEARTBEATS), str(folder), "--out",
-                           str(tmp_path / "r.h5"), "--workers", "2"], capture_output=True, text=True, timeout=300)
+def test_the_embedded_cluster_closes_without_a_traceback(default_run):
+    done = default_run[0]
     assert done.returncode == 0, done.stderr
     assert "Traceback" not in done.stderr and "ERROR" not in done.stderr, done.stderr
     assert done.stderr == ""
