@@ -15,7 +15,7 @@ __all__ = ["add_oma_parser", "add_oma_options", "run_oma"]
 
 def add_oma_options(parser: argparse.ArgumentParser) -> None:
     """The options of :class:`modal.operational.files.OMAOptions` (``modal oma`` and ``modal batch --oma``)."""
-    from .operational import OMA_METHODS
+    from .operational.methods import OMA_METHODS
 
     parser.add_argument("--band", nargs=2, type=float, metavar=("FMIN", "FMAX"),
                         help="band of interest in Hz (default: 0 Hz to 80 %% of the Nyquist frequency)")

@@ -12,7 +12,8 @@ ROOT = Path(__file__).resolve().parent.parent
 def _modules_after(code: str) -> dict:
     script = (f"import sys, json\nsys.path.insert(0, {str(ROOT)!r})\n{code}\n"
               "print(json.dumps({m: m in sys.modules for m in ('balancer.influence', 'matplotlib.figure', 'scipy.optimize',"
-              "'scipy.integrate', 'scipy.linalg', 'scipy.special', 'h5py', 'modal.synthetic', 'modal.operational')}))")
+              "'scipy.integrate', 'scipy.linalg', 'scipy.special', 'h5py', 'modal.synthetic', 'modal.operational',"
+              "'modal.operational.identify')}))")
     proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, proc.stderr[-2000:]
     return json.loads(proc.stdout.strip().splitlines()[-1])
@@ -87,3 +88,12 @@ def test_importing_the_toolkit_leaves_the_synthesisers_and_operational_analysis_
             "from modal import oma, add_noise\nassert modal.oma is oma and 'DigitalModes' in dir(modal)")
     loaded = _modules_after(used)
     assert loaded["modal.synthetic"] is True and loaded["modal.operational"] is True  # there when used
+
+
+def test_the_command_line_parser_lists_the_operational_methods_without_loading_them():
+    # `modal oma --method` lists the methods: every `modal` command builds that parser, and loading operational
+    # analysis for it cost ~0.05 CPU-s a command
+    loaded = _modules_after("import modal.cli\nmodal.cli.build_parser()")
+    assert loaded["modal.operational.identify"] is False
+    loaded = _modules_after("import modal.operational\nmodal.operational.oma")
+    assert loaded["modal.operational.identify"] is True

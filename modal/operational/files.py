@@ -49,7 +49,7 @@ class OMAOptions:
     max_order: int | None = None
 
     def __post_init__(self) -> None:
-        from .identify import OMA_METHODS
+        from .methods import OMA_METHODS
 
         one_of("method", self.method, OMA_METHODS)
         if self.band_hz is not None:

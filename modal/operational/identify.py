@@ -20,6 +20,7 @@ from ..errors import IdentificationError, ParameterError
 from ..results import IdentificationResult
 from .correlations import choose_references, correlations
 from .inputs import MIN_LAGS_IN_RECORD, Prepared, prepare
+from .methods import OMA_METHODS
 from .modes import error_blocks, estimates_from_clusters, resolved
 from .tones import flag_mains_hum, nearly_undamped, separate_tones
 from .result import oma_result
@@ -28,9 +29,6 @@ from .selection import OMAStabilisation, mpc, stabilise
 
 __all__ = ["oma", "OMA_METHODS"]
 
-#: the operational methods: covariance-driven SSI (default), poly-reference LSCF on half-spectra, and the
-#: frequency-domain decomposition quick looks
-OMA_METHODS = ("ssi", "plscf", "fdd", "efdd")
 #: at most this many reference (projection) channels are chosen automatically
 MAX_AUTO_REFERENCES = 8
 #: with more outputs than references, the outputs' block rows make the Hankel matrix about this many times as
