@@ -34,18 +34,9 @@ _HOME = {**dict.fromkeys(("DigitalModes", "add_noise", "impact_record", "matrix_
          **dict.fromkeys(("merge_setups", "oma", "scale_by_mass_change"), "operational")}
 
 
-def __getattr__(name: str):
-    if name not in _HOME:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    import importlib
+from .lazy import lazy_names  # noqa: E402
 
-    value = getattr(importlib.import_module(f".{_HOME[name]}", __name__), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__():
-    return sorted({*globals(), *_HOME})
+__getattr__, __dir__ = lazy_names(__name__, _HOME)
 
 
 __all__ = [

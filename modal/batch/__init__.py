@@ -8,7 +8,7 @@ resumable, into one archive and one table (``python -m modal batch``).
 """
 from __future__ import annotations
 
-import importlib
+from ..lazy import lazy_names
 
 __all__ = ["fit_files", "iter_fit", "find_files", "file_sha256", "BatchResult", "FileFit", "BatchInfo", "Outcome",
            "TABLE_COLUMNS", "FRF_EXTENSIONS", "OutputInUseError"]
@@ -21,13 +21,4 @@ _HOME = {"FRF_EXTENSIONS": "discover", "file_sha256": "discover", "find_files": 
          "BatchResult": "run", "fit_files": "run", "iter_fit": "run", "TABLE_COLUMNS": "store"}
 
 
-def __getattr__(name: str):
-    if name not in _HOME:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    value = getattr(importlib.import_module(f".{_HOME[name]}", __name__), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__():
-    return sorted({*globals(), *_HOME})
+__getattr__, __dir__ = lazy_names(__name__, _HOME)

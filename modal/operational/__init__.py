@@ -3,6 +3,7 @@ orders → stabilisation and clustering → machine tones apart → error bars; 
 scaling and the merging of several setups. Entry point: ``modal.oma(data, ...)``."""
 from __future__ import annotations
 
+from ..lazy import lazy_names
 from .methods import OMA_METHODS
 
 __all__ = ["oma", "OMA_METHODS", "scale_by_mass_change", "merge_setups"]
@@ -12,15 +13,4 @@ __all__ = ["oma", "OMA_METHODS", "scale_by_mass_change", "merge_setups"]
 _HOME = {"oma": "identify", "scale_by_mass_change": "scaling", "merge_setups": "setups"}
 
 
-def __getattr__(name: str):
-    if name not in _HOME:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    import importlib
-
-    value = getattr(importlib.import_module(f".{_HOME[name]}", __name__), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__():
-    return sorted({*globals(), *_HOME})
+__getattr__, __dir__ = lazy_names(__name__, _HOME)
