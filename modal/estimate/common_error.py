@@ -18,10 +18,14 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["common_error_factor", "compressed_factor", "SKETCH_COLUMNS", "MAX_SUPPORT_ROWS", "MAX_SUPPORT_FRACTION", "FACTOR_TOLERANCE"]
+__all__ = ["common_error_factor", "compressed_factor", "SKETCH_COLUMNS", "MAX_SUPPORT_ROWS", "MAX_FACTOR_WORK", "MAX_SUPPORT_FRACTION", "FACTOR_TOLERANCE"]
 
 #: records × window samples at most (the factor's Gram matrix is this square: 1024 rows, 20 ms)
 MAX_SUPPORT_ROWS = 1024
+#: rows² × lines at most (the products the factor's Gram matrix costs: 1024 rows of 1025 lines, ~1 s at the
+#: worst); beyond, as for a 16384-sample record's 8193 lines with 948 rows (7 s), the excitation's noise is left
+#: to the line correlation
+MAX_FACTOR_WORK = 1024**2 * 1025
 #: the excitation window keeps at most this fraction of a record (a force window's few dozen samples); a window
 #: over the whole record (a hammer test without a force window, a continuous estimate) is no short support: its
 #: excitation noise is left to the line correlation
@@ -51,14 +55,16 @@ def common_error_factor(excitation: np.ndarray, starts: np.ndarray, length: int,
     Returns
     -------
     ndarray or None
-        None where the window's support over the records exceeds :data:`MAX_SUPPORT_ROWS` rows or
+        None where the window's support over the records exceeds :data:`MAX_SUPPORT_ROWS` rows (or their
+        Gram matrix :data:`MAX_FACTOR_WORK` products) or
         :data:`MAX_SUPPORT_FRACTION` of a record, the noise power is not positive, or a line holds no excitation.
     """
     window = np.asarray(input_window, float)
     support = np.flatnonzero(window != 0)
     starts = np.asarray(starts, np.int64)
-    if (not excitation_noise_power > 0 or support.size * starts.size > MAX_SUPPORT_ROWS or support.size == 0
-            or support.size > MAX_SUPPORT_FRACTION * length):
+    n_rows = support.size * starts.size
+    if (not excitation_noise_power > 0 or n_rows > MAX_SUPPORT_ROWS or support.size == 0
+            or support.size > MAX_SUPPORT_FRACTION * length or n_rows**2 * (length // 2 + 1) > MAX_FACTOR_WORK):
         return None
     records = np.stack([excitation[s:s + length] for s in starts]) * window  # (n_records, length)
     spectra = np.fft.rfft(records, axis=-1)
@@ -85,8 +91,9 @@ def compressed_factor(rows: np.ndarray) -> np.ndarray:
     P = s Vᴴ on the kept singular values of ``rows`` = U s Vᴴ. Their range is found by a random sketch
     (Halko, Martinsson & Tropp 2011): Q, an orthonormal basis of ``rows`` Ω for a fixed Gaussian Ω of a few more
     columns than the rank, holds it when what Q leaves out, ‖rows‖² − ‖Qᴴ rows‖² (exact, Q orthonormal), is
-    below what the tolerance may drop; the SVD of the small Qᴴ rows then gives s Vᴴ. The sketch doubles until it
-    does; at the rows' own number the factor comes from their Gram matrix instead, exactly. A Gram matrix of every row
+    below what the tolerance may drop; the SVD of the small Qᴴ rows then gives s Vᴴ. The sketch doubles once if
+    it does not; then (a rank of hundreds, where sketches cost more than the Gram matrix) the factor comes from
+    the rows' Gram matrix instead, exactly. A Gram matrix of every row
     (records × window samples square, 504² for 12 hits) cost an eigendecomposition of that size: 0.15 s a
     hammer file, against the sketch's two products.
     """
@@ -94,7 +101,7 @@ def compressed_factor(rows: np.ndarray) -> np.ndarray:
     total = float(np.sum(np.abs(rows) ** 2))
     columns = min(SKETCH_COLUMNS, n_rows)
     rng = np.random.default_rng(0)  # fixed: the same file gives the same factor
-    while columns < n_rows:
+    while columns < n_rows and columns <= 2 * SKETCH_COLUMNS:  # a sketch that fails twice: the rank is high
         sketch = rows @ rng.standard_normal((rows.shape[1], columns))
         q, _ = np.linalg.qr(sketch)
         _, singular, vh = np.linalg.svd(q.conj().T @ rows, full_matrices=False)

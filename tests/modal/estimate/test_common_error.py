@@ -95,3 +95,21 @@ def test_the_compressed_factor_carries_the_rows_covariance():
         assert factor.shape[0] == rank
         error = np.linalg.norm(factor.conj().T @ factor - exact) / np.linalg.norm(exact)
         assert error < FACTOR_TOLERANCE**2 * n_rows
+
+
+def test_a_factor_whose_gram_matrix_would_cost_seconds_is_not_formed():
+    # 3 records of 16384 samples whose excitation window keeps 316 samples each: 948 rows of 8193 lines, a Gram
+    # matrix of 7e9 products (7 s a hammer file, where the estimate itself takes 0.1 s): left to the line
+    # correlation, as a window longer than MAX_SUPPORT_FRACTION of a record is
+    from modal.estimate.common_error import MAX_FACTOR_WORK, common_error_factor
+
+    length = 16384
+    window = np.zeros(length)
+    window[:316] = 1.0
+    excitation = np.random.default_rng(2).standard_normal(3 * length)
+    starts = np.arange(3) * length
+    assert 948**2 * (length // 2 + 1) > MAX_FACTOR_WORK
+    assert common_error_factor(excitation, starts, length, window, 1.0) is None
+    # records of 2048 samples (1025 lines) keeping 200 (600 rows: 4e8 products, within MAX_SUPPORT_FRACTION) are
+    short = common_error_factor(excitation, np.arange(3) * 2048, 2048, np.r_[np.ones(200), np.zeros(1848)], 1.0)
+    assert short is not None and short.shape[1] == 1025
