@@ -20,7 +20,7 @@ import numpy as np
 
 __all__ = ["common_error_factor", "compressed_factor", "SKETCH_COLUMNS", "MAX_SUPPORT_ROWS", "MAX_FACTOR_WORK", "MAX_SUPPORT_FRACTION", "FACTOR_TOLERANCE"]
 
-#: records × window samples at most (the factor's Gram matrix is this square: 1024 rows, 20 ms)
+#: records × window samples at most (rows of the factor before it is compressed, :func:`compressed_factor`)
 MAX_SUPPORT_ROWS = 1024
 #: rows² × lines at most (the products the factor's Gram matrix costs: 1024 rows of 1025 lines, ~1 s at the
 #: worst); beyond, as for a 16384-sample record's 8193 lines with 948 rows (7 s), the excitation's noise is left
@@ -88,29 +88,31 @@ def compressed_factor(rows: np.ndarray) -> np.ndarray:
     """P with Pᴴ P = rowsᴴ rows, of as few rows as the singular values of ``rows`` above
     :data:`FACTOR_TOLERANCE` of the largest (the rest dropped, as their variance is 1e-8 of it).
 
-    P = s Vᴴ on the kept singular values of ``rows`` = U s Vᴴ. Their range is found by a random sketch
+    P = Uᴴ rows on the kept left singular vectors U of ``rows``. Their range is found by a random sketch
     (Halko, Martinsson & Tropp 2011): Q, an orthonormal basis of ``rows`` Ω for a fixed Gaussian Ω of a few more
     columns than the rank, holds it when what Q leaves out, ‖rows‖² − ‖Qᴴ rows‖² (exact, Q orthonormal), is
-    below what the tolerance may drop; the SVD of the small Qᴴ rows then gives s Vᴴ. The sketch doubles once if
-    it does not; then (a rank of hundreds, where sketches cost more than the Gram matrix) the factor comes from
-    the rows' Gram matrix instead, exactly. A Gram matrix of every row
-    (records × window samples square, 504² for 12 hits) cost an eigendecomposition of that size: 0.15 s a
-    hammer file, against the sketch's two products.
+    below what the tolerance may drop; the small Qᴴ rows then give P (:func:`_kept_factor`). The sketch doubles
+    once if it does not; then (a rank of hundreds, where sketches cost more) the factor comes from all the rows
+    at once, exactly. An eigendecomposition of every row's Gram matrix (504² for 12 hits × 42 samples) cost
+    0.15 s a hammer file, against the sketch's two products.
     """
     n_rows = rows.shape[0]
     total = float(np.sum(np.abs(rows) ** 2))
     columns = min(SKETCH_COLUMNS, n_rows)
     rng = np.random.default_rng(0)  # fixed: the same file gives the same factor
     while columns < n_rows and columns <= 2 * SKETCH_COLUMNS:  # a sketch that fails twice: the rank is high
-        sketch = rows @ rng.standard_normal((rows.shape[1], columns))
-        q, _ = np.linalg.qr(sketch)
-        _, singular, vh = np.linalg.svd(q.conj().T @ rows, full_matrices=False)
-        if total - float(np.sum(singular**2)) <= FACTOR_TOLERANCE**2 * singular[0] ** 2 * n_rows:
-            kept = singular > FACTOR_TOLERANCE * singular[0]
-            return singular[kept, None] * vh[kept]
+        q, _ = np.linalg.qr(rows @ rng.standard_normal((rows.shape[1], columns)))
+        power, factor = _kept_factor(q.conj().T @ rows)
+        if total - float(np.sum(power)) <= FACTOR_TOLERANCE**2 * power[-1] * n_rows:
+            return factor
         columns *= 2
-    # as many columns as rows: U from the rows' Gram matrix (rows × rows; an SVD of the rows themselves, as wide
-    # as the lines, costs more), P = Uᴴ rows on the kept eigenvalues
-    power_of, vectors = np.linalg.eigh(rows @ rows.conj().T)
-    kept = power_of > FACTOR_TOLERANCE**2 * power_of[-1]
-    return vectors[:, kept].conj().T @ rows
+    return _kept_factor(rows)[1]
+
+
+def _kept_factor(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(every squared singular value of ``rows``, ascending; Uᴴ rows on those above :data:`FACTOR_TOLERANCE`
+    of the largest), U from the eigenvectors of the rows' small Gram matrix (rows × rows: an SVD of the rows
+    themselves, as wide as the lines, costs several times more)."""
+    power, vectors = np.linalg.eigh(rows @ rows.conj().T)
+    kept = power > FACTOR_TOLERANCE**2 * power[-1]
+    return power, vectors[:, kept].conj().T @ rows
