@@ -38,14 +38,14 @@ __all__ = ["SCHEMA", "SCHEMA_VERSION", "Archive", "write_archive", "read_archive
 _ALLOWED_MODULES = ("modal.", "balancer.")
 _COMPRESS_BYTES = 16384  # gzip+shuffle only where it pays: arrays above 16 kB
 
-# longest suffix first
-_UNIT_SUFFIXES = [
+#: unit suffixes of field names, longest first (``_n_s_per_m`` before ``_per_m`` before ``_m``)
+_UNIT_SUFFIXES = sorted([
     ("_per_s", "1/s"), ("_kg_per_m", "kg/m"), ("_per_m", "1/m"),
     ("_n_s_per_m", "N s/m"), ("_n_m_s", "N m s"), ("_n_per_m", "N/m"), ("_kg_m2", "kg m^2"), ("_kg_m", "kg m"),
     ("_rad_s", "rad/s"), ("_m_s", "m/s"), ("_hz", "Hz"), ("_rpm", "rpm"), ("_kg", "kg"), ("_rad", "rad"),
     ("_deg", "deg"), ("_mm", "mm"), ("_pa", "Pa"), ("_mpa", "MPa"), ("_n_m", "N m"), ("_w", "W"), ("_kw", "kW"),
     ("_n", "N"), ("_m", "m"), ("_s", "s"),
-]
+], key=lambda item: -len(item[0]))
 
 
 #: Units of names that carry no unit suffix (the toolkit's conventions; "1" = dimensionless).
@@ -67,7 +67,7 @@ def units_of(name: str) -> str | None:
     lower = name.lower()
     if lower in _NAMED_UNITS:
         return _NAMED_UNITS[lower]
-    for suffix, unit in sorted(_UNIT_SUFFIXES, key=lambda item: -len(item[0])):  # longest first
+    for suffix, unit in _UNIT_SUFFIXES:
         if lower.endswith(suffix):
             return unit
     if lower.startswith("n_") or lower.endswith(("_ratio", "_fraction", "_count")):
@@ -247,8 +247,7 @@ def _name_units(name: str) -> tuple[str, ...]:
     lower = name.lower()
     if lower in _NAMED_UNITS:
         return ()
-    return tuple(unit for suffix, unit in sorted(_UNIT_SUFFIXES, key=lambda item: -len(item[0]))
-                 if lower.endswith(suffix))
+    return tuple(unit for suffix, unit in _UNIT_SUFFIXES if lower.endswith(suffix))
 
 
 def _check_units(group, obj) -> None:
@@ -301,9 +300,7 @@ def read_node(node) -> Any:
         A result's number stored with another unit than the one the toolkit writes, or with none
         (:func:`_check_units`).
     """
-    kind = node.attrs.get("__type__")
-    if isinstance(kind, bytes):
-        kind = kind.decode()
+    kind = _str_type(node)
     if kind == "frf":
         return read_frf_group(node, source=node.file.filename)
     if kind == "dataclass":
@@ -329,7 +326,7 @@ def read_node(node) -> Any:
         return None
     if kind in ("bool",):
         return bool(node[()])
-    if kind in ("int", "float", "complex", "ndarray", "npscalar"):
+    if kind in _NUMBER_TYPES:
         _check_number(node, kind)
     if kind in ("int", "float", "complex"):
         return {"int": int, "float": float, "complex": complex}[kind](node[()])
