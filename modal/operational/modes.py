@@ -16,7 +16,7 @@ from ..parallel import map_over_threads
 from ..units import TWO_PI
 from .correlations import MAX_BLOCKS
 from .pole import PoleEstimate
-from .selection import Cluster, shape_mac
+from .selection import DETERMINED_SIGMAS, Cluster, shape_mac
 
 __all__ = ["pole_errors", "estimates_from_clusters", "error_blocks", "upper_half", "resolved"]
 
@@ -59,13 +59,20 @@ def _physical_shape(unit_shape: np.ndarray, d_unit: np.ndarray | None, scale: np
     """The shape in the channels' own units, largest entry 1, and the standard error of each entry.
 
     ``unit_shape`` was found on unit-RMS channels (its largest entry 1, so its deviations ``d_unit``
-    (blocks, channels) vanish there); the channels' RMS ``scale`` brings it back.
+    (blocks, channels) vanish there); the channels' RMS ``scale`` brings it back. The entry the shape is
+    normalised to is the largest of those the record determines (beyond :data:`DETERMINED_SIGMAS` standard errors
+    of zero): a channel of noise only (a disconnected sensor picking up hum, a broken cable) has a large RMS
+    and, in its own units, a large entry that is noise, and dividing by it would make every other entry noise
+    too.
     """
     raw = unit_shape * scale
-    lead = int(np.argmax(np.abs(raw)))
-    shape = raw / raw[lead]
     if d_unit is None:
-        return shape, np.full(scale.size, np.nan)
+        lead = int(np.argmax(np.abs(raw)))
+        return raw / raw[lead], np.full(scale.size, np.nan)
+    unit_std = np.sqrt(np.sum(np.abs(d_unit) ** 2, axis=0))
+    determined = np.abs(unit_shape) > DETERMINED_SIGMAS * unit_std  # (the unit shape's own lead always is)
+    lead = int(np.argmax(np.where(determined, np.abs(raw), -1.0)))
+    shape = raw / raw[lead]
     d_raw = d_unit * scale[None, :]
     d_shape = (d_raw - shape[None, :] * d_raw[:, lead][:, None]) / raw[lead]
     return shape, np.sqrt(np.sum(np.abs(d_shape) ** 2, axis=0))

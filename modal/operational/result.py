@@ -16,7 +16,7 @@ from ..flags import MPC_LIMIT, RULE_FLAGS, WEAK_FRACTION
 from ..results import IdentificationResult, ModeResult
 from ..units import TWO_PI
 from .pole import PoleEstimate
-from .selection import mpc
+from .selection import determined_mpc
 
 __all__ = ["KIND_OF_QUANTITY", "oma_result", "scaled_result", "merged_result"]
 
@@ -40,7 +40,7 @@ def _shape_flags(flags: set[str], shape_mpc: float, std_damping_ratio: float) ->
 
 
 def _estimate(pole: PoleEstimate, band_hz) -> ModeEstimate:
-    shape_mpc = mpc(pole.shape)
+    shape_mpc = determined_mpc(pole.shape, pole.std_shape)
     flags = set(pole.flags)
     if pole.n_orders_swept > 1 and pole.n_orders < WEAK_FRACTION * pole.n_orders_swept:
         flags.add("weak_evidence")
@@ -79,7 +79,7 @@ def _again(mode: ModeResult, flags: set[str], **changes) -> ModeEstimate:
     damping_ratio = changes.pop("damping_ratio", mode.damping_ratio)
     std_omega_n = changes.pop("std_omega_n", TWO_PI * mode.std.natural_frequency_hz)
     std_damping_ratio = changes.pop("std_damping_ratio", mode.std.damping_ratio)
-    shape_mpc = mpc(shape)
+    shape_mpc = determined_mpc(shape, std_shape)
     own = (set(mode.flags) - RULE_FLAGS - {"complex_shape"}) | flags
     own, details = _shape_flags(own, shape_mpc, std_damping_ratio)
     return ModeEstimate(

@@ -18,7 +18,7 @@ import numpy as np
 
 from .ssi import PoleSet
 
-__all__ = ["OMAStabilisation", "Cluster", "stabilise", "shape_mac", "mpc"]
+__all__ = ["OMAStabilisation", "Cluster", "stabilise", "shape_mac", "mpc", "determined_mpc", "DETERMINED_SIGMAS"]
 
 #: stability: relative frequency difference, relative damping difference, MAC of the shapes
 FREQ_TOL, DAMPING_TOL, MAC_TOL = 0.01, 0.05, 0.98
@@ -76,6 +76,27 @@ def shape_mac(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     num = np.abs(np.einsum("i...,i...->...", a.conj(), b)) ** 2
     den = np.sum(np.abs(a) ** 2, axis=0) * np.sum(np.abs(b) ** 2, axis=0)
     return num / np.where(den > 0, den, np.inf)
+
+
+#: a shape entry this many standard errors from zero or more is determined by the record: a shape is normalised
+#: to the largest of these (:func:`modal.operational.modes._physical_shape`) and its MPC judged on them
+DETERMINED_SIGMAS = 3.0
+
+
+def determined_mpc(shape: np.ndarray, std_shape) -> float:
+    """:func:`mpc` of the entries of ``shape`` at least :data:`DETERMINED_SIGMAS` standard errors (``std_shape``)
+    from zero; of every entry where the errors are unknown (NaN or None) or none is determined.
+
+    An entry the record does not determine is noise: small, as a node's, it hardly moves the MPC, but a channel
+    of noise only (a disconnected sensor picking up hum) is large in its own units, and its random phase would
+    make a real mode look complex."""
+    shape = np.asarray(shape, complex)
+    if std_shape is None:
+        return mpc(shape)
+    std_shape = np.asarray(std_shape, float)
+    with np.errstate(invalid="ignore"):
+        determined = np.abs(shape) >= DETERMINED_SIGMAS * std_shape
+    return mpc(shape[determined]) if determined.any() else mpc(shape)
 
 
 def mpc(shape: np.ndarray) -> float:

@@ -16,6 +16,7 @@ from modal.errors import ParameterError, QualityWarning
 from modal.io.timedata import TimeRecord, read_time
 from modal.io.timewrite import write_time
 from modal.operational.inputs import prepare
+from modal.operational.selection import shape_mac
 from modal.operational.screen import (HELD_FRACTION, MIN_STUCK_SAMPLES, TRANSIENT_KURTOSIS, TRANSIENT_SIGMAS,
                                      held_factor, screen_samples, stuck_runs, transient_kurtosis)
 from support.ambient import anchor_record
@@ -161,6 +162,27 @@ def test_disconnected_sensor_is_named(record):
     assert len(result) == 6
     found = _unresponsive(texts)
     assert len(found) == 1 and found[0].startswith("<array>: channel 4 moves in none of the 6 modes")
+
+
+def test_loud_noise_channel_is_named_and_leaves_the_shapes_alone(record):
+    # a broken cable picking up noise 1000 times the response's RMS: in its own units the channel's shape entry
+    # (noise) is the largest; the shapes must be normalised to an entry the record determines, so that the
+    # other channels keep their shapes and the noise channel alone is named (dividing by its entry made every
+    # other channel read as unmoving and every mode complex)
+    signals = record.signals.copy()
+    signals[5] = 1e3 * signals[5].std() * np.random.default_rng(3).standard_normal(signals.shape[1])
+    result, texts = _oma(signals, record.sample_rate_hz)
+    assert len(result) == 6
+    found = _unresponsive(texts)
+    assert len(found) == 1 and found[0].startswith("<array>: channel 6 moves in none of the 6 modes")
+    others = np.r_[0:5, 6:8]
+    for k, mode in enumerate(result):
+        assert "complex_shape" not in mode.flags
+        # the other channels' shapes: the MAC criterion for modes found with confidence, against the truth, as
+        # on a clean record
+        if "high_uncertainty" not in mode.flags:
+            assert shape_mac(mode.mode_shape[others], record.mode_shape[others, k]) >= 0.98
+        assert abs(mode.mode_shape[5]) <= 3 * mode.std.mode_shape[5]
 
 
 def test_hammer_force_among_the_responses_is_named(record):
