@@ -60,27 +60,60 @@ def _unwindow(omega_n, zeta, beta):
     return s + beta
 
 
-def _lsfd_shapes(S, omega, poles_windowed, dt, n_picked):
-    """Shapes (outputs, n_picked) from the residues of the half-spectra at the first ``n_picked`` of the given
-    (windowed) poles, z-domain; the other poles (the rest of the order's) are in the fit so that their
-    modes and tones do not leak into these residues."""
+#: each mode's residue is fitted on the lines within this many half-widths of its (windowed) peak, its decay rate
+#: ζωn plus the lag window's β
+LOCAL_HALF_WIDTHS = 4.0
+#: and on at least this many lines on either side (and twice as many lines as the fit has terms)
+LOCAL_MIN_LINES = 6
+#: the fit holds the terms of the poles within this many times that stretch's half-width of the mode (the
+#: farther ones' tails are smooth over the stretch: the residual takes them)
+NEAR_HALF_WIDTHS = 2.0
+
+
+def _lsfd_shapes(S, omega, poles_windowed, dt, n_picked, n_lags):
+    """Shapes (outputs, n_picked) from the residues of the half-spectra (of lags 0…``n_lags`` − 1) at the first
+    ``n_picked`` of the given (windowed) poles, z-domain.
+
+    Each residue is fitted on the lines around its own mode (:data:`LOCAL_HALF_WIDTHS`), with the terms of the
+    given poles near it (:data:`NEAR_HALF_WIDTHS`: a machine tone just outside the stretch has a steep tail)
+    and, for the modes farther off, a residual 1, 1/z, 1/z². Fitted over the whole band with one term per pole,
+    the misfit of a strong mode whose pole is off by its (large) error took the place of a weak mode's residue:
+    on 300 s records of the anchor case (seeds 0-15), the mode excited 10 times less than the others came out
+    with a strong neighbour's shape in 9 of 16 records (MAC 0.00-0.05 to its own, with small errors); fitted
+    locally, its MAC is 0.96-1.00 in all 16. A mode of (windowed)
+    discrete pole μ adds φ gᵀ Σ_{k=1}^{N−1} μ^{k−1} z^{−k} = φ gᵀ (1 − (μ/z)^{N−1}) / (z − μ) to a half-spectrum
+    of N lags, the factor in brackets the truncation at the last lag.
+    """
     z = np.exp(1j * omega * dt)
     mu = np.exp(poles_windowed * dt)
-    basis = np.column_stack([1.0 / (z - mu[r]) for r in range(mu.size)]
-                            + [1.0 / (z - mu[r].conj()) for r in range(mu.size)]
-                            + [np.ones_like(z), 1.0 / z])
+    truncated = n_lags - 1
     n_out, m, n_f = S.shape
-    coef, *_ = np.linalg.lstsq(basis, S.reshape(n_out * m, n_f).T, rcond=None)
+    flat = S.reshape(n_out * m, n_f).T
+    spacing = omega[1] - omega[0] if omega.size > 1 else 1.0
+    half_width = np.maximum(LOCAL_HALF_WIDTHS * np.abs(poles_windowed.real), LOCAL_MIN_LINES * spacing)
+
+    def term(pole):
+        return (1.0 - (pole / z) ** truncated) / (z - pole)
+
     shapes = np.empty((n_out, n_picked), complex)
     for r in range(n_picked):
-        residue = coef[r].reshape(n_out, m)
-        u, _, _ = np.linalg.svd(residue, full_matrices=False)
+        centre = abs(poles_windowed[r].imag)
+        inside = [r] + [q for q in range(mu.size) if q != r and abs(abs(poles_windowed[q].imag) - centre)
+                        <= NEAR_HALF_WIDTHS * half_width[r]]
+        distance = np.abs(omega - centre)
+        n_lines = max(int(np.count_nonzero(distance <= half_width[r])), 2 * (2 * len(inside) + 3))
+        lines = np.sort(np.argsort(distance, kind="stable")[:n_lines])
+        zl = z[lines]
+        basis = np.column_stack([term(mu[q])[lines] for q in inside] + [term(mu[q].conj())[lines] for q in inside]
+                                + [np.ones_like(zl), 1.0 / zl, 1.0 / zl**2])
+        coef, *_ = np.linalg.lstsq(basis, flat[lines], rcond=None)
+        u, _, _ = np.linalg.svd(coef[0].reshape(n_out, m), full_matrices=False)
         shapes[:, r] = u[:, 0]
     lead = np.argmax(np.abs(shapes), axis=0)
     return shapes / shapes[lead, np.arange(n_picked)][None, :]
 
 
-def _with_shapes(estimates, S, omega, beta, dt, blocks_dS, scale):
+def _with_shapes(estimates, S, omega, beta, dt, blocks_dS, scale, n_lags):
     """The estimates with shapes from one residue fit at all their poles together (LSFD: only the poles the
     stabilisation kept, so that no spurious pole of an order takes a share of a mode's residue), and the
     shapes' errors from the fit repeated on the half-spectra and poles moved by each block's deviation."""
@@ -91,14 +124,14 @@ def _with_shapes(estimates, S, omega, beta, dt, blocks_dS, scale):
     if not estimates:
         return estimates
     poles = np.array([e.pole for e in estimates])
-    unit = _lsfd_shapes(S, omega, poles - beta, dt, poles.size)
+    unit = _lsfd_shapes(S, omega, poles - beta, dt, poles.size, n_lags)
     d_unit = None
     if blocks_dS is not None and all(e.pole_deviation is not None for e in estimates):
         d_pole = np.column_stack([e.pole_deviation for e in estimates])  # (blocks, modes)
         d_unit = np.empty((d_pole.shape[0],) + unit.shape, complex)
         for b in range(d_pole.shape[0]):
-            plus = _lsfd_shapes(S + blocks_dS[b], omega, poles + d_pole[b] - beta, dt, poles.size)
-            minus = _lsfd_shapes(S - blocks_dS[b], omega, poles - d_pole[b] - beta, dt, poles.size)
+            plus = _lsfd_shapes(S + blocks_dS[b], omega, poles + d_pole[b] - beta, dt, poles.size, n_lags)
+            minus = _lsfd_shapes(S - blocks_dS[b], omega, poles - d_pole[b] - beta, dt, poles.size, n_lags)
             d_unit[b] = (plus - minus) / 2
     out = []
     for r, estimate in enumerate(estimates):
@@ -168,6 +201,6 @@ def plscf(prepared: Prepared, refs, max_order=None, workers: int = 1):
     estimates, chosen, kept = estimates_from_clusters(flat, clusters, perturb, len(orders),
                                                       prepared.scale[np.asarray(refs, int)],
                                                       representative="upper_half", workers=workers)
-    estimates = _with_shapes(estimates, S, omega, beta, 1.0 / fs, blocks_dS, prepared.scale)
+    estimates = _with_shapes(estimates, S, omega, beta, 1.0 / fs, blocks_dS, prepared.scale, n_lags)
     settings = {"orders": [orders[0], orders[-1]], "lags": n_lags, "window_decay_per_s": float(beta)}
     return estimates, chosen, kept, flat, stable, corr, settings
