@@ -149,7 +149,7 @@ def oma(data, sample_rate_hz: float | None = None, *, band_hz=None, method: str 
     IdentificationResult
         One :class:`~modal.results.ModeResult` per structural mode, in order of frequency:
         ``natural_frequency_hz``, ``damping_ratio``, ``mode_shape`` (complex, one entry per channel,
-        largest entry 1), ``mpc``, ``std`` (frequency, damping and shape), ``flags``; k, c, m and the
+        the largest entry the record determines 1), ``mpc``, ``std`` (frequency, damping and shape), ``flags``; k, c, m and the
         modal constant are NaN until the modes are scaled (:func:`modal.scale_by_mass_change`).
         ``stabilisation`` holds the diagram (:class:`~modal.operational.selection.OMAStabilisation`),
         ``harmonics_hz`` the machine tones found.

@@ -56,7 +56,7 @@ def error_blocks(duration_s: float, poles: np.ndarray, n_available: int) -> int:
 
 
 def _physical_shape(unit_shape: np.ndarray, d_unit: np.ndarray | None, scale: np.ndarray):
-    """The shape in the channels' own units, largest entry 1, and the standard error of each entry.
+    """The shape in the channels' own units, its largest determined entry 1, and the standard error of each entry.
 
     ``unit_shape`` was found on unit-RMS channels (its largest entry 1, so its deviations ``d_unit``
     (blocks, channels) vanish there); the channels' RMS ``scale`` brings it back. The entry the shape is

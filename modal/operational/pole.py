@@ -20,7 +20,8 @@ class PoleEstimate:
     pole : complex
         Continuous-time pole λ, rad/s.
     shape : ndarray, shape (n_channels,), complex
-        Observed shape over the channels, largest-magnitude entry 1.
+        Observed shape over the channels, its largest-magnitude entry 1 among those the record determines
+        (:func:`modal.operational.modes._physical_shape`).
     std_frequency_hz, std_damping_ratio : float
         Standard errors of the natural frequency (Hz) and damping ratio (NaN where the method gives none).
     std_shape : ndarray, shape (n_channels,)
