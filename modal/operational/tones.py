@@ -46,7 +46,7 @@ from ..parallel import map_over_threads
 from .inputs import Prepared
 from .pole import PoleEstimate
 
-__all__ = ["separate_tones", "nearly_undamped", "zero_damping", "resolved_decays", "band_kurtosis", "strongest_line_hz", "harmonic_of",
+__all__ = ["separate_tones", "warn_speed_off_the_tones", "nearly_undamped", "zero_damping", "resolved_decays", "band_kurtosis", "strongest_line_hz", "harmonic_of",
            "KURTOSIS_LIMIT", "TONE_DAMPING", "MIN_DECAYS", "flag_mains_hum", "line_ratio", "MAINS_HZ", "HUM_TOLERANCE", "HUM_LINE_RATIO"]
 
 #: a pole whose damping ratio is below this with its error (ζ + 3σ_ζ) has nearly zero damping
@@ -257,7 +257,30 @@ def separate_tones(estimates: list[PoleEstimate], prepared: Prepared, rotor_spee
         is_tone.append(tone)
         added = set() if tone else {f for f, holds in (("harmonic", on_comb), ("tone_like", is_peaky(k))) if holds}
         out.append(replace(estimate, flags=estimate.flags | added) if added else estimate)
+    if rotor_speed_hz is not None:
+        warn_speed_off_the_tones([e for e, t in zip(estimates, is_tone) if t], rotor_speed_hz, prepared.source)
     return is_tone, out
+
+
+def warn_speed_off_the_tones(tones: list[PoleEstimate], rotor_speed_hz: float, source: str) -> bool:
+    """Warn (and return True) when the record's machine tones (mains lines left aside) lie on no harmonic of
+    the running speed given: a nameplate speed where the motor slips (an induction motor runs 1-5 % slow under
+    load), rpm given as Hz, or the tones of another machine. The ``harmonic`` flags then follow a comb that is
+    not the record's; the fundamental the tones share, when two or more do, is named."""
+    from ..errors import QualityWarning, warn
+
+    own = [t for t in tones if not any(abs(t.natural_frequency_hz - k * mains) <= HUM_TOLERANCE * k * mains
+                                       for mains in MAINS_HZ for k in range(1, MAINS_HARMONICS + 1))]
+    if not own or any(harmonic_of(t.natural_frequency_hz, t.std_frequency_hz, rotor_speed_hz) for t in own):
+        return False
+    frequencies = sorted(t.natural_frequency_hz for t in own)
+    fundamental = _fundamental([t.natural_frequency_hz for t in own], [t.std_frequency_hz for t in own])
+    shared = f"; they are harmonics of {fundamental:.5g} Hz ({60 * fundamental:.5g} rpm)" if fundamental else ""
+    warn(f"{source}: the machine tones found ({', '.join(f'{f:.5g}' for f in frequencies)} Hz) lie on no harmonic "
+         f"of the running speed given, {rotor_speed_hz:.5g} Hz ({60 * rotor_speed_hz:.5g} rpm){shared}: check the "
+         "speed (a motor's slip under load, rpm given as Hz, another machine's tones); the 'harmonic' flags follow "
+         "the speed given", QualityWarning)
+    return True
 
 
 def line_ratio(samples: np.ndarray, sample_rate_hz: float, frequency_hz: float) -> float:
