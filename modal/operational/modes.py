@@ -70,8 +70,8 @@ def _physical_shape(unit_shape: np.ndarray, d_unit: np.ndarray | None, scale: np
         lead = int(np.argmax(np.abs(raw)))
         return raw / raw[lead], np.full(scale.size, np.nan)
     unit_std = np.sqrt(np.sum(np.abs(d_unit) ** 2, axis=0))
-    determined = np.abs(unit_shape) > DETERMINED_SIGMAS * unit_std  # (the unit shape's own lead always is)
-    lead = int(np.argmax(np.where(determined, np.abs(raw), -1.0)))
+    determined = np.abs(unit_shape) > DETERMINED_SIGMAS * unit_std  # (the unit shape's own lead is, unless NaN)
+    lead = int(np.argmax(np.where(determined, np.abs(raw), -1.0) if determined.any() else np.abs(raw)))
     shape = raw / raw[lead]
     d_raw = d_unit * scale[None, :]
     d_shape = (d_raw - shape[None, :] * d_raw[:, lead][:, None]) / raw[lead]

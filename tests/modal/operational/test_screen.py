@@ -185,6 +185,20 @@ def test_loud_noise_channel_is_named_and_leaves_the_shapes_alone(record):
         assert abs(mode.mode_shape[5]) <= 3 * mode.std.mode_shape[5]
 
 
+def test_shape_lead_is_a_determined_entry_or_the_largest_when_none_is():
+    from modal.operational.modes import _physical_shape
+
+    unit = np.array([0.5, 1.0, 0.2 + 0.1j])  # found on unit-RMS channels, its own lead (entry 1) exact
+    scale = np.array([1.0, 2.0, 1000.0])  # the third channel 1000 times louder
+    deviations = np.zeros((5, 3), complex)
+    deviations[:, 2] = 0.5  # the third entry undetermined (0.22 against errors of 1.1)
+    shape, std = _physical_shape(unit, deviations, scale)
+    assert shape[1] == 1 and abs(shape[2]) > 1 and std[2] > abs(shape[2]) / 3
+    # no errors at all (NaN deviations): the largest entry, as without error bars
+    shape, std = _physical_shape(unit, np.full((5, 3), np.nan), scale)
+    assert shape[2] == 1 and np.all(np.isnan(std))
+
+
 def test_hammer_force_among_the_responses_is_named(record):
     # a hammer's force channel of unknown unit left in the record: a train of short pulses, no mode in it
     n = record.signals.shape[1]
