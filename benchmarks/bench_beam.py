@@ -1,4 +1,4 @@
-"""The global method on the measured free-free beam (data/real, three driving-point and transfer FRFs).
+"""The global method on the measured free-free beam (data/real, three transfer FRFs of a roving-hammer test).
 
 Prints the synthesis error |model − data| / |data| over 20–990 Hz (median and 90th percentile, the figures
 tests/modal/global_/test_global.py holds to 4 % and 9 %) and every mode with its flags, lines per half-power

@@ -12,19 +12,21 @@ every method, in one order:
 2. the exponential window's damping taken out of the pole
    (:func:`modal.window_damping.remove_window_damping`);
 3. k, c, m of the driving points with their covariance, and the flags on the
-   way (``complex_mode``, ``non_positive_constant``, ``not_driving_point``);
+   way (``complex_mode``, ``non_positive_constant``, ``not_driving_point``), and none on a driving
+   point whose constants change sign between modes (``driving_point_contradicted``);
 4. one :class:`~modal.results.ModeResult` per mode, and a warning per flagged mode
    that names every flag and why (:data:`modal.flags.FLAG_TEXT`).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Sequence
 
 import numpy as np
 
 from .errors import IdentificationError, QualityWarning, ResolutionWarning, warn_caller
-from .flags import COMPLEX_PHASE_DEG, FLAG_TEXT, OVERLAP_LIMIT, REL_STD_LIMIT, RESOLUTION_FLAGS, overlap, serious_flags
+from .flags import (COMPLEX_PHASE_DEG, FLAG_TEXT, OVERLAP_LIMIT, REL_STD_LIMIT, RESOLUTION_FLAGS, SIGN_SIGMAS, overlap,
+                    serious_flags)
 from .results import ModeResult, ModeStd, correlation_of, physical_covariance, physical_parameters
 from .units import TWO_PI
 from .validate import channel_mask
@@ -187,7 +189,7 @@ def assemble_modes(estimates: Sequence[ModeEstimate], *, method: str, source: st
     omega_n = np.array([e.omega_n for e in estimates], float)
     damping_ratio = np.array([e.damping_ratio for e in estimates], float)
     overlaps = [overlap(omega_n, damping_ratio, index) for index in range(len(estimates))]
-    modes = []
+    modes, details, below_zero = [], [], []
     for estimate, mode_overlap in zip(estimates, overlaps):
         flags = set(estimate.flags)
         wn, zeta = estimate.omega_n, estimate.damping_ratio
@@ -242,9 +244,43 @@ def assemble_modes(estimates: Sequence[ModeEstimate], *, method: str, source: st
             quality=estimate.quality, window_damping_ratio=window_zeta,
             mode_shape=estimate.mode_shape, participation=estimate.participation, mpc=estimate.mpc,
             kcm_correlation=None if cov_kcm is None else correlation_of(cov_kcm[0] if single else cov_kcm)))
-        serious = serious_flags(flags_t)
+        details.append(estimate.details)
+        below_zero.append(np.nan_to_num(const.real + SIGN_SIGMAS * np.sqrt(np.maximum(cov[:, 2, 2], 0)), nan=1.0) < 0)
+    if driving is not None and modes:
+        contradicted = np.asarray(driving, bool) & np.any(below_zero, axis=0)
+        if contradicted.any():
+            modes = [_contradicted(mode, contradicted, single) for mode in modes]
+    for mode, detail in zip(modes, details):
+        serious = serious_flags(mode.flags)
         if serious:
             category = ResolutionWarning if serious & RESOLUTION_FLAGS else QualityWarning
-            reasons = "; ".join(f"{f}: {FLAG_TEXT[f]}{estimate.details.get(f, '')}" for f in sorted(serious))
-            warn_caller(f"{source}: {method} mode near {wn / TWO_PI:.6g} Hz is flagged ({reasons})", category)
+            reasons = "; ".join(f"{f}: {FLAG_TEXT[f]}{detail.get(f, '')}" for f in sorted(serious))
+            warn_caller(f"{source}: {method} mode near {mode.natural_frequency_hz:.6g} Hz is flagged ({reasons})",
+                        category)
     return tuple(modes)
+
+
+def _contradicted(mode: ModeResult, channels: np.ndarray, single: bool) -> ModeResult:
+    """``mode`` without k, c, m on ``channels`` (driving points whose constants change sign between modes, so
+    none: flag ``driving_point_contradicted``)."""
+    def cleared(value):
+        if value is None:
+            return None
+        if single:
+            return float("nan")
+        out = np.array(value, dtype=float)
+        out[channels] = np.nan
+        return out
+
+    std = replace(mode.std, stiffness_n_per_m=cleared(mode.std.stiffness_n_per_m),
+                  damping_n_s_per_m=cleared(mode.std.damping_n_s_per_m), mass_kg=cleared(mode.std.mass_kg))
+    correlation = mode.kcm_correlation
+    if correlation is not None:
+        correlation = np.array(correlation, dtype=float)
+        if single:
+            correlation[...] = np.nan
+        else:
+            correlation[channels] = np.nan
+    return replace(mode, stiffness_n_per_m=cleared(mode.stiffness_n_per_m),
+                   damping_n_s_per_m=cleared(mode.damping_n_s_per_m), mass_kg=cleared(mode.mass_kg), std=std,
+                   kcm_correlation=correlation, flags=tuple(sorted({*mode.flags, "driving_point_contradicted"})))

@@ -12,7 +12,7 @@ from .frf import line_spacing
 
 __all__ = ["FLAG_TEXT", "FLAG_ACTION", "CHI2_LIMIT", "RELATIVE_MISFIT", "REL_STD_LIMIT", "OVERLAP_LIMIT", "BIAS_LIMIT",
            "COMPLEX_PHASE_DEG", "MPC_LIMIT", "WEAK_FRACTION", "RIGID_BODY_RATIO", "HARMONIC_TOLERANCE",
-           "HARMONIC_SIGMAS", "KURTOSIS_LIMIT", "MIN_DECAYS", "MIN_SHIFT_SIGMAS", "MAX_SCALE_ERROR", "MAX_LOCATION_MISFIT", "GRID_FLAGS", "RESOLUTION_FLAGS", "RULE_FLAGS",
+           "HARMONIC_SIGMAS", "KURTOSIS_LIMIT", "MIN_DECAYS", "MIN_SHIFT_SIGMAS", "MAX_SCALE_ERROR", "MAX_LOCATION_MISFIT", "SIGN_SIGMAS", "GRID_FLAGS", "RESOLUTION_FLAGS", "RULE_FLAGS",
            "INFORMATIONAL", "serious_flags", "DRIVING_POINT_ONLY", "TRANSFER_ONLY", "lines_near_mode", "model_inadequate", "overlap",
            "channel_flags", "contradictions", "flags_markdown"]
 
@@ -25,6 +25,11 @@ CHI2_LIMIT = 3.0
 #: into one peak show 4.5 % (three modes, exact data) and 5.3 % (a pair 1 Hz apart, 0.2 % noise). On noisy
 #: data chi-square alone decides: a misfit of 3 noise σ there is above this fraction already.
 RELATIVE_MISFIT = 0.03
+#: a driving point's modal constant whose real part lies more than this many standard errors below zero shows the
+#: channel is no driving point (a driving point's constants are all positive: A = φ_dp²), and its other modes'
+#: positive constants give no k, c, m either (flag driving_point_contradicted); 3 σ: a right driving point's
+#: weak mode with a constant near zero falls below it by noise in 0.13 % of estimates (one-sided Gaussian)
+SIGN_SIGMAS = 3.0
 #: relative standard error of ζ above which an estimate is flagged high_uncertainty
 REL_STD_LIMIT = 0.1
 #: modal overlap 2·max(ζωn)/|Δωn| with another mode above which close_modes is raised: up to 1.5 the
@@ -99,6 +104,10 @@ FLAG_TEXT = {
     "complex_mode": (f"modal constant of a driving point is far from real (phase > {COMPLEX_PHASE_DEG:g} deg): "
                      "k, c, m are approximate"),
     "non_positive_constant": "driving-point modal constant has a negative real part: k, c, m not defined",
+    "driving_point_contradicted": (f"the channel taken as a driving point has another mode whose modal constant's "
+                                   f"real part lies more than {SIGN_SIGMAS:g} standard errors below zero, where a "
+                                   "driving point's constants are all positive: the channel is a transfer FRF (or "
+                                   "its point ids or declaration are wrong); k, c, m not given on it for any mode"),
     "close_modes": ("another mode lies within this mode's fitting band, or overlaps it "
                     f"(2*zeta*wn/delta_wn > {OVERLAP_LIMIT:g}): the standard errors understate the scatter"),
     "missing_mode": ("the residual holds another mode in or next to this band that peak detection missed (one more "
@@ -202,6 +211,9 @@ FLAG_ACTION = {
     "complex_mode": "check for close modes or non-proportional damping; k, c, m use |A| and are approximate",
     "non_positive_constant": "check the sign convention of the force and response channels and the driving-point "
                              "declaration; k, c, m are not reported",
+    "driving_point_contradicted": ("check which channel was measured at the excitation point (--driving-point, "
+                                   "driving_point=, or the file's point ids): that channel's modal constants are "
+                                   "all positive; a channel whose constants change sign is a transfer FRF"),
     "close_modes": "fit the close modes together (method nls with a --band per mode, or method global)",
     "missing_mode": "give --band for both modes, or lower the peak threshold (min_prominence_db)",
     "window_damping_dominates": "measure with a longer exponential window time constant tau",
@@ -230,7 +242,7 @@ RESOLUTION_FLAGS = GRID_FLAGS | {"outside_band"}
 #: Flags :func:`modal.assemble.assemble_modes` raises by its shared rules (a result assembled again, as by
 #: mass-change scaling or merging setups, starts from the method's own flags without these).
 RULE_FLAGS = frozenset({"high_uncertainty", "close_modes", "driving_point_unknown", "window_damping_dominates",
-                        "complex_mode", "non_positive_constant", "not_driving_point"})
+                        "complex_mode", "non_positive_constant", "not_driving_point", "driving_point_contradicted"})
 #: Flags that describe the setting, not a defect (``ModeResult.ok`` ignores them). ``driving_point_assumed``
 #: is no longer raised (k, c, m only where the driving point is known or declared) but archives written
 #: before still carry it, and read back their modes as they were judged then.
@@ -244,7 +256,8 @@ def serious_flags(flags) -> set[str]:
 
 
 #: Flags about a driving-point channel's constant (never on a transfer channel).
-DRIVING_POINT_ONLY = frozenset({"complex_mode", "non_positive_constant", "units_unknown"})
+DRIVING_POINT_ONLY = frozenset({"complex_mode", "non_positive_constant", "units_unknown",
+                                "driving_point_contradicted"})
 #: Flags about a transfer channel (never on a driving-point channel).
 TRANSFER_ONLY = frozenset({"not_driving_point"})
 

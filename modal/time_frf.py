@@ -13,7 +13,7 @@ import re
 from dataclasses import dataclass, replace
 from typing import Callable
 
-from .errors import FormatError
+from .errors import FormatError, ParameterError
 from .estimate import estimate_frf
 from .frf import DEFAULT_UNITS, FRF_KINDS
 
@@ -125,6 +125,13 @@ def plan_time_frf(record, args, report: Callable[[str], None] | None = None,
         not tell and the options do not give.
     """
     src = record.source
+    if not getattr(args, "impact", False):  # checked before any estimate: a scene refuses it in its check
+        window, decay = getattr(args, "window", None), getattr(args, "exponential_decay_s", None)
+        if window in ("force", "exponential") or decay is not None:
+            given = f"{option('window')} {window!r}" if window in ("force", "exponential") else \
+                option("exponential_decay_s")
+            raise ParameterError(f"{src}: {given} is for impact records (one record per hit); expected "
+                                 f"{option('impact')} as well, or a continuous record's window ('rect' or 'hann')")
     if args.excitation is not None:
         inputs = [record.channel_index(args.excitation)]
     else:

@@ -274,8 +274,10 @@ def test_driving_point_option_and_unknown_driving_point_in_table(tmp_path):
     assert {r["channel"] for r in rows} == {1, 2, 3}
     assert {r["channel"] for r in rows if r["driving_point"]} == {1}
     assert doc["driving_point"] == {"known_from": "declared", "channels": [1]}
-    assert any(r["stiffness_n_per_m"] is not None for r in rows if r["channel"] == 1)
-    assert all(r["stiffness_n_per_m"] is None for r in rows if r["channel"] != 1)
+    # the real beam's channel 1 is no driving point (its constants change sign): declared one, it says so and
+    # gives no k, c, m (a true driving point's do: plain.csv below)
+    assert all(r["stiffness_n_per_m"] is None for r in rows)
+    assert all("driving_point_contradicted" in r["flags"] for r in rows if r["channel"] == 1)
     for wrong in ("0", "4"):
         bad = run("modal", "fit", *REAL, "--frequency-step", "1", "--kind", "accelerance", "--driving-point", wrong)
         assert bad.returncode == 1 and f"--driving-point {wrong}: no such channel; expected a channel number 1..3" \
@@ -292,6 +294,9 @@ def test_driving_point_option_and_unknown_driving_point_in_table(tmp_path):
     assert unknown["driving_point"]["known_from"] == "unknown" and unknown["driving_point"]["channels"] == []
     assert "--driving-point" in unknown["driving_point"]["how_to_declare"]
     assert all(r["stiffness_n_per_m"] is None and r["mass_kg"] is None for r in unknown["modes"])
+    declared = json.loads(run("modal", "fit", tmp_path / "plain.csv", "--json", "--driving-point", "1").stdout)
+    assert declared["driving_point"] == {"known_from": "declared", "channels": [1]}
+    assert all(r["stiffness_n_per_m"] is not None and not r["flags"] for r in declared["modes"]), declared["modes"]
     plot = run("modal", "fit", tmp_path / "plain.csv", "--plot", tmp_path / "p.png", "--channel", "2")
     assert plot.returncode == 1 and "--channel 2: no such channel; expected 1..1" in plot.stderr
     assert not (tmp_path / "p.png").exists()
@@ -435,21 +440,32 @@ archive = true
 """
 
 
-def _beam_scene(tmp_path, mode, accept=""):
-    path = tmp_path / f"beam_{mode}_{bool(accept)}.toml"
-    path.write_text(_BEAM_SCENE.format(file=REAL[0].as_posix(), mode=mode, accept=accept))
+def _driving_point_file(tmp_path):
+    """A driving-point accelerance on 1 Hz lines as the beam's: two clean modes, then a pair 1 % apart that nls takes
+    for one mode (flagged model_inadequate)."""
+    path = tmp_path / "driving_point.txt"
+    if not path.exists():  # the beam files' layout: one complex value per line, no frequency axis
+        frf = modal_frf(np.arange(1001.0), [100.0, 300.0, 600.0, 606.0], [0.02, 0.005, 0.01, 0.01],
+                        [1.0, 0.5, 0.8, 0.6], kind="accelerance")
+        path.write_text("".join(f"{complex(v)!r}\n" for v in np.atleast_2d(add_noise(frf, 1e-4, seed=3).response)[0]))
     return path
 
 
-def _beam_flags():
-    frf = read_frf(REAL[0], frequency_step=1.0, kind="accelerance")
+def _beam_scene(tmp_path, mode, accept=""):
+    path = tmp_path / f"beam_{mode}_{bool(accept)}.toml"
+    path.write_text(_BEAM_SCENE.format(file=_driving_point_file(tmp_path).as_posix(), mode=mode, accept=accept))
+    return path
+
+
+def _beam_flags(tmp_path):
+    frf = read_frf(_driving_point_file(tmp_path), frequency_step=1.0, kind="accelerance")
     from modal.flags import INFORMATIONAL
 
     return [sorted(set(m.flags) - INFORMATIONAL) for m in _identify_driving(frf, "nls")]
 
 
 def test_scene_refuses_a_flagged_mode_and_says_which_mode_it_used(tmp_path):
-    flags = _beam_flags()
+    flags = _beam_flags(tmp_path)
     flagged = next(i for i, f in enumerate(flags) if f) + 1
     refused = run("balancer", "run", _beam_scene(tmp_path, flagged), "--out", tmp_path / "a.h5", cwd=tmp_path)
     assert refused.returncode == 1, refused.stderr
@@ -689,7 +705,7 @@ def test_readme_walkthrough_runs_as_written_and_its_numbers_are_the_tools(tmp_pa
         done = subprocess.run([sys.executable, *args], capture_output=True, text=True, cwd=ROOT, timeout=180)
         assert done.returncode == 0, (line, done.stderr)
         outputs.append(done.stdout)
-    fit, again, driving, scene, hammer = outputs
+    fit, again, driving, hammer = outputs
     assert (out / "beam.png").stat().st_size > 0 and (out / "beam.h5").exists()
 
     # 1. the global fit: how many modes, how many clean, each frequency named, and the flags named
@@ -711,27 +727,28 @@ def test_readme_walkthrough_runs_as_written_and_its_numbers_are_the_tools(tmp_pa
     # 2. the archive fitted again gives the same modes
     again_hz = sorted({m["natural_frequency_hz"] for m in json.loads(again)["modes"]})
     assert np.allclose(again_hz, sorted(f for f, _ in modes.values()), atol=1e-3), again_hz
-    # 3. the driving point alone: k, c, m, and the flag named
-    # (driving_point_unknown is what the text says an undeclared driving point gives: the first command's files
-    # hold no point ids and declare none)
+    # 3. file 1 declared a driving point: its constants (those the text quotes) change sign, every mode is flagged
+    # driving_point_contradicted and none has k, c, m (driving_point_unknown is what the text says an undeclared
+    # driving point gives: the first command's files hold no point ids and declare none)
     named = set(re.findall(r"`(\w+)`", items[3]))
     assert "k [N/m]" in driving and all(flag in driving for flag in named - {"driving_point_unknown"})
     assert "driving_point_unknown" in named and "driving_point_unknown" not in driving
     assert all("driving_point_unknown" in flags for _, flags in modes.values()), modes
-    # 4. the beam scene's rotor mode
-    mode, hz = re.search(r"takes mode (\d+) \(([\d.]+) Hz, no flag\)", items[4]).groups()
-    used = re.search(rf"mode {mode} at ([\d.]+) Hz, .*flags: none", scene)
-    assert used and _same_as_printed(hz, float(used.group(1))), scene
-    assert (out / "beam_scene.h5").exists()
-    # 5. the hammer scene: the truth is the generator's, the printed k, c, M are the tool's, and the text's claim
+    rows = [line.split() for line in driving.splitlines() if re.match(r"\s+\d+\s+\d", line)]
+    quoted = re.search(r"\(([-\d., ]+) 1/kg", items[3]).group(1).split(", ")
+    assert len(rows) == len(quoted) == 6, (rows, quoted)
+    for row, constant in zip(rows, quoted):
+        assert _same_as_printed(constant, complex(row[7]).real), (constant, row)
+        assert row[8:11] == ["n/a"] * 3 and "driving_point_contradicted" in row[-1], row
+    # 4. the hammer scene: the truth is the generator's, the printed k, c, M are the tool's, and the text's claim
     # about them holds
     spec = importlib.util.spec_from_file_location("generate", ROOT / "data" / "synthetic" / "generate.py")
     generate = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(generate)
-    hits = re.findall(r"(\w+) hits", items[5])
+    hits = re.findall(r"(\w+) hits", items[4])
     assert hits and all((_WORDS[n] if n in _WORDS else int(n)) == len(generate.HAMMER_HIT_TIMES_S) for n in hits), hits
     assert f"{len(generate.HAMMER_HIT_TIMES_S)} average(s)" in hammer and "0 hit(s) rejected" in hammer
-    truth, printed = items[5].split("It prints")
+    truth, printed = items[4].split("It prints")
     balls = 2 * 0.02  # the scene's [adb] n x m: the test was made with the balls in
     true = {"k": generate.RIG_STIFFNESS_N_PER_M, "c": generate.RIG_DAMPING_N_S_PER_M, "M": generate.RIG_MASS_KG - balls}
     units = {"k": "N/m", "c": "N s/m", "M": "kg"}

@@ -20,7 +20,7 @@ from ..units import TWO_PI
 
 __all__ = [
     "HINTS", "check_hints", "check_file", "refuse_copies", "source_name", "resolve_kind", "frequency_factor",
-    "frequency_unit_from_text", "build_frf", "KIND_ALIASES",
+    "frequency_unit_from_text", "build_frf", "KIND_ALIASES", "refuse_cut_last_value",
 ]
 
 #: Keyword hints accepted by :func:`modal.io.read_frf` (a reader uses those that apply).
@@ -223,3 +223,40 @@ def hint_frequency_axis(hints: dict[str, Any], n_lines: int, src: str, why: str)
         f"{src}: {why}; expected frequency_hz= (the lines) or frequency_step= "
         "(and frequency_start=, default 0) to say where the lines are"
     )
+
+
+def refuse_cut_last_value(text: str, rows: list[tuple[int, list[str]]], column: str, src: str) -> None:
+    """Refuse a text table whose last number was cut: the file ends inside it.
+
+    A file cut while being written or copied ends without a line break, its last row short of
+    fields (each reader says so) or its last field cut inside a number: ``1.234567e-03`` cut to
+    ``1.2345`` still parses, to a wrong value. The cut is decidable when the file ends without a
+    line break inside a last value shorter than every other of its column (fixed-width writers:
+    ``%.6e``, spreadsheets); it is not with writers of varying widths (``%g``, ``repr``) whose cut
+    value stays as long as their shortest, and then it reads as written.
+
+    Parameters
+    ----------
+    text : str
+        The whole file.
+    rows : list of (int, list of str)
+        The data rows: line number (1-based) and fields, the last field being the last column.
+    column : str
+        The last column's name, for the message.
+    src : str
+        The file's name.
+
+    Raises
+    ------
+    FormatError
+        Naming the line and column, when the last value is cut.
+    """
+    if len(rows) < 3 or text.endswith(("\n", "\r")) or rows[-1][0] != len(text.splitlines()):
+        return
+    line_no, last = rows[-1]
+    shortest = min(len(fields[-1]) for _, fields in rows[:-1])
+    if len(last[-1]) < shortest:
+        raise FormatError(f"{src}: line {line_no}, column {column!r}: {last[-1]!r} is shorter than every other "
+                          f"value of its column ({shortest} characters or more) and the file ends inside it, "
+                          f"without a line break (cut short?); expected whole rows (delete line {line_no} to "
+                          "read the rest)")

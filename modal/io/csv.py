@@ -45,7 +45,7 @@ from ..frf import FRF
 from ._atomic import atomic_path
 from ._common import (
     build_frf, check_file, frequency_factor, frequency_unit_from_text, hint_frequency_axis,
-    normalise_kind, resolve_kind, source_name,
+    normalise_kind, refuse_cut_last_value, resolve_kind, source_name,
 )
 
 __all__ = ["read_frf_csv", "write_frf_csv", "LAYOUTS", "CANONICAL_FORMAT"]
@@ -180,6 +180,8 @@ def _read_text(text: str, src: str, hints: dict[str, Any]) -> FRF:
     is_complex = "j" in data[0][1].lower()
     layout = _layout(hints, names, is_complex, canonical, n_cols, src, data[0][0])
     col_names = names or [f"column {k + 1}" for k in range(n_cols)]
+    if not text.endswith(("\n", "\r")) and len(_split(data[-1][1], delim)) == n_cols:
+        refuse_cut_last_value(text, [(n, _split(ln, delim)) for n, ln in data], col_names[-1], src)
     if layout == "complex":
         table = _parse_complex(data, delim, decimal, n_cols, col_names, src)
     else:

@@ -37,7 +37,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import FormatError, QualityWarning, warn
-from ._common import check_file, source_name
+from ._common import check_file, refuse_cut_last_value, source_name
 from .csv import choose_delimiter
 from .mat import _MAX_ELEMENTS_PER_BYTE
 
@@ -466,6 +466,7 @@ def _read_csv(path, src: str) -> TimeRecord:
                 else ""
             raise FormatError(f"{src}: line {line_no}: {len(row)} columns{last}; expected {len(header)} like the "
                               f"header (line {header_line}) in every row")
+    refuse_cut_last_value(text, rows[1:], header[-1], src)
     try:
         table = np.array([row for _, row in rows[1:]], dtype=float)
     except ValueError:

@@ -14,6 +14,10 @@ Mapping of the dataset 58 records into :class:`~modal.frf.FRF`:
   11/13 mobility, 12/13 accelerance; anything else needs ``kind=`` (never guessed).
 * several FRF datasets on one frequency axis → one multi-channel FRF, in file
   order; on different axes → an error unless ``dataset=`` (1-based) picks some.
+* a file that ends inside a dataset is refused; one cut exactly between datasets is well formed,
+  so it is only caught when the FRFs end inside a group of channels their own order implies
+  (a warning, :func:`cut_group`); a cut single-reference file reads as a smaller complete one
+  (``modal fit`` prints the channel count read).
 
 Precision (the format's, not pyuff's choice): ASCII dataset 58 writes double
 ordinates as E20.12 Fortran fields, 12 significant digits (relative rounding
@@ -37,7 +41,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import FormatError, ModalWarning, warn
+from ..errors import FormatError, ModalWarning, warn, warn_caller
 from ..frf import FRF
 from ._atomic import atomic_path
 from ._common import build_frf, check_file, frequency_factor, resolve_kind, source_name
@@ -343,6 +347,10 @@ def _assemble(chosen: list[_Block], parts: list[dict], src: str, hints: dict[str
     if units is not None and file_kind is None and hints.get("units") is None:
         units = None  # labels of an unknown quantity are not an FRF unit we can vouch for
     resp = np.array([p["h"] for p in parts])
+    short = cut_group(chosen, parts)
+    if short:
+        warn_caller(f"{src}: {short}; the file may be cut between datasets (a file cut there reads as a smaller "
+                    "complete one): expected the same channels in every group")
 
     def points(key):
         if all(p[key][0] == 0 for p in parts):
@@ -351,6 +359,40 @@ def _assemble(chosen: list[_Block], parts: list[dict], src: str, hints: dict[str
 
     return build_frf(first["freq"], resp, kind, src, response_points=points("rsp"),
                      reference_points=points("ref"), units=units, hints=hints)
+
+
+def cut_group(chosen: list[_Block], parts: list[dict]) -> str | None:
+    """What says the FRF datasets end inside a group their own order implies, or None.
+
+    A measurement grid written group by group (every response for one reference, then the next
+    reference; or every reference for one response) and cut between datasets ends on a group that
+    holds the first few channels of the others: the test here. Each group must be one run of
+    datasets, every group but the last must list the same channels in the same order, and the last
+    must list a strict start of them.
+
+    Not decidable, so not said: a cut file of a single group (one reference, or one roving hammer
+    response), a cut that falls exactly between groups, or files without point ids (node 0).
+    """
+    pairs = [(part["rsp"], part["ref"]) for part in parts]
+    if any(rsp[0] == 0 or ref[0] == 0 for rsp, ref in pairs):
+        return None
+    for key, other, names in ((1, 0, ("reference", "response")), (0, 1, ("response", "reference"))):
+        runs: list[tuple[tuple[int, int], list]] = []
+        for pair in pairs:
+            if runs and runs[-1][0] == pair[key]:
+                runs[-1][1].append(pair[other])
+            else:
+                runs.append((pair[key], [pair[other]]))
+        if len(runs) < 2 or len({k for k, _ in runs}) != len(runs):
+            continue
+        full = runs[0][1]
+        head, (last_key, last) = runs[:-1], runs[-1]
+        if any(r != full for _, r in head) or len(last) >= len(full) or last != full[:len(last)]:
+            continue
+        missing = ", ".join(format_point(*q) for q in full[len(last):])
+        return (f"{chosen[-1].where()}: the last {names[0]} {format_point(*last_key)} has {len(last)} "
+                f"{names[1]}(s) where each of the other {len(head)} has {len(full)} (missing {missing})")
+    return None
 
 
 _INT_FIELDS = {

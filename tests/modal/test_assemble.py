@@ -138,3 +138,38 @@ def test_an_output_only_method_hands_over_shapes_and_gets_the_shared_rules_witho
     assert np.all(np.isnan(first.mass_kg)) and np.all(np.isnan(first.modal_constant))
     assert first.driving_point.tolist() == [False] * 3 and first.kcm_correlation is None
     assert np.array_equal(first.mode_shape, shape) and first.natural_frequency_hz == pytest.approx(20.0, rel=1e-15)
+
+
+def test_a_driving_point_whose_constants_change_sign_gives_no_k_c_m_for_any_mode():
+    # a transfer channel declared a driving point (its modes' constants 0.5 and -0.8, errors 1e-4): the second mode
+    # was flagged non_positive_constant, but the first got k, c, m from a channel that cannot be a driving point
+    # (a driving point's constants are all positive, A = φ²); the other, true driving point keeps them
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", QualityWarning)
+        modes = assemble([estimate(100.0, const=(1.0, 0.5)), estimate(300.0, const=(0.6, -0.8))], single=False,
+                         driving=(True, True))
+    for mode in modes:
+        assert np.isfinite(mode.mass_kg[0]) and np.isnan(mode.mass_kg[1])
+        assert np.isnan([mode.stiffness_n_per_m[1], mode.damping_n_s_per_m[1], mode.std.stiffness_n_per_m[1],
+                         mode.std.mass_kg[1]]).all() and np.isnan(mode.kcm_correlation[1]).all()
+        assert "driving_point_contradicted" in mode.flags
+    assert "non_positive_constant" not in modes[0].flags and "non_positive_constant" in modes[1].flags
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        (one, _) = assemble([estimate(100.0, const=(0.5,)), estimate(300.0, const=(-0.8,))])
+    assert np.isnan(one.mass_kg) and "driving_point_contradicted" in one.flags
+    texts = [str(w.message) for w in said]
+    assert any("mode near 100 Hz is flagged (driving_point_contradicted: the channel taken as a driving point" in t
+               for t in texts), texts
+
+
+def test_a_driving_points_constant_within_three_errors_of_zero_contradicts_nothing():
+    # a mode near a node of the driving point: its constant -2.9e-4 with errors 1e-4 is zero within 3 of them
+    # (noise), the other mode keeps k, c, m; at -3.1e-4 the sign is significant
+    for const, contradicted in ((-2.9e-4, False), (-3.1e-4, True)):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", QualityWarning)
+            first, second = assemble([estimate(100.0, const=(0.5,)), estimate(300.0, const=(const,))])
+        assert np.isfinite(first.mass_kg) != contradicted
+        assert ("driving_point_contradicted" in second.flags) == contradicted
+        assert "non_positive_constant" in second.flags

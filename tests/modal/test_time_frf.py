@@ -69,3 +69,18 @@ def test_k_c_m_of_a_time_record_only_where_its_point_ids_or_the_user_say_where_t
     assert same.results[0].modes[0].flags == () and np.isfinite(same.results[0].modes[0].mass_kg)
     other = fit_path(_time_csv(tmp_path / "other.csv", names=("3+Z", "4+Z")), FitOptions(method="nls"))
     assert other.results[0].modes[0].flags == ("not_driving_point",)
+
+
+def test_impact_options_without_impact_are_refused_naming_the_file_and_the_options(tmp_path):
+    import pytest
+
+    from modal.errors import ParameterError
+
+    path = _time_csv(tmp_path / "record.csv")
+    for options, given in ((FitOptions(window="force"), "--window 'force'"),
+                           (FitOptions(window="exponential", exponential_decay_s=0.5), "--window 'exponential'"),
+                           (FitOptions(exponential_decay_s=0.5), "--exponential-decay-s")):
+        with pytest.raises(ParameterError) as caught:
+            frf_from_time(path, options.namespace(), None)
+        message = str(caught.value)
+        assert message.startswith(f"{path}: {given} is for impact records") and "--impact as well" in message, message

@@ -109,6 +109,10 @@ def _time_scene(tmp_path, **frf):
     ({"frequency_step": 1.0}, ["key 'frf.frequency_step' applies to an FRF file", "time record"]),
     ({"overlap": 1.0}, ["key 'frf.overlap' = 1.0", "0 <= f < 1"]),
     ({"window": "hamming"}, ["key 'frf.window'", "'force'"]),
+    # a hammer record's impact options without impact = true: refused in the check (was one line naming neither the
+    # scene nor its key once the estimate ran: "error: field 'window': 'force' is for impact records")
+    ({"window": "force"}, ["key 'frf'", "frf.window 'force' is for impact records", "frf.impact as well"]),
+    ({"window": "hann", "exponential_decay_s": 0.3}, ["frf.exponential_decay_s is for impact records"]),
 ])
 def test_a_time_record_in_a_scene_is_checked_before_any_work(tmp_path, frf, words):
     from balancer.scene import parse_scene

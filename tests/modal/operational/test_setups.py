@@ -128,3 +128,16 @@ def test_a_mode_left_out_for_its_references_is_said_to_be_found_not_missing():
                for t in texts), texts
     mode2 = [m for m in merged if abs(m.natural_frequency_hz / FN[1] - 1) < 0.005]
     assert len(mode2) == 1 and "missing_in_setup" in mode2[0].flags
+
+
+def test_a_reference_moved_where_half_the_modes_disagree_is_refused():
+    # setup 2's second reference on channel 4 instead of 5: three of the six modes' reference entries disagree
+    # (MAC < 0.8); the three that pass (3.1, 7.4 and 17.5 Hz at MAC 0.999, 0.86 and 0.93) are a right setup's values
+    # too (right setups: every mode >= 0.94, none disagreeing, benchmarks.calib_merge_references), so the passing
+    # modes would merge at a wrong scale, as they did before (half was not "most")
+    one = anchor_record(0, noise=0.1, tones=False, duration_s=300)
+    two = anchor_record(1, noise=0.1, tones=False, duration_s=300)
+    first, moved = _oma(one.signals[SETUP1]), _oma(two.signals[[0, 4, 6, 7, 1]])
+    with pytest.raises(ParameterError, match=r"setup 2 \(<array>\): the reference channels \[0, 1\] disagree with "
+                                             r"setup 1's \[0, 1\] in 3 of the 6 modes both hold.*a moved"):
+        modal.merge_setups([first, moved], reference_channels=[0, 1])
