@@ -272,7 +272,7 @@ def _least_squares_fits(frf, bands, power, noise, estimated_noise, known_noise, 
         if not np.all(np.isfinite(fit.noise_var)):
             flags.add("too_few_points")  # no lines left over for a residual: no errors
         elif not np.all(np.isfinite(fit.mode_cov[r])):
-            flags.add("high_uncertainty")  # errors undetermined: the data do not determine a pole (nls.FISHER_RCOND)
+            flags.add("high_uncertainty")  # errors undetermined: the data do not determine a pole (pole_covariance.FISHER_RCOND)
         if model_inadequate(chi2, relative[b]):
             flags.add("model_inadequate")
         cov = fit.mode_cov[r] if shift is None else with_shift(fit.mode_cov[r], shift[0][r], shift[1][r])
