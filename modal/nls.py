@@ -18,6 +18,7 @@ import numpy as np
 
 from .channel_covariance import relative_in_fit_units
 from .pole_covariance import fill_covariance
+from .record_variance import channel_influence_in_fit_units
 from .whitening import LineWhitening
 
 __all__ = ["NLSFit", "RowResidual", "fit_modes", "orthonormal_factor", "truncation_shift"]
@@ -338,8 +339,8 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
         Evaluations of the model (each a design and its projection, the unit of the fit's work) after the
         start's, at most; the fit stops there, not converged, with ``capped`` set (None: no limit but
         ``max_iter``; 0: the start's poles, with their errors).
-    record_influence : ndarray, shape (n_records, n_freq), optional
-        One channel estimated from records: each record's share of its error on the lines, FRF unit
+    record_influence : ndarray, shape (n_records, n_freq) or (n_channels, n_records, n_freq), optional
+        Channels estimated from records: each record's share of their error on the lines, FRF unit
         (:mod:`modal.estimate.record_influence`); the poles' covariance is then measured over the records
         (:mod:`modal.record_variance`; ``overlapping_records`` following records overlap each), where it
         can be, in place of the one above.
@@ -532,6 +533,9 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
             influence = np.asarray(record_influence, complex).T * inverse_scale[0]
             influence = influence if weight is None else influence * weight
             records = (influence if whitening is None else whitening(influence), overlapping_records)
+        elif record_influence is not None and np.ndim(record_influence) == 3 and len(record_influence) == n_ch:
+            records = (channel_influence_in_fit_units(record_influence, inverse_scale, weight, whitening),
+                       overlapping_records)
         common = None if relative_error is None or n_ch == 1 else relative_in_fit_units(
             relative_error, response, inverse_scale, weight, whitening)
         record_errors = fill_covariance(mode_cov, dphi, Q, R, Cm, noise_var, correlated_lags, residual, region,

@@ -13,7 +13,7 @@ from collections.abc import Callable
 import numpy as np
 
 from .channel_covariance import channel_sandwich, relative_error_terms, sandwich_product, widened
-from .record_variance import misfit_ratio, projected_scores, record_covariance
+from .record_variance import channel_scores, misfit_ratio, projected_scores, record_covariance
 
 __all__ = ["FISHER_RCOND", "NULL_WEIGHT", "fill_covariance", "lag_covariance", "line_scores", "pole_covariance"]
 
@@ -93,8 +93,9 @@ def fill_covariance(mode_cov, dphi, Q, R, Cm, noise_var, correlated_lags=0, resi
     With ``correlated_lags`` > 0 and a ``residual`` (:class:`modal.nls.RowResidual`, FRF unit; ``inverse_scale``
     takes it to the fit's) whose lines correlate over those lags (several channels, or ``residual_correlated()``
     says so: a Ljung–Box test), the poles' covariance is the Newey–West sandwich F⁻¹ B F⁻¹ instead (see
-    :func:`modal.nls.fit_modes`). ``records`` (one channel: the records'
-    influences in the fit's units, (n_freq, n_records), and the records each overlaps): the poles' covariance
+    :func:`modal.nls.fit_modes`). ``records`` (the records'
+    influences in the fit's units, (n_freq, n_records) for one channel or (n_freq, n_channels, n_records) for
+    several, and the records each overlaps): the poles' covariance
     measured over the records where it can be (:func:`modal.record_variance.record_covariance`); returns
     whether it was. ``common``: an error the channels share (:func:`modal.channel_covariance.relative_error_terms`)."""
     n_theta = dphi.shape[1]
@@ -117,13 +118,18 @@ def fill_covariance(mode_cov, dphi, Q, R, Cm, noise_var, correlated_lags=0, resi
             E, Q, Cm, common, dphi.shape[0] - Q.shape[1] - n_theta / (2 * Cm.shape[1]))
         cov_theta = channel_sandwich(bread, gram, Cm, noise_var, shared) if several else pole_covariance(F)
         measured = None
+        by_channel = records is not None and records[0].ndim == 3  # several channels' (n_freq, n_ch, n_records)
         if records is not None and np.all(np.isfinite(cov_theta)):
-            measured = record_covariance(np.real((E.conj().T @ E) * (Cm.conj() @ Cm.T)),
-                                         projected_scores(E, Cm[:, 0], records[0]), records[1])
+            scores = channel_scores(E, Cm, records[0]) if by_channel else projected_scores(E, Cm[:, 0], records[0])
+            measured = record_covariance(np.real((E.conj().T @ E) * (Cm.conj() @ Cm.T)), scores, records[1])
         if measured is not None:  # widened by a misfit the records do not see (see misfit_ratio)
-            off = records[0] - Q @ (Q.conj().T @ records[0])
+            influence = records[0].reshape(dphi.shape[0], -1) if by_channel else records[0]
+            off = influence - Q @ (Q.conj().T @ influence)
+            if by_channel:  # the channels' terms of one record summed in the Gram matrix of the records
+                off = off.reshape(records[0].shape).reshape(-1, records[0].shape[2])
             dof = dphi.shape[0] - Q.shape[1] - n_theta / (2 * Cm.shape[1])
-            ratio = misfit_ratio(float(noise_var[0]) * dof, off, records[1])
+            ratio = misfit_ratio(float(np.sum(noise_var)) * dof if by_channel else float(noise_var[0]) * dof, off,
+                                 records[1])
             cov_theta, from_records = measured * max(ratio, 1.0) if np.isfinite(ratio) else measured, True
         elif correlated_lags > 0 and np.all(np.isfinite(cov_theta)) and (several or (
                 residual_correlated is not None and residual_correlated())):
