@@ -77,16 +77,19 @@ def channel_influence(inputs: np.ndarray, outputs: np.ndarray, frf: np.ndarray,
     ndarray, shape (n_outputs · n_inputs, n_records, n_lines), complex, channels ordered as the estimate's
     (output by output, input by input within one), or None where a value is not finite.
     """
+    n_records, n_in, n_lines = inputs.shape
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        residual = outputs - np.einsum("opk,ipk->iok", frf, inputs)  # R_io, (records, outputs, lines)
+        residual = np.array(outputs, complex)  # R_io = Y_io − Σ_p Ĥ_op X_ip, (records, outputs, lines)
+        for p in range(n_in):
+            residual -= frf[None, :, p, :] * inputs[:, None, p, :]
         try:
             inverse = np.linalg.inv(np.moveaxis(input_power, -1, 0))  # (lines, inputs, inputs)
         except np.linalg.LinAlgError:
             return None
-        products = residual[:, :, None, :] * inputs.conj()[:, None, :, :]  # R_io conj(X_ip), (i, o, p, k)
-        influence = np.einsum("iopk,kpq->oqik", products, inverse)
-    n_out, n_in, n_records, n_lines = influence.shape
-    influence = influence.reshape(n_out * n_in, n_records, n_lines)
+        # Σ_p conj(X_ip) [S_xx⁻¹]_pq once per record and input q, (records, inputs, lines); then times each R_io
+        weights = np.einsum("ipk,kpq->iqk", inputs.conj(), inverse)
+        influence = residual[:, :, None, :] * weights[:, None, :, :]  # (records, outputs, inputs, lines)
+    influence = influence.transpose(1, 2, 0, 3).reshape(-1, n_records, n_lines)
     return influence if np.all(np.isfinite(influence)) else None
 
 
