@@ -641,7 +641,7 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
     model = _noise_model(sums, output_correlation, in_w, out_w, fs, factor, decay_s=exponential_decay_s,
                          frf=frf3 if estimator == "H1" else None, quiet=quiet,
                          overlapping=0 if impact else overlapping_records(length, step),
-                         withheld=measured and not keep_records and estimator == "H1",
+                         withheld=measured and not keep_records and (n_in * n_out == 1 or estimator == "H1"),
                          excitation=(x[0], starts, length) if impact and n_in == 1 else None)
 
     if not impact and repeats_every([x[i] for i in range(x.shape[0])], length):

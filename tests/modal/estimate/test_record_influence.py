@@ -82,7 +82,7 @@ def test_conversions_and_crops_carry_the_influences(record):
                                rtol=1e-9, atol=1e-12 * np.abs(influence[:, 1:] / omega**2).max())
 
 
-def test_several_channels_carry_each_records_share_of_their_errors():
+def test_several_channels_carry_each_records_share_of_their_errors(monkeypatch):
     # two independent forces, two outputs: Ĥ_o = S_yx,o S_xx⁻¹, so record i's share of channel (o, q) is
     # Σ_p R_iop conj(X_ip) [S_xx⁻¹]_pq with R_io = Y_io − Ĥ_o X_i; as for one channel, the shares of every
     # channel sum to zero at every line (H1 leaves no residual correlated with any input), to rounding
@@ -114,6 +114,10 @@ def test_several_channels_carry_each_records_share_of_their_errors():
         alone = modal.estimate_frf(forces[0], responses[1], FS, segment_length=length)
     np.testing.assert_allclose(single.noise_model.record_influence[1], alone.noise_model.record_influence,
                                rtol=0, atol=1e-9 * np.abs(alone.noise_model.record_influence).max())
+    # the memory budget counts every channel's: 47 records × 513 lines fit in it once, not four times
+    monkeypatch.setattr(core, "MAX_INFLUENCE_VALUES", 2 * starts.size * (length // 2 + 1))
+    withheld = modal.estimate_frf(forces, responses, FS, segment_length=length).noise_model
+    assert withheld.record_influence is None and withheld.influence_withheld
 
 
 def test_errors_measured_over_the_records_take_no_truncation_shift(record, monkeypatch):
