@@ -143,8 +143,11 @@ class EstimatedFRF(FRF):
         pts = lambda ids: None if ids is None else (ids[index],)  # noqa: E731
         pick = lambda a: None if a is None else np.atleast_2d(a)[index]  # noqa: E731
         output = index // self.n_inputs
+        model = self.noise_model
+        if model is not None and model.record_influence is not None and model.record_influence.ndim == 3:
+            model = replace(model, record_influence=model.record_influence[index])  # that channel's records' shares
         return replace(self, response=self.channels[index], response_points=pts(self.response_points),
-                       reference_points=pts(self.reference_points), coherence=pick(self.coherence),
+                       noise_model=model, reference_points=pts(self.reference_points), coherence=pick(self.coherence),
                        noise_std=pick(self.noise_std), multiple_coherence=np.atleast_2d(
                            self.multiple_coherence)[output] if self.multiple_coherence is not None else None,
                        n_inputs=1)

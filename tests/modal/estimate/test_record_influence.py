@@ -114,6 +114,8 @@ def test_several_channels_carry_each_records_share_of_their_errors(monkeypatch):
         alone = modal.estimate_frf(forces[0], responses[1], FS, segment_length=length)
     np.testing.assert_allclose(single.noise_model.record_influence[1], alone.noise_model.record_influence,
                                rtol=0, atol=1e-9 * np.abs(alone.noise_model.record_influence).max())
+    # one channel taken out carries its own shares
+    np.testing.assert_array_equal(frf.channel(2).noise_model.record_influence, influence[2])
     # the memory budget counts every channel's: 47 records × 513 lines fit in it once, not four times
     monkeypatch.setattr(core, "MAX_INFLUENCE_VALUES", 2 * starts.size * (length // 2 + 1))
     withheld = modal.estimate_frf(forces, responses, FS, segment_length=length).noise_model
