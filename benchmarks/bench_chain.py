@@ -69,12 +69,12 @@ def system(damping_ratio=DAMPING_RATIO, n_outputs: int = 1) -> DigitalModes:
 
 
 def random_cell(duration_s: float, window: str = "hann", damping_ratio=DAMPING_RATIO, segment_length=None,
-                noise: float = 0.05):
+                noise: float = 0.05, n_outputs: int = 1):
     def make(seed: int):
-        structure = system(damping_ratio)
+        structure = system(damping_ratio, n_outputs)
         rec = random_record(structure, duration_s, response_noise=noise, force_noise=0.0, seed=seed).record
-        frf = modal.estimate_frf(rec.signals[0], rec.signals[1], rec.sample_rate_hz, window=window, kind="accelerance",
-                                 segment_length=segment_length)
+        frf = modal.estimate_frf(rec.signals[0], rec.signals[1] if n_outputs == 1 else rec.signals[1:],
+                                 rec.sample_rate_hz, window=window, kind="accelerance", segment_length=segment_length)
         return frf, structure
     return make
 
@@ -144,6 +144,38 @@ def roving_cell(n_hits: int, window: str = "exponential", n_points: int = 3, spa
     return make
 
 
+#: where the two shakers of the two-shaker cells sit (:data:`ACCELEROMETER_POSITIONS`' indices: 0.2 and 0.8), and the
+#: accelerometers (0.2, 0.35, 0.8: the shakers' driving points and one between)
+SHAKER_POINTS = (0, 2)
+TWO_SHAKER_OUTPUTS = 3
+
+
+def two_shaker_cell(duration_s: float = 120.0, noise: float = 0.05):
+    """Two independent white forces at two points of the beam (:data:`SHAKER_POINTS`), three accelerometers,
+    white noise of ``noise`` times each response's RMS; the FRF of both inputs estimated at once (H1 over the
+    two inputs, the default Hann segments). The system returned is the first input's (the poles are shared)."""
+    def make(seed: int):
+        x = np.array(ACCELEROMETER_POSITIONS[:TWO_SHAKER_OUTPUTS])
+        modes = np.arange(1, len(MODAL_CONSTANT) + 1)
+        shape = np.sin(np.pi * np.outer(x, modes)) / np.sin(np.pi * x[0] * modes)  # (outputs, modes)
+        rng = np.random.default_rng(seed)
+        n = int(round(duration_s * SAMPLE_RATE_HZ))
+        forces = rng.standard_normal((len(SHAKER_POINTS), n))
+        response = np.zeros((TWO_SHAKER_OUTPUTS, n))
+        structures = []
+        for point, force in zip(SHAKER_POINTS, forces):
+            constants = np.array(MODAL_CONSTANT)[None, :] * shape * shape[point]  # reciprocity: A_op = c φ_o φ_p
+            seen = DigitalModes(np.array(NATURAL_FREQUENCY_HZ), np.array(DAMPING_RATIO), constants, SAMPLE_RATE_HZ)
+            structures.append(seen)
+            response += seen.respond(force, "acceleration")
+        response += noise * np.sqrt(np.mean(response**2, axis=1))[:, None] * rng.standard_normal(response.shape)
+        frf = modal.estimate_frf(forces, response, SAMPLE_RATE_HZ, kind="accelerance",
+                                 excitation_points=[f"{p + 1}" for p in SHAKER_POINTS],
+                                 response_points=[f"{o + 1}" for o in range(TWO_SHAKER_OUTPUTS)])
+        return frf, structures[0]
+    return make
+
+
 #: the cells the chain is held to (z spread 0.75–1.3, |mean| ≤ 0.35 for fn and ζ of every mode)
 TARGET_CELLS = ("random-hann-default", "hammer-exp-6")
 
@@ -176,6 +208,13 @@ CELLS = {c.name: c for c in [
       for short, window, long in (("exp", "exponential", "exponential window τ = 0.5 s"),
                                   ("force", "force", "force window"))
       for hits in (3, 6, 12) for outputs in counts],
+    Cell("random-hann-ch3", "random, 120 s, Hann, default segments, one shaker, 3 accelerometers",
+         random_cell(120.0, n_outputs=3)),
+    # two shakers: band-wise nls over the six channels, and the default for a poly-reference grid (global)
+    Cell("shakers-2-ch3", "two shakers (independent white forces), 120 s, Hann, default segments, "
+         "3 accelerometers, 5 % response noise, method nls", two_shaker_cell(), {"method": "nls"}),
+    Cell("shakers-2-ch3-global", "two shakers as shakers-2-ch3, global method (identify's default for them)",
+         two_shaker_cell()),
     # a roving hammer: one accelerometer, the hammer at three points, one record per point, joined
     *[Cell(f"hammer-{short}-{hits}-roving3", f"roving hammer, 3 points × {hits} hits, {long}, one accelerometer",
            roving_cell(hits, window))

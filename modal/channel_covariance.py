@@ -30,7 +30,7 @@ def sandwich_product(bread: np.ndarray, middle: np.ndarray) -> np.ndarray:
 
 def widened(model: np.ndarray, measured: np.ndarray) -> np.ndarray:
     """The ``model`` covariance with each parameter's variance raised to the ``measured`` one's where that is
-    larger (the correlations kept). The residual's lag covariance (:func:`modal.nls._lag_covariance`) widens the errors
+    larger (the correlations kept). The residual's lag covariance (:func:`modal.pole_covariance.lag_covariance`) widens the errors
     where the lines correlate beyond the noise model, but it is biased low over the few lines near a peak that
     carry a pole: the fit leaves a residual orthogonal to its derivatives, so the lines' scores sum to zero and
     their lagged products cancel. Several channels: it only widens (on the multi-channel hammer cells of
@@ -43,7 +43,7 @@ def channel_sandwich(bread: np.ndarray, gram: np.ndarray, Cm: np.ndarray, noise_
                      common: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
     """Covariance of poles fitted by least squares that weighs every (scaled) channel alike while the channels'
     noise variances ``noise_var`` differ: B⁻¹ M B⁻¹ with ``bread`` B⁻¹ the inverse of the unweighted information
-    2 Re(Eᴴ E ∘ C̄ Cᵀ) (:func:`modal.nls._pole_covariance`; ``gram`` Eᴴ E, ``Cm`` C) and M = 2 Re(Eᴴ E ∘ C̄ diag(σ²) Cᵀ) the
+    2 Re(Eᴴ E ∘ C̄ Cᵀ) (:func:`modal.pole_covariance.pole_covariance`; ``gram`` Eᴴ E, ``Cm`` C) and M = 2 Re(Eᴴ E ∘ C̄ diag(σ²) Cᵀ) the
     covariance of that cost's gradient. Equal to the Fisher information's inverse where every σ² is equal; with
     unequal ones the Fisher inverse is the covariance of a fit weighing the channels by 1/σ², which this one is
     not (a channel twice as noisy as its scale says counts as much as a quiet one).

@@ -209,11 +209,11 @@ class FRF:
                 raise FRFValidationError(f"{src}: field 'noise_model' has a variance model over {variance.size} "
                                          f"lines; expected {freq.size} (one per line)")
             influence = self.noise_model.record_influence
-            if influence is not None and influence.shape[1] != freq.size:
+            if influence is not None and influence.shape[-1] != freq.size:
                 raise FRFValidationError(f"{src}: field 'noise_model' has records' influences over "
-                                         f"{influence.shape[1]} lines; expected {freq.size} (one per line)")
+                                         f"{influence.shape[-1]} lines; expected {freq.size} (one per line)")
             if order is not None and influence is not None:
-                object.__setattr__(self, "noise_model", replace(self.noise_model, record_influence=influence[:, order]))
+                object.__setattr__(self, "noise_model", replace(self.noise_model, record_influence=influence[..., order]))
             if order is not None and corr is not None:  # the lines were reordered: neighbours are not neighbours
                 object.__setattr__(self, "noise_model", replace(self.noise_model, line_correlation=None))
             if order is not None and variance is not None:

@@ -16,8 +16,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .channel_covariance import channel_sandwich, relative_error_terms, relative_in_fit_units, sandwich_product, widened
-from .record_variance import misfit_ratio, projected_scores, record_covariance
+from .channel_covariance import relative_in_fit_units
+from .pole_covariance import fill_covariance
+from .record_variance import channel_influence_in_fit_units
 from .whitening import LineWhitening
 
 __all__ = ["NLSFit", "RowResidual", "fit_modes", "orthonormal_factor", "truncation_shift"]
@@ -154,48 +155,6 @@ def _design(x, numerator, x_squared, params, out, dphi):
     return out, dphi
 
 
-#: eigenvalues of the poles' Fisher information (scaled to a unit diagonal) below this fraction of the largest
-#: count as zero: directions of the poles the data do not determine (two poles fitted onto one peak, a mode the
-#: lines cannot resolve). Its inverse there held rounding noise: variances of either sign, 1e7 times the data's
-#: spread, or spuriously small (stress: 8 modes at ζ ≈ 0.3, eigenvalue ratio −5e-17).
-FISHER_RCOND = 1e-12
-#: a parameter whose weight in such a direction exceeds this (of a unit eigenvector) is not determined: the
-#: weights of the determined ones there are rounding, ~eps over the gap to the next eigenvalue
-NULL_WEIGHT = 1e-6
-
-
-def _pole_covariance(F: np.ndarray) -> np.ndarray:
-    """Covariance of the poles from their Fisher information ``F`` (symmetric, finite): its inverse, with NaN
-    rows and columns for the parameters the data do not determine (see :data:`FISHER_RCOND`).
-
-    The plain inverse of ``F`` scaled to a unit diagonal (n parameters) serves when its variances are
-    positive and below 1/(n² ``FISHER_RCOND``): then no eigenvalue is below ``FISHER_RCOND`` of the largest
-    (the smallest is at least 1/(n · the largest variance), the largest at most n); otherwise the
-    eigen-decomposition decides.
-    """
-    s = np.sqrt(np.abs(np.diag(F)))
-    s[s == 0] = 1.0
-    scale = np.outer(s, s)
-    scaled = F / scale
-    try:
-        inverse = np.linalg.inv(scaled)
-        variance = np.diag(inverse)
-        if np.all(variance > 0) and variance.max() * F.shape[0] ** 2 * FISHER_RCOND < 1:
-            return inverse / scale
-    except np.linalg.LinAlgError:
-        pass
-    try:
-        eigenvalues, vectors = np.linalg.eigh(scaled)
-    except np.linalg.LinAlgError:
-        return np.full(F.shape, np.nan)
-    resolved = eigenvalues > FISHER_RCOND * eigenvalues[-1]
-    cov = (vectors[:, resolved] / eigenvalues[resolved]) @ vectors[:, resolved].T
-    loose = np.any(np.abs(vectors[:, ~resolved]) > NULL_WEIGHT, axis=1)
-    cov[loose, :] = np.nan
-    cov[:, loose] = np.nan
-    return cov / scale
-
-
 #: the residual counts as correlated between lines when its Ljung–Box statistic over the lags exceeds the
 #: chi-square quantile of this tail probability (white residuals pass 99 % of the time)
 WHITENESS_P = 0.01
@@ -223,29 +182,6 @@ def _residual_correlated(residual, lags: int, region) -> bool:
         rho = product.sum() / energy  # complex: real and imaginary parts each ~ N(0, 1/(2n)) when white
         statistic += 2 * n * n / (n - lag) * abs(rho) ** 2 * r.shape[0]
     return bool(statistic > chi2.ppf(1 - WHITENESS_P, 2 * lags))
-
-
-def _line_scores(E, Cm, weights, residual, inverse_scale) -> np.ndarray:
-    """Each line's contribution 2 Σ_c w_c Re(conj(∂r/∂θ_j) r) to the gradient of the weighted cost, (n_theta, n_freq)."""
-    scaled = residual[:] * inverse_scale[:, None]  # (n_ch, n_freq), the fit's units
-    finite = np.where(np.isfinite(weights), weights, 0.0)
-    combined = (Cm.conj() * finite) @ scaled  # (n_theta, n_freq): Σ_c w_c conj(C_jc) r_ck
-    return 2.0 * np.real(E.conj().T * combined)
-
-
-def _lag_covariance(scores: np.ndarray, lags: int, region) -> np.ndarray:
-    """Σ_ℓ (1 − |ℓ|/(L + 1)) Σ_k s_k s_{k+ℓ}ᵀ over |ℓ| ≤ L, pairs of lines in one region only."""
-    out = scores @ scores.T
-    n = scores.shape[1]
-    same = None if region is None else np.asarray(region)
-    for lag in range(1, min(lags, n - 1) + 1):
-        left, right = scores[:, :-lag], scores[:, lag:]
-        if same is not None:
-            keep = same[:-lag] == same[lag:]
-            left, right = left[:, keep], right[:, keep]
-        product = left @ right.T
-        out += (1.0 - lag / (lags + 1.0)) * (product + product.T)
-    return out
 
 
 def _compress(rows: np.ndarray, scale: np.ndarray, design: np.ndarray, derivatives: np.ndarray) -> np.ndarray:
@@ -328,82 +264,6 @@ def _project(Phi, Y, y_energy=None):
     return Q, R, QhY, float(np.vdot(res, res).real)
 
 
-def _fill_covariance(mode_cov, dphi, Q, R, Cm, noise_var, correlated_lags=0, residual=None, region=None,
-                     inverse_scale=None, records=None, common=None) -> bool:
-    """Covariance of (ωn, ζ, Re c, Im c) per mode and channel, in the fit's units, into ``mode_cov``
-    (n_modes, n_ch, 4, 4): the poles' from their Fisher information (the Schur complement, by the projected
-    Jacobian), the constants' from the linear fit's plus their sensitivity to the poles.
-
-    With ``correlated_lags`` > 0 and a ``residual`` (:class:`RowResidual`, FRF unit; ``inverse_scale`` takes
-    it to the fit's) whose lines a Ljung–Box test finds correlated over those lags, the poles' covariance is
-    the Newey–West sandwich F⁻¹ B F⁻¹ instead (see :func:`fit_modes`). ``records`` (one channel: the records'
-    influences in the fit's units, (n_freq, n_records), and the records each overlaps): the poles' covariance
-    measured over the records where it can be (:func:`modal.record_variance.record_covariance`); returns
-    whether it was. ``common``: an error the channels share (:func:`modal.channel_covariance.relative_error_terms`)."""
-    n_theta = dphi.shape[1]
-    n_modes = n_theta // 2
-    from_records = False
-    E = dphi - Q @ (Q.conj().T @ dphi)
-    gram = E.conj().T @ E
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        weights = np.where(noise_var > 0, 1.0 / noise_var, np.inf)
-        # a channel fitted exactly (residual 0) has infinite weight: F is then not finite and
-        # the covariance is zero (below); inf·0 inside the product is expected, not an error
-        F = 2 * np.real(gram * ((Cm.conj() * weights) @ Cm.T))
-    cov_theta = np.full((n_theta, n_theta), np.nan)
-    several = Cm.shape[1] > 1
-    if np.all(np.isfinite(F)):
-        # several channels: the fit weighs every scaled channel alike, not by its noise, so its poles' covariance
-        # is the sandwich of that unweighted cost (equal to F⁻¹ where the channels' noise is equal)
-        bread = _pole_covariance(2 * np.real(gram * (Cm.conj() @ Cm.T))) if several else None
-        shared = None if common is None else relative_error_terms(
-            E, Q, Cm, common, dphi.shape[0] - Q.shape[1] - n_theta / (2 * Cm.shape[1]))
-        cov_theta = channel_sandwich(bread, gram, Cm, noise_var, shared) if several else _pole_covariance(F)
-        measured = None
-        if records is not None and np.all(np.isfinite(cov_theta)):
-            measured = record_covariance(np.real((E.conj().T @ E) * (Cm.conj() @ Cm.T)),
-                                         projected_scores(E, Cm[:, 0], records[0]), records[1])
-        if measured is not None:  # widened by a misfit the records do not see (see misfit_ratio)
-            off = records[0] - Q @ (Q.conj().T @ records[0])
-            dof = dphi.shape[0] - Q.shape[1] - n_theta / (2 * Cm.shape[1])
-            ratio = misfit_ratio(float(noise_var[0]) * dof, off, records[1])
-            cov_theta, from_records = measured * max(ratio, 1.0) if np.isfinite(ratio) else measured, True
-        elif correlated_lags > 0 and np.all(np.isfinite(cov_theta)) and (several or _residual_correlated(
-                residual, correlated_lags, region)):
-            n_freq = dphi.shape[0]
-            dof = n_freq - Q.shape[1] - n_theta / (2 * Cm.shape[1])
-            scores = _line_scores(E, Cm, np.ones_like(weights) if several else weights, residual, inverse_scale)
-            middle = _lag_covariance(scores, correlated_lags, region) * (n_freq / dof if dof > 0 else np.nan)
-            sandwich = sandwich_product(bread, middle) if several else cov_theta @ middle @ cov_theta
-            if several and np.all(np.isfinite(sandwich)) and np.all(np.diag(cov_theta) > 0):
-                cov_theta = widened(cov_theta, sandwich)
-            elif np.all(np.isfinite(sandwich)) and np.all(np.diag(sandwich) > 0):
-                cov_theta = sandwich
-    elif np.all(noise_var == 0):
-        cov_theta = np.zeros((n_theta, n_theta))
-    # sensitivity of the linear coefficients to the poles: G_j = −Φ⁺ ∂Φ/∂θ_j C
-    Rinv = np.linalg.inv(R)
-    H = Rinv @ (Q.conj().T @ dphi)  # (n_b, n_theta)
-    lin_var = np.sum(np.abs(Rinv) ** 2, axis=1)  # diag (ΦᴴΦ)⁻¹
-    for r in range(n_modes):
-        G = -H[r][:, None] * Cm  # (n_theta, n_ch): ∂c_r/∂θ_j per channel
-        g_re, g_im = G.real, G.imag
-        blk = mode_cov[r]
-        idx = [2 * r, 2 * r + 1]
-        blk[:, :2, :2] = cov_theta[2 * r:2 * r + 2, 2 * r:2 * r + 2]
-        cross_re = cov_theta[idx] @ g_re  # (2, n_ch)
-        cross_im = cov_theta[idx] @ g_im
-        blk[:, :2, 2] = cross_re.T
-        blk[:, :2, 3] = cross_im.T
-        blk[:, 2, :2] = cross_re.T
-        blk[:, 3, :2] = cross_im.T
-        lin = noise_var / 2 * lin_var[r]
-        blk[:, 2, 2] = lin + np.einsum("jc,jk,kc->c", g_re, cov_theta, g_re)
-        blk[:, 3, 3] = lin + np.einsum("jc,jk,kc->c", g_im, cov_theta, g_im)
-        blk[:, 2, 3] = blk[:, 3, 2] = np.einsum("jc,jk,kc->c", g_re, cov_theta, g_im)
-    return from_records
-
-
 def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, damping_ratio0,
               region: np.ndarray | None = None, max_iter: int = 200, step_tol: float = 1e-13,
               background_powers: tuple[int, ...] = (0,), residual_terms: bool = False,
@@ -479,8 +339,8 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
         Evaluations of the model (each a design and its projection, the unit of the fit's work) after the
         start's, at most; the fit stops there, not converged, with ``capped`` set (None: no limit but
         ``max_iter``; 0: the start's poles, with their errors).
-    record_influence : ndarray, shape (n_records, n_freq), optional
-        One channel estimated from records: each record's share of its error on the lines, FRF unit
+    record_influence : ndarray, shape (n_records, n_freq) or (n_channels, n_records, n_freq), optional
+        Channels estimated from records: each record's share of their error on the lines, FRF unit
         (:mod:`modal.estimate.record_influence`); the poles' covariance is then measured over the records
         (:mod:`modal.record_variance`; ``overlapping_records`` following records overlap each), where it
         can be, in place of the one above.
@@ -673,10 +533,14 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
             influence = np.asarray(record_influence, complex).T * inverse_scale[0]
             influence = influence if weight is None else influence * weight
             records = (influence if whitening is None else whitening(influence), overlapping_records)
+        elif record_influence is not None and np.ndim(record_influence) == 3 and len(record_influence) == n_ch:
+            records = (channel_influence_in_fit_units(record_influence, inverse_scale, weight, whitening),
+                       overlapping_records)
         common = None if relative_error is None or n_ch == 1 else relative_in_fit_units(
             relative_error, response, inverse_scale, weight, whitening)
-        record_errors = _fill_covariance(mode_cov, dphi, Q, R, Cm, noise_var, correlated_lags, residual, region,
-                                         inverse_scale, records, common)
+        record_errors = fill_covariance(mode_cov, dphi, Q, R, Cm, noise_var, correlated_lags, residual, region,
+                                        inverse_scale, records, common,
+                                        lambda: _residual_correlated(residual, correlated_lags, region))
     # back to physical units: x → ω = x w_ref; c → A = c · ch_scale · w_ref^(2−p)
     a_scale = ch_scale * w_ref ** (2 - power)  # (n_ch,)
     unit = np.empty((n_ch, 4))  # each channel's (ωn, ζ, Re A, Im A) per fitted unit

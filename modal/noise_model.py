@@ -34,7 +34,7 @@ __all__ = ["NoiseModel", "window_line_correlation", "lag_window", "input_noise_s
 
 #: neighbouring lines whose noise correlation is carried, at most
 MAX_LAGS = 64
-#: records × lines whose influences a continuous estimate keeps at most (64 MiB of complex values, 160 MiB while
+#: records × lines (× channels) whose influences a continuous estimate keeps at most (64 MiB of complex values, 160 MiB while
 #: they are formed; 29 records × 4097 lines is 0.12 M); above, it carries none and identification reports the
 #: errors of the lines' correlation (:mod:`modal.estimate.record_influence`)
 MAX_INFLUENCE_VALUES = 1 << 22
@@ -76,11 +76,12 @@ class NoiseModel:
         noise found, several inputs, one record). Several outputs of one input: the part every channel's variance
         shares, a/S_xx with a the outputs' mean response-noise power (the excitation noise's part, b|H_o|², differs
         per channel).
-    record_influence : ndarray, shape (n_records, n_freq), complex, or None
+    record_influence : ndarray, shape (n_records, n_freq) or (n_channels, n_records, n_freq), complex, or None
         Each record's share of the estimate's error at each line, in the FRF's unit
         (:mod:`modal.estimate.record_influence`): identification measures its parameters' variance over
-        the records with them (:mod:`modal.record_variance`). None when not kept (one input and one output,
-        continuous records, at least :data:`MEASURED_CORRELATION_RECORDS` of them, within the memory budget).
+        the records with them (:mod:`modal.record_variance`). 2-D: one channel; 3-D: several channels (inputs or
+        outputs), each channel's over the same records. None when not kept (H1, continuous records, at least
+        :data:`MEASURED_CORRELATION_RECORDS` of them, within the memory budget).
     overlapping_records : int
         How many following records each record overlaps (1 for half-overlapping records; 0 without overlap).
     influence_withheld : bool
@@ -129,8 +130,9 @@ class NoiseModel:
             object.__setattr__(self, "variance_model", variance)
         if self.record_influence is not None:
             influence = np.array(self.record_influence, dtype=complex)
-            if influence.ndim != 2 or not np.all(np.isfinite(influence)):
-                raise FRFValidationError("field 'record_influence' must be a finite 2-D array (records × lines)")
+            if influence.ndim not in (2, 3) or not np.all(np.isfinite(influence)):
+                raise FRFValidationError("field 'record_influence' must be a finite array of records × lines "
+                                         "(or channels × records × lines)")
             influence.setflags(write=False)
             object.__setattr__(self, "record_influence", influence)
         if self.relative_error is not None:
@@ -166,7 +168,7 @@ class NoiseModel:
         Lines dropped from inside the run break the neighbour relation: the correlation is then dropped.
         """
         variance = None if self.variance_model is None else self.variance_model[keep]
-        influence = None if self.record_influence is None else self.record_influence[:, keep]
+        influence = None if self.record_influence is None else self.record_influence[..., keep]
         common = None if self.relative_error is None else self.relative_error[..., keep]
         if self.line_correlation is None:
             return replace(self, variance_model=variance, record_influence=influence, relative_error=common)

@@ -25,7 +25,8 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["record_covariance", "projected_scores", "misfit_ratio", "MIN_EFFECTIVE_RECORDS"]
+__all__ = ["record_covariance", "projected_scores", "channel_scores", "channel_influence_in_fit_units", "misfit_ratio",
+           "MIN_EFFECTIVE_RECORDS"]
 
 #: the covariance is measured where the records leave at least this many (after the overlap's and the mean's
 #: share, see the module; a standard error from 12 scatters by about 20 %) and outnumber the parameters (else
@@ -52,6 +53,31 @@ def projected_scores(derivatives: np.ndarray, coefficients: np.ndarray, influenc
     covariance.
     """
     return np.real(np.conj(coefficients)[:, None] * (derivatives.conj().T @ influence))
+
+
+def channel_scores(derivatives: np.ndarray, coefficients: np.ndarray, influence: np.ndarray) -> np.ndarray:
+    """Each record's score s_i = Σ_c Jᵀ ψ_ic of a variable-projection fit of several channels that weighs them
+    alike (the sum of :func:`projected_scores` over the channels), (n_theta, n_records).
+
+    ``coefficients`` (n_theta, n_channels); ``influence`` (n_freq, n_channels, n_records), each channel's ψ_i
+    transformed as its data (:func:`channel_influence_in_fit_units`).
+    """
+    projected = np.einsum("kj,kcr->jcr", derivatives.conj(), influence)  # (n_theta, n_ch, n_records)
+    return np.real(np.einsum("jc,jcr->jr", np.conj(coefficients), projected))
+
+
+def channel_influence_in_fit_units(influence: np.ndarray, inverse_scale: np.ndarray, weight: np.ndarray | None,
+                                   whitening) -> np.ndarray:
+    """Several channels' records' influences (n_channels, n_records, n_freq), FRF unit, as the fit sees its
+    data: each channel over its scale (``inverse_scale``), times the line ``weight`` (n_freq, 1), whitened;
+    (n_freq, n_channels, n_records)."""
+    out = np.asarray(influence, complex).transpose(2, 0, 1) * inverse_scale[None, :, None]
+    if weight is not None:
+        out = out * weight[:, :, None]
+    if whitening is not None:
+        n_freq, n_ch, n_records = out.shape
+        out = whitening(np.ascontiguousarray(out.reshape(n_freq, n_ch * n_records))).reshape(n_freq, n_ch, n_records)
+    return out
 
 
 def record_covariance(information: np.ndarray, scores: np.ndarray, overlapping: int = 0) -> np.ndarray | None:

@@ -28,7 +28,7 @@ from . import spectra
 from .excitation_noise import EXCITATION_NOISE_LIMIT, excitation_noise_share
 from .common_error import common_error_factor
 from .error_correlation import LEAKAGE_LAGS, MIN_RECORDS, measured_line_correlation
-from .record_influence import MAX_INFLUENCE_VALUES, overlapping_records, record_influence
+from .record_influence import MAX_INFLUENCE_VALUES, channel_influence, overlapping_records, record_influence
 from .hits import find_hits, pulse_train
 from .levels import level_dependence, take_dependence
 from .overload import find_overloads
@@ -143,8 +143,11 @@ class EstimatedFRF(FRF):
         pts = lambda ids: None if ids is None else (ids[index],)  # noqa: E731
         pick = lambda a: None if a is None else np.atleast_2d(a)[index]  # noqa: E731
         output = index // self.n_inputs
+        model = self.noise_model
+        if model is not None and model.record_influence is not None and model.record_influence.ndim == 3:
+            model = replace(model, record_influence=model.record_influence[index])  # that channel's records' shares
         return replace(self, response=self.channels[index], response_points=pts(self.response_points),
-                       reference_points=pts(self.reference_points), coherence=pick(self.coherence),
+                       noise_model=model, reference_points=pts(self.reference_points), coherence=pick(self.coherence),
                        noise_std=pick(self.noise_std), multiple_coherence=np.atleast_2d(
                            self.multiple_coherence)[output] if self.multiple_coherence is not None else None,
                        n_inputs=1)
@@ -173,7 +176,8 @@ def _noise_model(sums, output_correlation, input_window, output_window, sample_r
     One input: the errors of lines k and k + m correlate by c_out(m) Σ conj(X_k) X_{k+m} / √(S_xx,k S_xx,k+m)
     (the response noise's window correlation times the excitation's own, over the records), and the lag window
     follows from the excitation's mean square per sample; an exponential window's decay is divided out of it
-    (identification removes that damping exactly). Several inputs: the averages and the lag window.
+    (identification removes that damping exactly). Several inputs: the averages, the lag window and the records'
+    influences.
 
     One input and one output with ``frf`` (H1, shape (1, 1, n_lines)) and more than one record: the
     excitation's own noise enters the estimate as −H N_x X*/S_xx, an error in proportion to H that correlates
@@ -192,8 +196,10 @@ def _noise_model(sums, output_correlation, input_window, output_window, sample_r
     Continuous records (``sums.error_products`` summed): the correlation measured over the records
     (:func:`~modal.estimate.error_correlation.measured_line_correlation`) replaces the window's model.
 
-    Records kept one by one (``sums.record_cross``): each record's share of the error
-    (:func:`~modal.estimate.record_influence.record_influence`), ``overlapping`` the records each overlaps;
+    Records kept one by one (``sums.record_cross``; several channels, ``sums.record_input`` and
+    ``sums.record_output``): each record's share of the error
+    (:func:`~modal.estimate.record_influence.record_influence`,
+    :func:`~modal.estimate.record_influence.channel_influence`), ``overlapping`` the records each overlaps;
     ``withheld``: they were not kept, over the memory budget.
 
     One record (a single hit) has no residual over records: ``quiet`` (:func:`~modal.estimate.quiet.quiet_noise`,
@@ -209,7 +215,9 @@ def _noise_model(sums, output_correlation, input_window, output_window, sample_r
         lags = lag_window(input_window, output_window, sums.excitation_square / sums.n_records)
         if decay_s is not None:
             lags = lags * np.exp(np.arange(lags.size) * interval / decay_s)
-        return NoiseModel(sums.n_records, dof, None, lags, interval)
+        influence = _channel_influence(sums, frf)
+        return NoiseModel(sums.n_records, dof, None, lags, interval, record_influence=influence,
+                          overlapping_records=overlapping if influence is not None else 0, influence_withheld=withheld)
     power = sums.sxx[0, 0].real
     n_lags, n_lines = sums.sxx_lag.shape
     correlation = np.zeros((n_lags, n_lines), complex)
@@ -261,8 +269,18 @@ def _noise_model(sums, output_correlation, input_window, output_window, sample_r
     influence = None
     if sums.record_cross is not None and frf is not None and frf.shape[:2] == (1, 1):
         influence = record_influence(sums.record_cross, sums.record_power, frf[0, 0], power)
+    elif frf is not None:
+        influence = _channel_influence(sums, frf)
     return NoiseModel(sums.n_records, dof, correlation, lags, interval, variance, influence,
                       overlapping if influence is not None else 0, withheld, common)
+
+
+def _channel_influence(sums, frf: np.ndarray | None) -> np.ndarray | None:
+    """Several channels' records' influences (:func:`~modal.estimate.record_influence.channel_influence`), or
+    None where the records' spectra were not kept or the estimate is not H1 (``frf`` None)."""
+    if frf is None or sums.record_input is None:
+        return None
+    return channel_influence(sums.record_input, sums.record_output, frf, sums.sxx)
 
 
 def _shared_variance(sums, frf: np.ndarray, power: np.ndarray) -> tuple[np.ndarray, float]:
@@ -592,8 +610,8 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
     window_lags = lags_carried(output_correlation, length // 2 + 1)
     # continuous records, enough of them: the errors' correlation is also measured over the records
     measured = not impact and starts.size >= MIN_RECORDS
-    # ... and each record's share of it kept, within a memory budget
-    keep_records = measured and starts.size * (length // 2 + 1) <= MAX_INFLUENCE_VALUES
+    # ... and each record's share of it kept (of every channel), within a memory budget
+    keep_records = measured and starts.size * (length // 2 + 1) * x.shape[0] * y.shape[0] <= MAX_INFLUENCE_VALUES
     sums = spectra.accumulate(x, y, starts, length, in_w, out_w, lags=window_lags,
                               error_lags=max(window_lags, LEAKAGE_LAGS) if measured else 0,
                               keep_records=keep_records)
@@ -626,7 +644,7 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
     model = _noise_model(sums, output_correlation, in_w, out_w, fs, factor, decay_s=exponential_decay_s,
                          frf=frf3 if estimator == "H1" else None, quiet=quiet,
                          overlapping=0 if impact else overlapping_records(length, step),
-                         withheld=measured and not keep_records and n_in == 1 and n_out == 1,
+                         withheld=measured and not keep_records and (n_in * n_out == 1 or estimator == "H1"),
                          excitation=(x[0], starts, length) if impact and n_in == 1 else None)
 
     if not impact and repeats_every([x[i] for i in range(x.shape[0])], length):

@@ -48,6 +48,10 @@ class SpectralSums:
     record_cross, record_power : ndarray, shape (n_records, n_lines), optional
         One input and one output, when asked: each record's Y conj(X) (complex) and |X|² (real), the terms
         of the sums above record by record (:mod:`modal.estimate.record_influence`).
+    record_input : ndarray, shape (n_records, n_inputs, n_lines), optional
+    record_output : ndarray, shape (n_records, n_outputs, n_lines), optional
+        Several channels (inputs or outputs), when asked: each record's spectra X and Y, windowed as summed
+        (:func:`modal.estimate.record_influence.channel_influence`).
     """
 
     sxx: np.ndarray
@@ -59,6 +63,8 @@ class SpectralSums:
     error_products: np.ndarray | None = None
     record_cross: np.ndarray | None = None
     record_power: np.ndarray | None = None
+    record_input: np.ndarray | None = None
+    record_output: np.ndarray | None = None
 
 
 def _records(signal, starts: np.ndarray, length: int) -> np.ndarray:
@@ -90,7 +96,8 @@ def accumulate(excitation, response, starts, length: int, input_window: np.ndarr
     error_lags : int
         One input and one output: also sum the ``error_products`` over this many lags (0: not).
     keep_records : bool
-        One input and one output: also keep each record's ``record_cross`` and ``record_power``.
+        Also keep each record's terms: one input and one output, ``record_cross`` and ``record_power``; several
+        channels, ``record_input`` and ``record_output``.
     """
     starts = np.asarray(starts, dtype=np.int64)
     n_in, n_out = excitation.shape[0], response.shape[0]
@@ -103,9 +110,12 @@ def accumulate(excitation, response, starts, length: int, input_window: np.ndarr
     square = np.zeros(length)
     error_lags = min(error_lags, n_lines - 1) if one_input and n_out == 1 else 0
     products = np.zeros((4, error_lags + 1, n_lines), complex) if error_lags > 0 else None
+    keep_spectra = keep_records and not (one_input and n_out == 1)
     keep_records = keep_records and one_input and n_out == 1
     record_cross = np.zeros((starts.size, n_lines), complex) if keep_records else None
     record_power = np.zeros((starts.size, n_lines)) if keep_records else None
+    record_input = np.zeros((starts.size, n_in, n_lines), complex) if keep_spectra else None
+    record_output = np.zeros((starts.size, n_out, n_lines), complex) if keep_spectra else None
     per_record = (n_in + n_out) * n_lines * 16 + (n_in + n_out) * length * 8
     block = max(1, int(_BLOCK_BYTES // max(per_record, 1)))
     for first in range(0, starts.size, block):
@@ -129,7 +139,11 @@ def accumulate(excitation, response, starts, length: int, input_window: np.ndarr
                 _add_error_products(products, cross, power)
             if keep_records:
                 record_cross[first:first + chunk.size], record_power[first:first + chunk.size] = cross, power
-    return SpectralSums(sxx, syx, syy, int(starts.size), sxx_lag, square, products, record_cross, record_power)
+        if keep_spectra:
+            record_input[first:first + chunk.size] = x.transpose(1, 0, 2)
+            record_output[first:first + chunk.size] = y.transpose(1, 0, 2)
+    return SpectralSums(sxx, syx, syy, int(starts.size), sxx_lag, square, products, record_cross, record_power,
+                        record_input, record_output)
 
 
 def _add_error_products(products: np.ndarray, cross: np.ndarray, power: np.ndarray) -> None:

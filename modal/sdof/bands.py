@@ -208,15 +208,22 @@ def whitening_on_lines(frf, keep):
     return whitening
 
 
-def band_influence(frf, bands):
-    """Each record's share of the error on the bands' lines, (n_records, n_lines), and the records each overlaps,
-    for a one-channel FRF whose noise model carries them (:mod:`modal.estimate.record_influence`); else
-    (None, 0)."""
+def band_influence(frf, bands, channels=None):
+    """Each record's share of the error on the bands' lines and the records each overlaps, for an FRF whose noise
+    model carries them (:mod:`modal.estimate.record_influence`): (n_records, n_lines) for one channel,
+    (n_channels, n_records, n_lines) of the ``channels`` fitted for several; else (None, 0)."""
     model = frf.noise_model
-    if model is None or model.record_influence is None or frf.n_channels != 1:
+    if model is None or model.record_influence is None:
+        return None, 0
+    influence = model.record_influence
+    if influence.ndim == 2 and frf.n_channels == 1:
+        keep, _ = regions(bands, frf.frequency_hz)
+        return influence[:, keep], model.overlapping_records
+    if influence.ndim != 3 or influence.shape[0] != frf.n_channels:  # not this FRF's channels (one taken out)
         return None, 0
     keep, _ = regions(bands, frf.frequency_hz)
-    return model.record_influence[:, keep], model.overlapping_records
+    influence = influence[:, :, keep] if channels is None else influence[channels][:, :, keep]
+    return (influence[0] if influence.shape[0] == 1 else influence), model.overlapping_records
 
 
 def band_relative_error(frf, bands, channels=None):

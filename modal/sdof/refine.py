@@ -99,7 +99,7 @@ def fit_bands(frf, bands, power, omega_n0, damping_ratio0, channels=None, data=N
     weight = line_weight(frf, bands)
     whitening = line_whitening(frf, bands)
     lags = correlated_lags(frf, omega, damping_ratio0, omega_n0)
-    influence, overlapping = band_influence(frf, bands)
+    influence, overlapping = band_influence(frf, bands, channels)
     common = band_relative_error(frf, bands, channels)
     scale = None if band_peak is None else band_peak.max(axis=0)  # max |H| of each channel on the lines
     with np.errstate(all="ignore"):

@@ -2,7 +2,7 @@
 import numpy as np
 
 from modal.channel_covariance import channel_sandwich, sandwich_product, widened
-from modal.nls import _pole_covariance
+from modal.pole_covariance import pole_covariance
 
 
 def test_pole_errors_of_channels_with_equal_noise_are_the_fisher_information_inverse():
@@ -13,7 +13,7 @@ def test_pole_errors_of_channels_with_equal_noise_are_the_fisher_information_inv
     C = rng.standard_normal((4, 3)) + 1j * rng.standard_normal((4, 3))
     gram = E.conj().T @ E
     noise_var = np.full(3, 0.37)
-    bread = _pole_covariance(2 * np.real(gram * (C.conj() @ C.T)))
+    bread = pole_covariance(2 * np.real(gram * (C.conj() @ C.T)))
     fisher = 2 * np.real(gram * ((C.conj() / noise_var) @ C.T))
     np.testing.assert_allclose(channel_sandwich(bread, gram, C, noise_var), np.linalg.inv(fisher), rtol=1e-10)
 

@@ -5,23 +5,6 @@ from modal.nls import fit_modes
 from modal.synthetic import add_noise, modal_frf
 
 
-def test_pole_covariance_leaves_undetermined_poles_undetermined():
-    # a Fisher information with one direction the data do not determine (two parameters that enter only as
-    # their sum): those two get NaN variances, the determined ones the inverse of their own block, as for a
-    # regular matrix, where the result is its inverse (to the rounding of the diagonal scaling, a few ulp)
-    from modal.nls import _pole_covariance
-
-    regular = np.array([[4.0, 1.0], [1.0, 3.0]])
-    np.testing.assert_allclose(_pole_covariance(regular), np.linalg.inv(regular), rtol=1e-14)
-    u = np.array([1.0, 1.0])
-    F = np.zeros((4, 4))
-    F[:2, :2] = regular
-    F[2:, 2:] = 5.0 * np.outer(u, u)  # rank one: only θ2 + θ3 is determined
-    cov = _pole_covariance(F)
-    assert np.all(np.isnan(cov[2:, :])) and np.all(np.isnan(cov[:, 2:]))
-    np.testing.assert_allclose(cov[:2, :2], np.linalg.inv(regular), rtol=1e-12)
-
-
 def test_residual_sum_of_squares_by_difference_matches_the_residual_it_stands_for():
     # many channels: each channel's residual sum of squares is ‖y‖² − ‖Qᴴy‖² (no product with every channel)
     # where that keeps 1e-4 of ‖y‖² (nls.RSS_BY_DIFFERENCE): the two sums' rounding, ~1e-15 of ‖y‖² (a few
