@@ -58,6 +58,16 @@ def test_identification_and_its_checks_leave_scipy_special_and_stats_out():
         assert loaded["scipy.special"] is False and loaded["scipy.stats"] is False, method
 
 
+def test_fits_of_frf_and_time_files_leave_scipy_linalg_optimize_and_special_out():
+    # a fit imported scipy.linalg only for one_blas_thread to find its BLAS (0.2 CPU-s), and a time record's
+    # H1 noise split scipy.optimize for a two-coefficient nnls (0.4 CPU-s more, special and linalg with it):
+    # `modal fit hammer.csv --impact` went 1.45 -> 0.53 CPU-s, demo_frf.csv 0.55 -> 0.35 (medians of 10)
+    for args in (["demo_frf.csv", "--json"], ["hammer.csv", "--impact", "--json"]):
+        path = str(ROOT / "data" / "synthetic" / args[0])
+        loaded = _modules_after(f"import modal.cli\nassert modal.cli.main([{'fit'!r}, {path!r}, *{args[1:]!r}]) == 0")
+        assert not any(loaded[m] for m in ("scipy.linalg", "scipy.optimize", "scipy.special", "scipy.stats")), args
+
+
 def test_a_least_squares_balancing_job_leaves_scipy_optimize_out():
     # scipy.optimize (the min-max correction's linear programs) was most of the import time of every
     # `balancer influence` run (0.86 -> 0.48 CPU-s per run): the default least-squares job does without it
