@@ -295,7 +295,11 @@ def _nonnegative_fit(design: np.ndarray, target: np.ndarray) -> tuple[float, flo
     with scipy.linalg's, cost a time-record fit 0.4 CPU-s): the unconstrained fit if it is non-negative, else
     the better of the fits of one column alone (clipped at 0). The problem is convex, so the best feasible
     point of these active sets is its minimum."""
-    coefficients = np.linalg.lstsq(design, target, rcond=None)[0]
+    # columns scaled to unit length first: |H|² may be 1e-13 of the constant column, which lstsq's cut of small
+    # singular values would otherwise drop (its coefficient set to 0)
+    norms = np.sqrt(np.sum(design**2, axis=0))
+    norms = np.where(norms > 0, norms, 1.0)
+    coefficients = np.linalg.lstsq(design / norms, target, rcond=None)[0] / norms
     if np.all(coefficients >= 0):
         return float(coefficients[0]), float(coefficients[1])
     best, best_cost = (0.0, 0.0), float(target @ target)

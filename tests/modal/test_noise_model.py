@@ -236,8 +236,10 @@ def test_the_two_coefficient_nonnegative_fit_is_scipys_nnls():
     rng = np.random.default_rng(7)
     held = set()
     for _ in range(300):
-        design = np.column_stack([np.ones(40), rng.exponential(1.0, 40) ** 3]) * rng.exponential(1.0, (40, 1))
-        target = design @ rng.normal(0.0, 1.0, 2) + rng.normal(0.0, 0.3, 40)
+        # the |H|² column is 1e-10 to 1e-16 of the constant one in a receptance hammer test (in m/N): far apart
+        scale = 10.0 ** rng.uniform(-20, 2)
+        design = np.column_stack([np.ones(40), scale * rng.exponential(1.0, 40) ** 3]) * rng.exponential(1.0, (40, 1))
+        target = design @ (rng.normal(0.0, 1.0, 2) / [1.0, scale]) + rng.normal(0.0, 0.3, 40)
         expected, _ = nnls(design, target)
         fitted = np.array(_nonnegative_fit(design, target))
         assert np.all(fitted >= 0)
