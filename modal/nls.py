@@ -163,7 +163,7 @@ WHITENESS_P = 0.01
 def _residual_correlated(residual, lags: int, region) -> bool:
     """Ljung–Box test of the (whitened) residual, pooled over channels: whether its lines correlate over
     ``lags`` (then the sandwich covariance is used, else the Fisher information alone)."""
-    from scipy.stats import chi2
+    from .quantiles import chi2_upper_quantile
 
     r = residual[:]  # (n_ch, n_freq)
     n = r.shape[1]
@@ -181,7 +181,7 @@ def _residual_correlated(residual, lags: int, region) -> bool:
             product = product[:, same[:-lag] == same[lag:]]
         rho = product.sum() / energy  # complex: real and imaginary parts each ~ N(0, 1/(2n)) when white
         statistic += 2 * n * n / (n - lag) * abs(rho) ** 2 * r.shape[0]
-    return bool(statistic > chi2.ppf(1 - WHITENESS_P, 2 * lags))
+    return bool(statistic > chi2_upper_quantile(2 * lags, WHITENESS_P))
 
 
 def _compress(rows: np.ndarray, scale: np.ndarray, design: np.ndarray, derivatives: np.ndarray) -> np.ndarray:

@@ -12,7 +12,8 @@ ROOT = Path(__file__).resolve().parent.parent
 def _modules_after(code: str) -> dict:
     script = (f"import sys, json\nsys.path.insert(0, {str(ROOT)!r})\n{code}\n"
               "print(json.dumps({m: m in sys.modules for m in ('balancer.influence', 'matplotlib.figure', 'scipy.optimize',"
-              "'scipy.integrate', 'scipy.linalg', 'scipy.special', 'h5py', 'modal.synthetic', 'modal.operational',"
+              "'scipy.integrate', 'scipy.linalg', 'scipy.special', 'scipy.stats', 'h5py', 'modal.synthetic',"
+              "'modal.operational',"
               "'modal.operational.identify')}))")
     proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, proc.stderr[-2000:]
@@ -43,15 +44,28 @@ def test_the_scene_runner_imports_the_solvers_only_when_a_stage_needs_them():
     assert not loaded["h5py"]  # only the parent writes the archive, after the fork
 
 
-def test_importing_the_toolkit_leaves_scipy_special_until_a_check_needs_it():
-    # scipy.special was half of the CPU time of ``import modal`` (0.65 s -> 0.33 s without it), paid by every
-    # command line, plotting process and Dask worker, also those that never run identification's checks
+def test_identification_and_its_checks_leave_scipy_special_and_stats_out():
+    # scipy.special was half of the CPU time of ``import modal`` (0.65 s -> 0.33 s without it), and the checks'
+    # quantiles imported it (0.38 CPU-s more per fitting process): they are modal.quantiles' own now
     loaded = _modules_after("import modal, modal.cli, balancer.cli")
-    assert loaded["scipy.special"] is False
-    loaded = _modules_after("import warnings\nimport modal\nwarnings.simplefilter('ignore')\n"
-                            "modal.identify(modal.add_noise(modal.modal_frf(__import__('numpy').linspace(50, 150, 401),"
-                            " [100.0], [0.01], [1.0]), 1e-3, seed=1), 'nls')")
-    assert loaded["scipy.special"] is True  # the checks import it when they run
+    assert loaded["scipy.special"] is False and loaded["scipy.stats"] is False
+    for method in ("nls", "global"):
+        # two close modes and noise: the hidden-mode, missing-peak and residual-whiteness checks all run
+        loaded = _modules_after(
+            "import warnings\nimport numpy as np\nimport modal\nwarnings.simplefilter('ignore')\n"
+            "frf = modal.add_noise(modal.modal_frf(np.linspace(50, 150, 401), [90.0, 100.0, 104.0],"
+            f" [0.01, 0.01, 0.02], [1.0, 0.5, 0.05]), 1e-3, seed=1)\nmodal.identify(frf, {method!r})")
+        assert loaded["scipy.special"] is False and loaded["scipy.stats"] is False, method
+
+
+def test_fits_of_frf_and_time_files_leave_scipy_linalg_optimize_and_special_out():
+    # a fit imported scipy.linalg only for one_blas_thread to find its BLAS (0.2 CPU-s), and a time record's
+    # H1 noise split scipy.optimize for a two-coefficient nnls (0.4 CPU-s more, special and linalg with it):
+    # `modal fit hammer.csv --impact` went 1.45 -> 0.53 CPU-s, demo_frf.csv 0.55 -> 0.35 (medians of 10)
+    for args in (["demo_frf.csv", "--json"], ["hammer.csv", "--impact", "--json"]):
+        path = str(ROOT / "data" / "synthetic" / args[0])
+        loaded = _modules_after(f"import modal.cli\nassert modal.cli.main([{'fit'!r}, {path!r}, *{args[1:]!r}]) == 0")
+        assert not any(loaded[m] for m in ("scipy.linalg", "scipy.optimize", "scipy.special", "scipy.stats")), args
 
 
 def test_a_least_squares_balancing_job_leaves_scipy_optimize_out():

@@ -139,8 +139,8 @@ def _drawing_modal() -> None:
     """In a plotting process forked before ``modal`` was imported: make its submodules importable
     without running ``modal/__init__``.
 
-    ``import modal`` loads the whole identification toolkit (scipy.special, scipy.linalg: some 0.2 s of a
-    scene run); drawing needs only a few of its submodules (the figures, the result classes it unpickles).
+    ``import modal`` loads the whole identification toolkit; drawing needs only a few of its submodules (the
+    figures, the result classes it unpickles).
     The package's module is made from its spec but not executed, so each ``modal.<submodule>`` this process
     imports is loaded from the same files, and nothing else.  Only this process sees it; a name that
     ``modal/__init__`` would have provided (``modal.identify``) is missing here, by design.

@@ -26,6 +26,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..quantiles import f_survival
+
 __all__ = ["LevelTest", "TakeTest", "level_dependence", "take_dependence", "FAMILY_LEVEL", "MIN_LEVEL_RATIO",
            "MIN_HITS", "MATERIAL_CHANGE", "MAX_SPECTRUM_VALUES"]
 
@@ -103,8 +105,6 @@ def level_dependence(force, response, starts, length: int, input_window, output_
         None with fewer than :data:`MIN_HITS` hits, peak forces within :data:`MIN_LEVEL_RATIO` of each other,
         no line in the force's band, or spectra above :data:`MAX_SPECTRUM_VALUES`.
     """
-    from scipy.special import fdtrc
-
     starts = np.asarray(starts, int)
     n = starts.size
     n_out = np.shape(response)[0]
@@ -148,7 +148,7 @@ def level_dependence(force, response, starts, length: int, input_window, output_
         ok = np.isfinite(F) & (rss1 > 0) & (change >= MATERIAL_CHANGE)
         if not ok.any():
             continue
-        p = fdtrc(2.0, 2.0 * (n - 2), np.maximum(F[ok], 0.0))
+        p = f_survival(2.0, 2.0 * (n - 2), np.maximum(F[ok], 0.0))
         k = int(np.argmin(p))
         if p[k] < best[0]:
             best = (float(p[k]), float(lines[np.flatnonzero(ok)[k]] * sample_rate_hz / length), o)
@@ -195,8 +195,6 @@ def take_dependence(force, response, starts, take_of_hit, length: int, input_win
     Other parameters as :func:`level_dependence`. None with fewer than two takes, no take of two hits or more
     (no noise left once each take has its FRF), no line in the force's band, or spectra too large.
     """
-    from scipy.special import fdtrc
-
     starts, takes = np.asarray(starts, int), np.asarray(take_of_hit, int)
     n = starts.size
     labels, takes = np.unique(takes, return_inverse=True)
@@ -234,7 +232,7 @@ def take_dependence(force, response, starts, take_of_hit, length: int, input_win
         ok = np.isfinite(F) & (rss_t > 0) & (change >= MATERIAL_CHANGE)
         if not ok.any():
             continue
-        p = fdtrc(2.0 * (n_takes - 1), 2.0 * (n - n_takes), np.maximum(F[ok], 0.0))
+        p = f_survival(2.0 * (n_takes - 1), 2.0 * (n - n_takes), np.maximum(F[ok], 0.0))
         k = int(np.argmin(p))
         if p[k] < best[0]:
             best = (float(p[k]), float(lines[np.flatnonzero(ok)[k]] * sample_rate_hz / length), o)

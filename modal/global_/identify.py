@@ -25,6 +25,7 @@ from ..frf import FRF, KIND_POWER
 from ..model import mode_basis, solve_linear
 from ..nls import fit_modes, orthonormal_factor
 from ..peaks import estimate_noise_std, find_modes
+from ..quantiles import gamma_upper_inverse
 from ..results import IdentificationResult
 from ..sdof.bands import weight_on_lines, whitening_on_lines
 from ..sdof.refine import correlated_lags
@@ -151,9 +152,7 @@ def _significance(omega, H, power, wn, zeta, noise):
 
 def _significance_threshold(n_channels: int) -> float:
     """Upper 1e-6 quantile of Gamma(n_channels, 1): a mode that only fits noise exceeds it once in 10⁶."""
-    from scipy.special import gammainccinv
-
-    return float(gammainccinv(n_channels, 1e-6))
+    return gamma_upper_inverse(n_channels, 1e-6)
 
 
 def _significant(omega, H, power, selected, noise):
@@ -360,11 +359,9 @@ def _residual_peaks(omega, H, misfit, noise, omega_n):
     """
     if not np.all(np.isfinite(noise)) or np.any(noise <= 0) or omega.size < 10:
         return np.zeros(0), np.zeros(0)
-    from scipy.special import gammainccinv
-
     n_ch, n_freq = misfit.shape
     power = np.einsum("cf,c->f", np.abs(misfit) ** 2, 1.0 / noise**2)
-    limit = max(float(gammainccinv(n_ch, 1e-6 / n_freq)), MISSING_PEAK_RATIO * float(np.median(power)))
+    limit = max(gamma_upper_inverse(n_ch, 1e-6 / n_freq), MISSING_PEAK_RATIO * float(np.median(power)))
     share = np.sum(np.abs(misfit) ** 2, axis=0) / np.maximum(np.sum(np.abs(H) ** 2, axis=0), np.finfo(float).tiny)
     inner = power[1:-1]
     peak = np.flatnonzero((inner >= power[:-2]) & (inner > power[2:]) & (inner > limit)) + 1

@@ -38,6 +38,7 @@ from ..frf import line_spacing
 from ..model import mode_basis, solve_linear
 from ..nls import fit_modes
 from ..peaks import neighbour_noise_std
+from ..quantiles import chi2_upper_quantile, f_upper_quantile, gamma_lower_inverse
 from ..units import TWO_PI
 
 __all__ = [
@@ -163,11 +164,7 @@ def _level(energy: np.ndarray, n_channels: int) -> float:
 @functools.lru_cache(maxsize=64)
 def _exp_mean_median(n_channels: int) -> float:
     """Median of the mean of ``n_channels`` Exp(1) variables: gammaincinv(n, 1/2)/n."""
-    # imported where it is used: scipy.special is half of what ``import modal`` costs (about 0.3 s of CPU),
-    # paid otherwise by every command line, plotting process and Dask worker that never runs a check
-    from scipy import special
-
-    return float(special.gammaincinv(n_channels, 0.5)) / n_channels
+    return gamma_lower_inverse(n_channels, 0.5) / n_channels
 
 
 def _seen_through(noise_std, seen, peak):
@@ -413,12 +410,10 @@ def find_missing_mode(omega: np.ndarray, response: np.ndarray, power: int, regio
     if dof <= 0 or np.sum(rss1) <= 0:
         return None
     f_stat = float((np.sum(rss0 - rss1) / q) / (np.sum(rss1) / dof))
-    from scipy import special  # where it is used, as in _exp_mean_median
-
-    f_limit = float(special.fdtri(q, dof, 1 - SIGNIFICANCE))
+    f_limit = f_upper_quantile(q, dof, SIGNIFICANCE)
     # against the noise above: each real part of the noise has variance σ²/2
     ratio = float(np.sum(2 * (rss0 - rss1) / sigma2))
-    ratio_limit = float(special.chdtri(q, SIGNIFICANCE))
+    ratio_limit = chi2_upper_quantile(q, SIGNIFICANCE)
     if f_stat > f_limit and ratio > ratio_limit:
         # a fitted mode that moves by more than 3 of its errors once the hidden one is in the
         # model was biased by it as well, wherever its band (a neighbour that absorbed a
