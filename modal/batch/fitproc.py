@@ -126,9 +126,9 @@ def serve(memory_budget_bytes: int | None = None) -> None:  # pragma: no cover -
     os.dup2(devnull, 1)
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the worker decides when this process ends
     from .fitone import fit_one
-    # identification's checks import scipy.special when they first run: loaded here, before the budget, so
-    # that the budget is the fits' own and a fit after an out-of-memory one does not fail importing it
-    from scipy import special  # noqa: F401
+    # identification's checks import their quantiles when they first run: loaded here, before the budget, so
+    # that the budget is the fits' own and a fit after an out-of-memory one does not fail importing them
+    from .. import quantiles  # noqa: F401
 
     if memory_budget_bytes and sys.platform == "linux":
         _limit_memory(memory_budget_bytes)
