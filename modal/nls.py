@@ -536,7 +536,7 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
         elif record_influence is not None and np.ndim(record_influence) == 3 and len(record_influence) == n_ch:
             records = (channel_influence_in_fit_units(record_influence, inverse_scale, weight, whitening),
                        overlapping_records)
-        common = None if relative_error is None or n_ch == 1 else relative_in_fit_units(
+        common = None if relative_error is None else relative_in_fit_units(
             relative_error, response, inverse_scale, weight, whitening)
         record_errors = fill_covariance(mode_cov, dphi, Q, R, Cm, noise_var, correlated_lags, residual, region,
                                         inverse_scale, records, common,

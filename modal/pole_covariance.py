@@ -148,6 +148,8 @@ def fill_covariance(mode_cov, dphi, Q, R, Cm, noise_var, correlated_lags=0, resi
     Rinv = np.linalg.inv(R)
     H = Rinv @ (Q.conj().T @ dphi)  # (n_b, n_theta)
     lin_var = np.sum(np.abs(Rinv) ** 2, axis=1)  # diag (ΦᴴΦ)⁻¹
+    white_var, shared_var = constants_noise(Q, Rinv, noise_var, common, dphi.shape[0] - Q.shape[1]
+                                            - n_theta / (2 * Cm.shape[1]))
     for r in range(n_modes):
         G = -H[r][:, None] * Cm  # (n_theta, n_ch): ∂c_r/∂θ_j per channel
         g_re, g_im = G.real, G.imag
@@ -160,8 +162,30 @@ def fill_covariance(mode_cov, dphi, Q, R, Cm, noise_var, correlated_lags=0, resi
         blk[:, :2, 3] = cross_im.T
         blk[:, 2, :2] = cross_re.T
         blk[:, 3, :2] = cross_im.T
-        lin = noise_var / 2 * lin_var[r]
+        lin = white_var / 2 * lin_var[r] + shared_var[r] / 2
         blk[:, 2, 2] = lin + np.einsum("jc,jk,kc->c", g_re, cov_theta, g_re)
         blk[:, 3, 3] = lin + np.einsum("jc,jk,kc->c", g_im, cov_theta, g_im)
         blk[:, 2, 3] = blk[:, 3, 2] = np.einsum("jc,jk,kc->c", g_re, cov_theta, g_im)
     return from_records
+
+
+def constants_noise(Q: np.ndarray, Rinv: np.ndarray, noise_var: np.ndarray, common, dof: float):
+    """The linear coefficients' error from the data's noise: (white variance per line, per channel; variance of
+    each coefficient from the error the channels share, (n_b, n_ch)).
+
+    The coefficients are c = Φ⁺ h = R⁻¹ Qᴴ h per channel. Independent noise of variance σ² per line gives each
+    σ² ‖row of R⁻¹‖²; an error shared over the lines (``common``, (n_ch, n_freq, n_factors): channel c's is
+    ``common[c] @ ξ``, E ξξᴴ = I; the excitation noise of a short force window, smooth over the lines, a gain
+    error of every line near a mode) moves them by R⁻¹ Qᴴ common[c] ξ, a variance ‖R⁻¹ Qᴴ common[c]‖² per
+    coefficient that white noise of the same residual power understates by about the lines per mode (a hammer
+    test's constants, and with them k, c, m, scattered 2-5 times their errors on three accelerometers). The
+    residual power the shared error leaves (its part off the design) is taken out of the white part."""
+    n_ch = noise_var.shape[0]
+    if common is None:
+        return noise_var, np.zeros((Rinv.shape[0], n_ch))
+    projected = np.einsum("kb,ckr->cbr", Q.conj(), common)  # (n_ch, n_b, n_factors): Qᴴ common_c
+    moved = np.einsum("ab,cbr->car", Rinv, projected)
+    shared_var = np.einsum("car,car->ac", moved, moved.conj()).real  # (n_b, n_ch)
+    off = common - np.einsum("kb,cbr->ckr", Q, projected)
+    shared_power = np.einsum("ckr,ckr->c", off, off.conj()).real / dof if dof > 0 else np.zeros(n_ch)
+    return np.maximum(noise_var - shared_power, 0.0), shared_var

@@ -1,5 +1,6 @@
 """The poles' covariance of a fit (modal.pole_covariance)."""
 import numpy as np
+import pytest
 
 from modal.pole_covariance import pole_covariance
 
@@ -17,3 +18,24 @@ def test_pole_covariance_leaves_undetermined_poles_undetermined():
     cov = pole_covariance(F)
     assert np.all(np.isnan(cov[2:, :])) and np.all(np.isnan(cov[:, 2:]))
     np.testing.assert_allclose(cov[:2, :2], np.linalg.inv(regular), rtol=1e-12)
+
+
+def test_a_gain_error_shared_by_the_lines_moves_the_constant_by_its_own_size():
+    from modal.pole_covariance import constants_noise
+
+    rng = np.random.default_rng(0)
+    design = rng.standard_normal((200, 2)) + 1j * rng.standard_normal((200, 2))
+    Q, R = np.linalg.qr(design)
+    gain = 0.01 + 0.005j  # every line's response off by the same relative error, as an excitation's gain
+    # a shared error inside the design's span (the first column times the gain) moves the first coefficient by the
+    # gain and leaves no residual: white noise of the residual's power (which it adds none to) says nothing of it
+    common = (design[:, :1] * gain)[None]  # (1 channel, 200 lines, 1 factor)
+    white, shared = constants_noise(Q, np.linalg.inv(R), np.array([1e-6]), common, 200 - 2)
+    assert white == pytest.approx([1e-6])
+    assert shared[:, 0] == pytest.approx([abs(gain) ** 2, 0.0], abs=1e-18)
+    # off the design's span entirely: all of it in the residual, taken out of the white part, nothing in the
+    # coefficients
+    off = design[:, :1] - Q @ (Q.conj().T @ design[:, :1])
+    white, shared = constants_noise(Q, np.linalg.inv(R), np.array([1.0]), off[None], 200 - 2)
+    assert shared[:, 0] == pytest.approx([0.0, 0.0], abs=1e-20)
+    assert white[0] == pytest.approx(1.0 - np.sum(np.abs(off) ** 2) / 198)
