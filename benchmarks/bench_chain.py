@@ -198,6 +198,7 @@ CELLS = {c.name: c for c in [
     Cell("hammer-exp-1", "hammer, 1 hit, exponential window τ = 0.5 s", hammer_cell(1)),
     Cell("hammer-rect-1", "hammer, 1 hit, rectangular window (each hit of a repeated test on its own)",
          hammer_cell(1, "rect", None)),
+    Cell("hammer-force-6", "hammer, 6 hits, force window, one accelerometer", hammer_cell(6, "force", None)),
     # one force, several accelerometers in one file (modal fit's default is nls for them: one reference, two
     # peaks); the global method on three of them
     *[Cell(f"hammer-{short}-{hits}-ch{outputs}{suffix}",

@@ -228,11 +228,12 @@ def band_influence(frf, bands, channels=None):
 
 def band_relative_error(frf, bands, channels=None):
     """The factor of the channels' errors relative to their FRF (the excitation noise's) on the bands' lines,
-    (n_factors, n_lines) or, per channel, (n_channels, n_factors, n_lines) of the ``channels`` fitted, for a
-    several-channel FRF whose noise model carries it (:class:`~modal.noise_model.NoiseModel`'s
-    ``relative_error``); else None."""
+    (n_factors, n_lines) or, per channel, (n_channels, n_factors, n_lines) of the ``channels`` fitted, for an
+    FRF whose noise model carries it (:class:`~modal.noise_model.NoiseModel`'s ``relative_error``); else None.
+    Several channels share it (their poles' covariance takes it); one channel's modal constants take it as a
+    gain error of every line near a mode."""
     model = frf.noise_model
-    if model is None or model.relative_error is None or frf.n_channels < 2:
+    if model is None or model.relative_error is None:
         return None
     keep, _ = regions(bands, frf.frequency_hz)
     factor = model.relative_error[..., keep]
