@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["common_error_factor", "compressed_factor", "SKETCH_COLUMNS", "MAX_SUPPORT_ROWS", "MAX_FACTOR_WORK", "MAX_SUPPORT_FRACTION", "FACTOR_TOLERANCE"]
+__all__ = ["common_error_factor", "compressed_factor", "SKETCH_COLUMNS", "MAX_SUPPORT_ROWS", "MAX_FACTOR_WORK", "MAX_UNCOMPRESSED_BYTES", "MAX_SUPPORT_FRACTION", "FACTOR_TOLERANCE"]
 
 #: records × window samples at most (rows of the factor before it is compressed, :func:`compressed_factor`)
 MAX_SUPPORT_ROWS = 1024
@@ -30,6 +30,11 @@ MAX_FACTOR_WORK = 1024**2 * 1025
 #: over the whole record (a hammer test without a force window, a continuous estimate) is no short support: its
 #: excitation noise is left to the line correlation
 MAX_SUPPORT_FRACTION = 1 / 8
+#: beyond MAX_FACTOR_WORK the rows themselves are the factor (P = rows, nothing compressed) if they take at most
+#: this many bytes: a 4-hit test of 8 s records at 1 kHz with a 138-sample force window has 552 rows of 4097 lines
+#: (36 MB), whose Gram matrix would cost 0.7 s, and without the factor its constants (and k, c, m) scattered 11
+#: times their errors; the fits use only their bands' lines of it
+MAX_UNCOMPRESSED_BYTES = 64 * 2**20
 #: singular values of the factor below this fraction of the largest are dropped (their variance is 1e-8 of it)
 FACTOR_TOLERANCE = 1e-4
 
@@ -56,15 +61,18 @@ def common_error_factor(excitation: np.ndarray, starts: np.ndarray, length: int,
     -------
     ndarray or None
         None where the window's support over the records exceeds :data:`MAX_SUPPORT_ROWS` rows (or their
-        Gram matrix :data:`MAX_FACTOR_WORK` products) or
+        Gram matrix :data:`MAX_FACTOR_WORK` products and the rows :data:`MAX_UNCOMPRESSED_BYTES`) or
         :data:`MAX_SUPPORT_FRACTION` of a record, the noise power is not positive, or a line holds no excitation.
     """
     window = np.asarray(input_window, float)
     support = np.flatnonzero(window != 0)
     starts = np.asarray(starts, np.int64)
     n_rows = support.size * starts.size
+    n_lines = length // 2 + 1
+    compress = n_rows**2 * n_lines <= MAX_FACTOR_WORK
     if (not excitation_noise_power > 0 or n_rows > MAX_SUPPORT_ROWS or support.size == 0
-            or support.size > MAX_SUPPORT_FRACTION * length or n_rows**2 * (length // 2 + 1) > MAX_FACTOR_WORK):
+            or support.size > MAX_SUPPORT_FRACTION * length
+            or not (compress or n_rows * n_lines * 16 <= MAX_UNCOMPRESSED_BYTES)):
         return None
     records = np.stack([excitation[s:s + length] for s in starts]) * window  # (n_records, length)
     spectra = np.fft.rfft(records, axis=-1)
@@ -76,7 +84,7 @@ def common_error_factor(excitation: np.ndarray, starts: np.ndarray, length: int,
     # row (i, n): σ w[n] e^{−2πikn/N} X*_ik / S_k
     phase = np.exp(-2j * np.pi * np.outer(support, lines) / length) * (sigma * window[support])[:, None]
     rows = (phase[None, :, :] * (spectra.conj() / power)[:, None, :]).reshape(-1, lines.size)
-    return compressed_factor(rows)
+    return compressed_factor(rows) if compress else rows
 
 
 #: columns of the first random sketch of the rows' range (:func:`compressed_factor`): a force window's rows
