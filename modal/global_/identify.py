@@ -221,7 +221,7 @@ def _loose_lines(omega, wn, zeta):
     return index, np.where(near[index], 1.0, np.sqrt(LOOSE_EVERY))
 
 
-def _fit_within(omega, H, power, wn, zeta, step_tol, budget=None, weighting=(None, None, 0)):
+def _fit_within(omega, H, power, wn, zeta, step_tol, budget=None, weighting=(None, None, 0, None)):
     """The joint fit with residual terms, without the poles that widen past :data:`MAX_DAMPING`.
 
     A pole that the stabilisation kept on the tail of a mode outside the lines (or on noise) has no
@@ -232,7 +232,7 @@ def _fit_within(omega, H, power, wn, zeta, step_tol, budget=None, weighting=(Non
     dropped and the others go on from where they are.
     Returns the fit and the dropped poles' frequencies (Hz). ``budget``: the identification's
     :class:`~modal.work_budget.EvaluationBudget` (each fit takes what is left of it; a fit it stops is returned).
-    ``weighting``: (line weights, :class:`~modal.whitening.LineWhitening`, lags) of every line, for the tight fits
+    ``weighting``: (line weights, :class:`~modal.whitening.LineWhitening`, lags, shared error factor) of every line, for the tight fits
     (:func:`_line_weighting`); the loose ones, on a sample of the lines, only start others and go unweighted.
     """
     removed: list[float] = []
@@ -243,11 +243,12 @@ def _fit_within(omega, H, power, wn, zeta, step_tol, budget=None, weighting=(Non
             lines = None if tight else _loose_lines(omega, wn, zeta)
             allowed = None if budget is None else budget.for_fit()
             if lines is None:
-                weight, whitening, lags = weighting if tight else (None, None, 0)
+                weight, whitening, lags, common = weighting if tight else (None, None, 0, None)
                 fit = fit_modes(omega, H, power, wn, zeta, region=None, residual_terms=True, step_tol=step_tol,
                                 max_damping=MAX_DAMPING, errors=tight, max_evaluations=allowed,
                                 decrement_tol=TIGHT_DECREMENT if tight else LOOSE_DECREMENT,
-                                line_weight=weight, whitening=whitening, correlated_lags=lags if tight else 0)
+                                line_weight=weight, whitening=whitening, correlated_lags=lags if tight else 0,
+                                relative_error=common)
             else:
                 index, line_weight = lines
                 fit = fit_modes(omega[index], H[:, index], power, wn, zeta, region=None, residual_terms=True,
@@ -267,7 +268,8 @@ def _fit_within(omega, H, power, wn, zeta, step_tol, budget=None, weighting=(Non
         wn, zeta = fit.omega_n[~wide], fit.damping_ratio[~wide]
 
 
-def _refine(omega, H, power, wn0, zeta0, noise, step_tol=LOOSE_STEP_TOL, budget=None, weighting=(None, None, 0)):
+def _refine(omega, H, power, wn0, zeta0, noise, step_tol=LOOSE_STEP_TOL, budget=None,
+            weighting=(None, None, 0, None)):
     """Joint refinement of the poles (rad/s, 1) to ``step_tol``, with the significance test at the refined
     poles: the modes that only fit noise are dropped and the others refitted, until none is.
 
@@ -301,15 +303,19 @@ def _refine(omega, H, power, wn0, zeta0, noise, step_tol=LOOSE_STEP_TOL, budget=
 
 
 def _line_weighting(frf: FRF, omega_n, damping_ratio):
-    """(line weights, :class:`~modal.whitening.LineWhitening`, lags) of every line of ``frf`` for the final fit, as
-    the band-wise fits take them (:func:`modal.sdof.bands.line_weight`, :func:`~modal.sdof.bands.line_whitening`,
-    :func:`modal.sdof.refine.correlated_lags` at the poles ``omega_n`` (rad/s), ``damping_ratio``): an estimate from
-    time records carries its lines' noise shape and their correlation (an exponential window correlates its errors
-    over tens of lines), and its errors may correlate beyond that over a half-power width (the lag covariance then
-    widens the errors of several channels); None, None, 0 where the FRF does not carry them."""
+    """(line weights, :class:`~modal.whitening.LineWhitening`, lags, shared error factor) of every line of ``frf`` for
+    the final fit, as the band-wise fits take them (:func:`modal.sdof.bands.line_weight`,
+    :func:`~modal.sdof.bands.line_whitening`, :func:`modal.sdof.refine.correlated_lags` at the poles ``omega_n``
+    (rad/s), ``damping_ratio``, :func:`~modal.sdof.bands.band_relative_error`): an estimate from time records
+    carries its lines' noise shape and their correlation (an exponential window correlates its errors over tens of
+    lines), its errors may correlate beyond that over a half-power width (the lag covariance then widens the
+    errors of several channels), and the excitation's noise is an error every channel shares, a gain error of
+    every line near a mode in the modal constants; None, None, 0, None where the FRF does not carry them."""
     every = np.ones(frf.n_freq, bool)
+    model = frf.noise_model
     return (weight_on_lines(frf, every), whitening_on_lines(frf, every),
-            correlated_lags(frf, frf.omega_rad_s, damping_ratio, omega_n))
+            correlated_lags(frf, frf.omega_rad_s, damping_ratio, omega_n),
+            None if model is None else model.relative_error)
 
 
 def _poles_above_band(omega, matrix, orders, low_hz, high_hz, taken):
