@@ -347,8 +347,9 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
     overlapping_records : int
         See ``record_influence``.
     relative_error : ndarray, shape (n_factors, n_freq), complex, optional
-        Several channels: an error they share relative to their FRF (:mod:`modal.estimate.common_error`), in
-        the poles' covariance with the channels' own noise (:func:`modal.channel_covariance.channel_sandwich`).
+        An error shared over the lines (and the channels) relative to the FRF (:mod:`modal.estimate.common_error`):
+        in the modal constants' covariance (:func:`modal.pole_covariance.constants_noise`) and, for several
+        channels, the poles' (:func:`modal.channel_covariance.channel_sandwich`).
     """
     omega = np.asarray(omega, float)
     rows = np.ascontiguousarray(np.atleast_2d(np.asarray(response, complex)))  # (n_ch, n_freq), the FRF's unit

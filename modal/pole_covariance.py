@@ -4,7 +4,8 @@
 (:func:`pole_covariance`, NaN where the data do not determine a pole), the sandwich of a cost that weighs
 several channels alike (:mod:`modal.channel_covariance`), the variance measured over the records
 (:mod:`modal.record_variance`) or the Newey–West lag sum of the lines' scores (:func:`line_scores`,
-:func:`lag_covariance`); then each channel's modal constants through their sensitivity to the poles.
+:func:`lag_covariance`); then each channel's modal constants through their sensitivity to the poles and the
+data's noise (:func:`constants_noise`: white, and an error the lines share).
 """
 from __future__ import annotations
 
@@ -15,7 +16,8 @@ import numpy as np
 from .channel_covariance import channel_sandwich, relative_error_terms, sandwich_product, widened
 from .record_variance import channel_scores, misfit_ratio, projected_scores, record_covariance
 
-__all__ = ["FISHER_RCOND", "NULL_WEIGHT", "fill_covariance", "lag_covariance", "line_scores", "pole_covariance"]
+__all__ = ["FISHER_RCOND", "NULL_WEIGHT", "constants_noise", "fill_covariance", "lag_covariance", "line_scores",
+           "pole_covariance"]
 
 
 #: eigenvalues of the poles' Fisher information (scaled to a unit diagonal) below this fraction of the largest
