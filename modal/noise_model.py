@@ -108,40 +108,30 @@ class NoiseModel:
 
     def __post_init__(self) -> None:
         if self.line_correlation is not None:
-            corr = np.array(self.line_correlation, dtype=complex)
+            corr = _frozen(self.line_correlation, complex)
             if corr.ndim != 2:
                 raise FRFValidationError(f"field 'line_correlation' has shape {corr.shape}; expected (n_lags, n_freq)")
             if not np.all(np.isfinite(corr)) or np.any(np.abs(corr) > 1 + 1e-9):
                 raise FRFValidationError("field 'line_correlation' holds values that are not correlation "
                                          "coefficients; expected finite |values| <= 1")
-            corr.setflags(write=False)
             object.__setattr__(self, "line_correlation", corr)
         if self.lag_window is not None:
-            lag = np.array(self.lag_window, dtype=float)
+            lag = _frozen(self.lag_window, float)
             if lag.ndim != 1 or not np.all(np.isfinite(lag)):
                 raise FRFValidationError("field 'lag_window' must be a finite 1-D array (one value per lag)")
-            lag.setflags(write=False)
             object.__setattr__(self, "lag_window", lag)
         if self.variance_model is not None:
-            variance = np.array(self.variance_model, dtype=float)
+            variance = _frozen(self.variance_model, float)
             if variance.ndim != 1 or np.any(np.isinf(variance)) or np.any(variance < 0):
                 raise FRFValidationError("field 'variance_model' must hold one variance >= 0 (or NaN) per line")
-            variance.setflags(write=False)
             object.__setattr__(self, "variance_model", variance)
-        if self.record_influence is not None:
-            influence = np.array(self.record_influence, dtype=complex)
-            if influence.ndim not in (2, 3) or not np.all(np.isfinite(influence)):
-                raise FRFValidationError("field 'record_influence' must be a finite array of records × lines "
-                                         "(or channels × records × lines)")
-            influence.setflags(write=False)
-            object.__setattr__(self, "record_influence", influence)
-        if self.relative_error is not None:
-            common = np.array(self.relative_error, dtype=complex)
-            if common.ndim not in (2, 3) or not np.all(np.isfinite(common)):
-                raise FRFValidationError("field 'relative_error' must be a finite array of factors × lines "
-                                         "(or channels × factors × lines)")
-            common.setflags(write=False)
-            object.__setattr__(self, "relative_error", common)
+        for name, rows in (("record_influence", "records"), ("relative_error", "factors")):
+            if getattr(self, name) is not None:
+                value = _frozen(getattr(self, name), complex)
+                if value.ndim not in (2, 3) or not np.all(np.isfinite(value)):
+                    raise FRFValidationError(f"field '{name}' must be a finite array of {rows} × lines "
+                                             f"(or channels × {rows} × lines)")
+                object.__setattr__(self, name, value)
         if not (isinstance(self.overlapping_records, (int, np.integer)) and self.overlapping_records >= 0):
             raise FRFValidationError(f"field 'overlapping_records' is {self.overlapping_records!r}; "
                                      "expected an integer >= 0")
@@ -313,3 +303,14 @@ def _nonnegative_fit(design: np.ndarray, target: np.ndarray) -> tuple[float, flo
         if cost < best_cost:
             best, best_cost = ((value, 0.0) if column == 0 else (0.0, value)), cost
     return best
+
+
+def _frozen(value, dtype) -> np.ndarray:
+    """``value`` as a read-only array of ``dtype``: itself when it is one already (a noise model made from
+    another by ``replace``, whose arrays may be tens of MB: a common error factor of 552 rows × 4097 lines), else
+    a copy, so that no caller's array is frozen or shared."""
+    if isinstance(value, np.ndarray) and value.dtype == np.dtype(dtype) and not value.flags.writeable:
+        return value
+    copy = np.array(value, dtype=dtype)
+    copy.setflags(write=False)
+    return copy

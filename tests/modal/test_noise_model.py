@@ -246,3 +246,16 @@ def test_the_two_coefficient_nonnegative_fit_is_scipys_nnls():
         np.testing.assert_allclose(fitted, expected, rtol=1e-9, atol=1e-12 * np.abs(target).max())
         held.add(tuple(expected == 0))
     assert held == {(False, False), (True, False), (False, True), (True, True)}  # every active set was met
+
+
+def test_large_arrays_are_copied_once_then_shared_by_derived_models():
+    from dataclasses import replace
+
+    factor = np.ones((552, 4097), complex)  # a common error factor of 36 MB, as a 4-hit 8 s force-window test's
+    model = NoiseModel(4, 3.0, None, None, 1e-3, relative_error=factor)
+    assert model.relative_error is not factor and factor.flags.writeable  # the caller's array is left alone
+    assert not model.relative_error.flags.writeable
+    derived = replace(model, averages=5)  # every crop or scaling of an FRF makes one: no 36 MB copy each time
+    assert derived.relative_error is model.relative_error
+    with pytest.raises(FRFValidationError, match="field 'relative_error' must be a finite array of factors"):
+        NoiseModel(4, 3.0, None, None, 1e-3, relative_error=np.full((2, 5), np.nan))
