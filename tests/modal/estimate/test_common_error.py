@@ -21,14 +21,18 @@ def _estimate(force, response, window="force"):
         return modal.estimate_frf(force, response, FS, impact=True, window=window, kind="accelerance")
 
 
+def _three_hits():
+    """(force, the plant's accelerations) of three hits 4 s apart, exact."""
+    force = hammer_force(int(16 * FS), FS, 0.5 + 4.0 * np.arange(3))
+    return force, PLANT.respond(force, "acceleration")
+
+
 def test_the_force_noise_error_is_common_to_the_outputs_and_as_large_as_carried():
     # three hits, the force channel noisy (0.5 % of its peak), the responses nearly exact: each output's error
     # relative to its FRF is η, one for both; its power is the factor's Σ_r |P_rk|². Over 12 draws of the noise
     # and the 460 lines of 20-250 Hz, whose errors correlate over ~50 lines (the force window's 42 samples of
     # 2048), ~110 independent values: the mean power's ratio to the model is known to ±10 %, held within 30 %
-    hits = 0.5 + 4.0 * np.arange(3)
-    force = hammer_force(int(16 * FS), FS, hits)
-    response = PLANT.respond(force, "acceleration")
+    force, response = _three_hits()
     rng = np.random.default_rng(11)
     relative, carried = [], []
     for _ in range(12):
@@ -49,14 +53,12 @@ def test_the_force_noise_error_is_common_to_the_outputs_and_as_large_as_carried(
 
 
 def test_hits_carry_it_with_one_output_too_and_continuous_records_do_not():
-    hits = 0.5 + 4.0 * np.arange(3)
-    force = hammer_force(int(16 * FS), FS, hits)
-    response = PLANT.respond(force, "acceleration")
+    force, response = _three_hits()
     rng = np.random.default_rng(3)
     noisy = force + 0.005 * force.max() * rng.standard_normal(force.size)
     assert _estimate(noisy, response + 1e-4 * rng.standard_normal(response.shape)).noise_model.relative_error is not None
     one = _estimate(noisy, response[0] + 1e-4 * rng.standard_normal(response.shape[1])).noise_model.relative_error
-    assert one is not None and one.ndim == 2  # for a roving join (modal.roving); one channel's fit ignores it
+    assert one is not None and one.ndim == 2  # a roving join (modal.roving) keeps it; one channel's constants take it
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         continuous = modal.estimate_frf(noisy, response, FS, kind="accelerance")
@@ -66,9 +68,7 @@ def test_hits_carry_it_with_one_output_too_and_continuous_records_do_not():
 def test_a_hammer_without_a_force_window_carries_none():
     # a rectangular window keeps the force channel's noise over the whole record: no short support to factor
     # (its 2048 samples would make a Gram matrix of 2048² per hit), the line correlation carries it instead
-    hits = 0.5 + 4.0 * np.arange(3)
-    force = hammer_force(int(16 * FS), FS, hits)
-    response = PLANT.respond(force, "acceleration")
+    force, response = _three_hits()
     rng = np.random.default_rng(5)
     noisy = force + 0.005 * force.max() * rng.standard_normal(force.size)
     assert _estimate(noisy, response + 1e-4 * rng.standard_normal(response.shape), "rect").noise_model.relative_error \

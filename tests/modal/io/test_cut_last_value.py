@@ -4,11 +4,10 @@ parse to a wrong last sample); whole files, and files merely lacking the final l
 from __future__ import annotations
 
 import numpy as np
-import pytest
 
-from modal.errors import FormatError
 from modal.io import read_frf
 from modal.io.timedata import read_time
+from support.refusals import assert_refused
 
 FS = 1000.0
 
@@ -20,15 +19,6 @@ def _time_csv(tmp_path, n=40):
     return "time,force [N],a [m/s^2]\n" + "\n".join(rows)
 
 
-def _refused(path, read, *fragments):
-    with pytest.raises(FormatError) as info:
-        read(path)
-    msg = str(info.value)
-    assert "\n" not in msg and str(path) in msg and "expected" in msg, msg
-    for frag in fragments:
-        assert frag in msg, f"{frag!r} not in {msg!r}"
-
-
 def test_time_csv_cut_inside_its_last_number_is_refused(tmp_path):
     text = _time_csv(tmp_path)
     last = text.rsplit(",", 1)[1]
@@ -37,7 +27,7 @@ def test_time_csv_cut_inside_its_last_number_is_refused(tmp_path):
     # character gone, '-9.364566' (a number 10^4 times too large, read silently before)
     for keep in (len(text) - 3, len(text) - 4):
         path.write_text(text[:keep])
-        _refused(path, read_time, "line 41, column 'a [m/s^2]'", repr(text[:keep].rsplit(",", 1)[1]),
+        assert_refused(path, read_time, "line 41, column 'a [m/s^2]'", repr(text[:keep].rsplit(",", 1)[1]),
                  "ends inside it", "delete line 41")
     assert len(last) == 13
 
@@ -64,6 +54,6 @@ def test_frf_csv_cut_inside_its_last_number_is_refused(tmp_path):
     text = _frf_csv()
     path = tmp_path / "cut.csv"
     path.write_text(text[:-4])
-    _refused(path, read_frf, "line 43, column 'im'", "ends inside it")
+    assert_refused(path, read_frf, "line 43, column 'im'", "ends inside it")
     path.write_text(text)
     assert read_frf(path).n_freq == 41
