@@ -112,12 +112,12 @@ def fill_covariance(mode_cov, dphi, Q, R, Cm, noise_var, correlated_lags=0, resi
         F = 2 * np.real(gram * ((Cm.conj() * weights) @ Cm.T))
     cov_theta = np.full((n_theta, n_theta), np.nan)
     several = Cm.shape[1] > 1
+    shared = None if common is None else relative_error_terms(
+        E, Q, Cm, common, dphi.shape[0] - Q.shape[1] - n_theta / (2 * Cm.shape[1]))
     if np.all(np.isfinite(F)):
         # several channels: the fit weighs every scaled channel alike, not by its noise, so its poles' covariance
         # is the sandwich of that unweighted cost (equal to F⁻¹ where the channels' noise is equal)
         bread = pole_covariance(2 * np.real(gram * (Cm.conj() @ Cm.T))) if several else None
-        shared = None if common is None else relative_error_terms(
-            E, Q, Cm, common, dphi.shape[0] - Q.shape[1] - n_theta / (2 * Cm.shape[1]))
         cov_theta = channel_sandwich(bread, gram, Cm, noise_var, shared) if several else pole_covariance(F)
         measured = None
         by_channel = records is not None and records[0].ndim == 3  # several channels' (n_freq, n_ch, n_records)
@@ -150,8 +150,7 @@ def fill_covariance(mode_cov, dphi, Q, R, Cm, noise_var, correlated_lags=0, resi
     Rinv = np.linalg.inv(R)
     H = Rinv @ (Q.conj().T @ dphi)  # (n_b, n_theta)
     lin_var = np.sum(np.abs(Rinv) ** 2, axis=1)  # diag (ΦᴴΦ)⁻¹
-    white_var, shared_var = constants_noise(Q, Rinv, noise_var, common, dphi.shape[0] - Q.shape[1]
-                                            - n_theta / (2 * Cm.shape[1]))
+    white_var, shared_var = constants_noise(Q, Rinv, noise_var, common, None if shared is None else shared[1])
     for r in range(n_modes):
         G = -H[r][:, None] * Cm  # (n_theta, n_ch): ∂c_r/∂θ_j per channel
         g_re, g_im = G.real, G.imag
@@ -171,7 +170,7 @@ def fill_covariance(mode_cov, dphi, Q, R, Cm, noise_var, correlated_lags=0, resi
     return from_records
 
 
-def constants_noise(Q: np.ndarray, Rinv: np.ndarray, noise_var: np.ndarray, common, dof: float):
+def constants_noise(Q: np.ndarray, Rinv: np.ndarray, noise_var: np.ndarray, common, shared_power):
     """The linear coefficients' error from the data's noise: (white variance per line, per channel; variance of
     each coefficient from the error the channels share, (n_b, n_ch)).
 
@@ -181,13 +180,10 @@ def constants_noise(Q: np.ndarray, Rinv: np.ndarray, noise_var: np.ndarray, comm
     error of every line near a mode) moves them by R⁻¹ Qᴴ common[c] ξ, a variance ‖R⁻¹ Qᴴ common[c]‖² per
     coefficient that white noise of the same residual power understates by about the lines per mode (a hammer
     test's constants, and with them k, c, m, scattered 2-5 times their errors on three accelerometers). The
-    residual power the shared error leaves (its part off the design) is taken out of the white part."""
-    n_ch = noise_var.shape[0]
+    residual power the shared error leaves (its part off the design, ``shared_power`` per channel:
+    :func:`modal.channel_covariance.relative_error_terms`) is taken out of the white part."""
     if common is None:
-        return noise_var, np.zeros((Rinv.shape[0], n_ch))
-    projected = np.einsum("kb,ckr->cbr", Q.conj(), common)  # (n_ch, n_b, n_factors): Qᴴ common_c
-    moved = np.einsum("ab,cbr->car", Rinv, projected)
+        return noise_var, np.zeros((Rinv.shape[0], noise_var.shape[0]))
+    moved = np.einsum("ab,cbr->car", Rinv, np.einsum("kb,ckr->cbr", Q.conj(), common))  # R⁻¹ Qᴴ common_c
     shared_var = np.einsum("car,car->ac", moved, moved.conj()).real  # (n_b, n_ch)
-    off = common - np.einsum("kb,cbr->ckr", Q, projected)
-    shared_power = np.einsum("ckr,ckr->c", off, off.conj()).real / dof if dof > 0 else np.zeros(n_ch)
     return np.maximum(noise_var - shared_power, 0.0), shared_var

@@ -21,6 +21,7 @@ def test_pole_covariance_leaves_undetermined_poles_undetermined():
 
 
 def test_a_gain_error_shared_by_the_lines_moves_the_constant_by_its_own_size():
+    from modal.channel_covariance import relative_error_terms
     from modal.pole_covariance import constants_noise
 
     rng = np.random.default_rng(0)
@@ -30,12 +31,14 @@ def test_a_gain_error_shared_by_the_lines_moves_the_constant_by_its_own_size():
     # a shared error inside the design's span (the first column times the gain) moves the first coefficient by the
     # gain and leaves no residual: white noise of the residual's power (which it adds none to) says nothing of it
     common = (design[:, :1] * gain)[None]  # (1 channel, 200 lines, 1 factor)
-    white, shared = constants_noise(Q, np.linalg.inv(R), np.array([1e-6]), common, 200 - 2)
+    white, shared = constants_noise(Q, np.linalg.inv(R), np.array([1e-6]), common,
+                                    relative_error_terms(Q, Q, np.ones((2, 1)), common, 198)[1])
     assert white == pytest.approx([1e-6])
     assert shared[:, 0] == pytest.approx([abs(gain) ** 2, 0.0], abs=1e-18)
     # off the design's span entirely: all of it in the residual, taken out of the white part, nothing in the
     # coefficients
     off = design[:, :1] - Q @ (Q.conj().T @ design[:, :1])
-    white, shared = constants_noise(Q, np.linalg.inv(R), np.array([1.0]), off[None], 200 - 2)
+    white, shared = constants_noise(Q, np.linalg.inv(R), np.array([1.0]), off[None],
+                                    relative_error_terms(Q, Q, np.ones((2, 1)), off[None], 198)[1])
     assert shared[:, 0] == pytest.approx([0.0, 0.0], abs=1e-20)
     assert white[0] == pytest.approx(1.0 - np.sum(np.abs(off) ** 2) / 198)
