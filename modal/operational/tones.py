@@ -269,8 +269,7 @@ def warn_speed_off_the_tones(tones: list[PoleEstimate], rotor_speed_hz: float, s
     not the record's; the fundamental the tones share, when two or more do, is named."""
     from ..errors import QualityWarning, warn
 
-    own = [t for t in tones if not any(abs(t.natural_frequency_hz - k * mains) <= HUM_TOLERANCE * k * mains
-                                       for mains in MAINS_HZ for k in range(1, MAINS_HARMONICS + 1))]
+    own = [t for t in tones if not mains_lines_near(t.natural_frequency_hz)]
     if not own or any(harmonic_of(t.natural_frequency_hz, t.std_frequency_hz, rotor_speed_hz) for t in own):
         return False
     frequencies = sorted(t.natural_frequency_hz for t in own)
@@ -300,6 +299,12 @@ def line_ratio(samples: np.ndarray, sample_rate_hz: float, frequency_hz: float) 
     return float(power[k - 1:k + 2].max() / floor) if floor > 0 else float("inf")
 
 
+def mains_lines_near(frequency_hz: float, std_hz: float = 0.0) -> list[float]:
+    """The mains harmonics (Hz) within :data:`HUM_TOLERANCE` of ``frequency_hz``, or 3 of its standard errors."""
+    return [k * mains for mains in MAINS_HZ for k in range(1, MAINS_HARMONICS + 1)
+            if abs(frequency_hz - k * mains) <= max(HUM_TOLERANCE * k * mains, 3 * std_hz)]
+
+
 def flag_mains_hum(estimates: list[PoleEstimate], prepared: Prepared) -> list[PoleEstimate]:
     """The estimates, those on a mains line (:data:`HUM_TOLERANCE` or 3 standard errors of a multiple of 50 or
     60 Hz, where some channel holds a line :data:`HUM_LINE_RATIO` above its surroundings) flagged ``mains_hum``,
@@ -312,8 +317,7 @@ def flag_mains_hum(estimates: list[PoleEstimate], prepared: Prepared) -> list[Po
     for estimate in estimates:
         f = estimate.natural_frequency_hz
         std = estimate.std_frequency_hz if np.isfinite(estimate.std_frequency_hz) else 0.0
-        lines = [k * mains for mains in MAINS_HZ for k in range(1, MAINS_HARMONICS + 1)
-                 if abs(f - k * mains) <= max(HUM_TOLERANCE * k * mains, 3 * std)]
+        lines = mains_lines_near(f, std)
         humming = []
         for line in lines:
             ratios = [line_ratio(prepared.signals[ch], prepared.sample_rate_hz, line)
