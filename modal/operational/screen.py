@@ -28,6 +28,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ParameterError, QualityWarning, warn
+from .selection import DETERMINED_SIGMAS
 
 __all__ = ["check_units", "screen_samples", "stuck_runs", "unresponsive_channels", "transient_kurtosis",
            "warn_transients", "held_factor", "check_held", "STRIDE", "MIN_STUCK_SAMPLES", "NODE_SIGMAS", "TRANSIENT_SIGMAS", "TRANSIENT_KURTOSIS"]
@@ -40,8 +41,9 @@ STRIDE = 128
 #: neighbouring samples are equal)
 MIN_STUCK_SAMPLES = 2 * STRIDE
 #: a shape entry within this many of its standard errors of zero does not show the channel moving in the
-#: mode (for Gaussian errors a moving entry falls inside with probability below 0.3 %)
-NODE_SIGMAS = 3.0
+#: mode (for Gaussian errors a moving entry falls inside with probability below 0.3 %): the complement of a
+#: determined entry (:data:`modal.operational.selection.DETERMINED_SIGMAS`)
+NODE_SIGMAS = DETERMINED_SIGMAS
 #: a record whose (median) channel's kurtosis lies this many of its standard errors above a Gaussian response's 3 is
 #: not stationary random response. Over 450 Gaussian records (one or two modes of 0.2-2 % damping, 30-60 s, the
 #: shortest and most lightly damped the identification accepts) the deviation in standard errors had SD 0.72 and
