@@ -92,8 +92,8 @@ def _lsfd_shapes(S, omega, poles_windowed, dt, n_picked, n_lags):
     spacing = omega[1] - omega[0] if omega.size > 1 else 1.0
     half_width = np.maximum(LOCAL_HALF_WIDTHS * np.abs(poles_windowed.real), LOCAL_MIN_LINES * spacing)
 
-    def term(pole):
-        return (1.0 - (pole / z) ** truncated) / (z - pole)
+    def term(pole, at):  # the pole's term on the lines ``at`` (their z)
+        return (1.0 - (pole / at) ** truncated) / (at - pole)
 
     shapes = np.empty((n_out, n_picked), complex)
     for r in range(n_picked):
@@ -104,7 +104,7 @@ def _lsfd_shapes(S, omega, poles_windowed, dt, n_picked, n_lags):
         n_lines = max(int(np.count_nonzero(distance <= half_width[r])), 2 * (2 * len(inside) + 3))
         lines = np.sort(np.argsort(distance, kind="stable")[:n_lines])
         zl = z[lines]
-        basis = np.column_stack([term(mu[q])[lines] for q in inside] + [term(mu[q].conj())[lines] for q in inside]
+        basis = np.column_stack([term(mu[q], zl) for q in inside] + [term(mu[q].conj(), zl) for q in inside]
                                 + [np.ones_like(zl), 1.0 / zl, 1.0 / zl**2])
         coef, *_ = np.linalg.lstsq(basis, flat[lines], rcond=None)
         u, _, _ = np.linalg.svd(coef[0].reshape(n_out, m), full_matrices=False)
