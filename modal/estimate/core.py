@@ -29,12 +29,12 @@ from .excitation_noise import EXCITATION_NOISE_LIMIT, excitation_noise_share
 from .common_error import common_error_factor
 from .error_correlation import LEAKAGE_LAGS, MIN_RECORDS, measured_line_correlation
 from .record_influence import MAX_INFLUENCE_VALUES, channel_influence, overlapping_records, record_influence
-from .hits import find_hits, pulse_train
+from .hits import find_hits, pulse_train, reject_pulses_the_window_cuts
 from .levels import level_dependence, take_dependence
 from .overload import find_overloads
 from .periodic import repeats_every, shortest_period
 from .quiet import quiet_noise
-from .takes import find_hits_in_takes, segment_starts, take_bounds
+from .takes import find_hits_in_takes, hit_labels, segment_starts, take_bounds
 from .takes import take_names as _take_names
 from .windows import WINDOWS, exponential_window, force_window, segment_window
 
@@ -542,6 +542,11 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
             force, np.asarray(y, dtype=float), fs, threshold=threshold, pretrigger_s=pre, record_length=length,
             double_hit_window_s=double_hit_window_s, decay_fraction=decay_fraction, decay_window=decay,
             full_scale=full_scale, channel_names=labels, source=source)
+        in_w = np.ones(length)
+        if window in ("force", "exponential"):
+            in_w = force_window(length, pre_samples, width=max(8, 3 * hits.pulse_samples))
+            hits = reject_pulses_the_window_cuts(hits, force, in_w, fs, hit_labels(
+                hits, None if take_lengths is None else bounds, names_of_takes, fs))
         rejected = hits.rejected
         overloads = hits.overloads
         # the force channel's offset (a charge amplifier's, an IEPE sensor settling) is no force the structure
@@ -563,9 +568,6 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
                           "decay within them (window='exponential' with exponential_decay_s; modal fit --window "
                           "exponential --exponential-decay-s S), its damping taken back out of the modes")
             raise ParameterError(f"{source}: every hit was rejected ({reasons}){advice}")
-        in_w = np.ones(length)
-        if window in ("force", "exponential"):
-            in_w = force_window(length, pre_samples, width=max(8, 3 * hits.pulse_samples))
         out_w = np.ones(length)
         if decay is not None:
             in_w = in_w * decay

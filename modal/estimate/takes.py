@@ -16,7 +16,7 @@ import numpy as np
 from ..errors import ParameterError
 from .hits import Hits, find_hits
 
-__all__ = ["take_bounds", "take_names", "segment_starts", "find_hits_in_takes"]
+__all__ = ["hit_labels", "take_bounds", "take_names", "segment_starts", "find_hits_in_takes"]
 
 
 def take_bounds(take_lengths: Sequence[int] | None, n_samples: int, source: str) -> np.ndarray:
@@ -87,3 +87,16 @@ def find_hits_in_takes(force: np.ndarray, response: np.ndarray, sample_rate_hz: 
         rejected=rejected,
         overloads=[item for hits in found for item in hits.overloads],
     )
+
+
+def hit_labels(hits: Hits, bounds: np.ndarray | None, names: Sequence[str], sample_rate_hz: float) -> list[dict]:
+    """Per hit of ``hits``: how its rejection names it, ``hit`` and ``time_s`` counted within its take, with
+    ``take`` (from 1) and ``take_name`` when ``bounds`` (the takes' first samples and the end) is given, as
+    :func:`find_hits_in_takes` names them; on the whole record without."""
+    trigger = np.asarray(hits.trigger_index)
+    if bounds is None:
+        return [{"hit": k + 1, "time_s": float(t / sample_rate_hz)} for k, t in enumerate(trigger)]
+    take = np.searchsorted(bounds, trigger, side="right") - 1
+    first_of_take = np.searchsorted(take, take, side="left")  # triggers are in time order
+    return [{"hit": int(k - first_of_take[k] + 1), "time_s": float((t - bounds[take[k]]) / sample_rate_hz),
+             "take": int(take[k] + 1), "take_name": names[take[k]]} for k, t in enumerate(trigger)]
