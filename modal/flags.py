@@ -14,7 +14,7 @@ __all__ = ["FLAG_TEXT", "FLAG_ACTION", "CHI2_LIMIT", "RELATIVE_MISFIT", "REL_STD
            "COMPLEX_PHASE_DEG", "MPC_LIMIT", "WEAK_FRACTION", "RIGID_BODY_RATIO", "HARMONIC_TOLERANCE",
            "HARMONIC_SIGMAS", "KURTOSIS_LIMIT", "MIN_DECAYS", "MIN_SHIFT_SIGMAS", "MAX_SCALE_ERROR", "MAX_LOCATION_MISFIT", "SIGN_SIGMAS", "GRID_FLAGS", "RESOLUTION_FLAGS", "RULE_FLAGS",
            "INFORMATIONAL", "serious_flags", "DRIVING_POINT_ONLY", "TRANSFER_ONLY", "lines_near_mode", "model_inadequate", "overlap",
-           "channel_flags", "contradictions", "flags_markdown"]
+           "channel_flags", "contradictions", "WITHOUT_KCM"]
 
 #: chi-square (residual variance over the noise variance) above which a model may be flagged model_inadequate
 CHI2_LIMIT = 3.0
@@ -262,14 +262,22 @@ DRIVING_POINT_ONLY = frozenset({"complex_mode", "non_positive_constant", "units_
 TRANSFER_ONLY = frozenset({"not_driving_point"})
 
 
-def channel_flags(flags, driving_point: bool) -> list[str]:
+#: Flags of a driving-point channel that gives no k, c, m for the mode (its constant has no positive real part, or
+#: its constants change sign between modes): on a driving-point channel that gives them they are another channel's.
+WITHOUT_KCM = frozenset({"non_positive_constant", "driving_point_contradicted"})
+
+
+def channel_flags(flags, driving_point: bool, gives_kcm: bool = False) -> list[str]:
     """The mode's flags that apply to one channel.
 
     A mode's flags are raised over all its channels; the per-channel report keeps those
     about the kind of channel it is (``not_driving_point`` only on transfer channels,
-    ``complex_mode`` and the like only on driving points).
+    ``complex_mode`` and the like only on driving points), and on a driving point that gives k, c, m
+    (``gives_kcm``) none of :data:`WITHOUT_KCM` (raised by another driving point of the mode).
     """
     drop = TRANSFER_ONLY if driving_point else DRIVING_POINT_ONLY
+    if driving_point and gives_kcm:
+        drop = drop | WITHOUT_KCM
     return [f for f in flags if f not in drop]
 
 
@@ -279,6 +287,8 @@ def contradictions(row: dict) -> list[str]:
     found = []
     if row["driving_point"]:
         found += [f"driving_point is true with flag {f}" for f in sorted(flags & TRANSFER_ONLY)]
+        if np.isfinite(row["stiffness_n_per_m"]):
+            found += [f"driving point reports stiffness_n_per_m with flag {f}" for f in sorted(flags & WITHOUT_KCM)]
     else:
         found += [f"driving_point is false with flag {f}" for f in sorted(flags & DRIVING_POINT_ONLY)]
         found += [f"transfer channel reports {name}" for name in ("stiffness_n_per_m", "damping_n_s_per_m", "mass_kg")

@@ -268,9 +268,9 @@ class IdentificationResult:
                 row["std"] = {f.name: float(pick(getattr(mode.std, f.name))) for f in fields(ModeStd)
                               if getattr(mode.std, f.name) is not None}
                 row["driving_point"] = bool(pick(mode.driving_point))
-                row["flags"] = channel_flags(mode.flags, row["driving_point"])  # only those that apply here
+                # only those that apply here
+                row["flags"] = channel_flags(mode.flags, row["driving_point"], np.isfinite(row["stiffness_n_per_m"]))
                 row["band_hz"] = [float(b) for b in mode.band_hz]
-                row["driving_point"] = bool(pick(mode.driving_point))
                 row["chi2"] = float(mode.chi2)
                 row["window_damping_ratio"] = float(mode.window_damping_ratio)
                 out.append(row)

@@ -79,3 +79,22 @@ def test_a_mass_line_without_a_finite_0_hz_value_is_refused_there_and_kept_elsew
     omega = frf.frequency_hz[1:] * 2 * np.pi
     no_residual = replace(result, residuals=None).synthesize(frf.frequency_hz[1:])
     assert np.allclose(above.response - no_residual.response, 1e-6 * 1j * omega - 2.0j / omega, rtol=1e-12, atol=0)
+
+
+def test_a_contradicted_driving_point_flags_its_own_rows_only():
+    # two channels declared driving points; the second's constants change sign between the modes (a transfer
+    # channel): its rows carry driving_point_contradicted and non_positive_constant and no k, c, m; the first,
+    # a true driving point, gives k, c, m and its rows said the other channel's flags as their own
+    from modal.flags import contradictions
+
+    frf = modal_frf(np.linspace(50.0, 350.0, 3001), [100.0, 300.0], [0.02, 0.02], [[1.0, 0.6], [0.5, -0.8]])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        rows = identify(frf, "nls", driving_point=[0, 1]).rows()
+    for row in rows:
+        assert contradictions(row) == [], row
+        if row["channel"] == 0:
+            assert np.isfinite(row["stiffness_n_per_m"]) and row["flags"] == [], row
+        else:
+            assert np.isnan(row["stiffness_n_per_m"]) and "driving_point_contradicted" in row["flags"], row
+    assert [("non_positive_constant" in row["flags"]) for row in rows if row["channel"] == 1] == [False, True]
