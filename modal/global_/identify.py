@@ -221,7 +221,7 @@ def _loose_lines(omega, wn, zeta):
     return index, np.where(near[index], 1.0, np.sqrt(LOOSE_EVERY))
 
 
-def _fit_within(omega, H, power, wn, zeta, step_tol, budget=None, weighting=(None, None, 0, None)):
+def _fit_within(omega, H, power, wn, zeta, step_tol, budget=None, weighting=(None, None, 0, None), noise=None):
     """The joint fit with residual terms, without the poles that widen past :data:`MAX_DAMPING`.
 
     A pole that the stabilisation kept on the tail of a mode outside the lines (or on noise) has no
@@ -234,6 +234,7 @@ def _fit_within(omega, H, power, wn, zeta, step_tol, budget=None, weighting=(Non
     :class:`~modal.work_budget.EvaluationBudget` (each fit takes what is left of it; a fit it stops is returned).
     ``weighting``: (line weights, :class:`~modal.whitening.LineWhitening`, lags, shared error factor) of every line, for the tight fits
     (:func:`_line_weighting`); the loose ones, on a sample of the lines, only start others and go unweighted.
+    ``noise``: each channel's noise standard deviation, when known (the channels weighed by it).
     """
     removed: list[float] = []
     while True:
@@ -248,13 +249,13 @@ def _fit_within(omega, H, power, wn, zeta, step_tol, budget=None, weighting=(Non
                                 max_damping=MAX_DAMPING, errors=tight, max_evaluations=allowed,
                                 decrement_tol=TIGHT_DECREMENT if tight else LOOSE_DECREMENT,
                                 line_weight=weight, whitening=whitening, correlated_lags=lags if tight else 0,
-                                relative_error=common)
+                                relative_error=common, channel_noise=noise)
             else:
                 index, line_weight = lines
                 fit = fit_modes(omega[index], H[:, index], power, wn, zeta, region=None, residual_terms=True,
                                 step_tol=step_tol, max_damping=MAX_DAMPING, errors=False,
                                 decrement_tol=LOOSE_DECREMENT, line_weight=line_weight,
-                                channel_scale=np.abs(H).max(axis=1), max_evaluations=allowed)
+                                channel_scale=np.abs(H).max(axis=1), max_evaluations=allowed, channel_noise=noise)
         if budget is not None:
             budget.spend(fit)
             if fit.capped:
@@ -284,7 +285,7 @@ def _refine(omega, H, power, wn0, zeta0, noise, step_tol=LOOSE_STEP_TOL, budget=
     once it is spent, no mode is tested or dropped. ``weighting``: as for :func:`_fit_within`.
     """
     n_ch = H.shape[0]
-    fit, dropped = _fit_within(omega, H, power, wn0, zeta0, step_tol, budget, weighting)
+    fit, dropped = _fit_within(omega, H, power, wn0, zeta0, step_tol, budget, weighting, noise)
     for _ in range(3):
         if budget is not None and budget.spent:
             break
@@ -297,7 +298,7 @@ def _refine(omega, H, power, wn0, zeta0, noise, step_tol=LOOSE_STEP_TOL, budget=
             break
         dropped += [float(w / TWO_PI) for w in fit.omega_n[weak]]
         fit, removed = _fit_within(omega, H, power, fit.omega_n[~weak], fit.damping_ratio[~weak], step_tol, budget,
-                                   weighting)
+                                   weighting, noise)
         dropped += removed
     return fit, dropped
 

@@ -216,7 +216,7 @@ def _least_squares_fits(frf, bands, power, noise, estimated_noise, known_noise, 
                                                                          n_regions))
     fit = nls_fit(frf, bands, power, noise, data, band_peak, budget)
     # an estimate from windowed records: fit the model as the window shows it (its bias is the window's)
-    data, fit, note = without_window_bias(frf, bands, power, data, band_peak, fit, budget)
+    data, fit, note = without_window_bias(frf, bands, power, data, band_peak, fit, budget, noise)
     # the checks all measure the residual of the same modes on the same lines: the fit's own when it is
     # unweighted (no second solve), else computed once
     own = fit.residual is not None and not fit.line_weighted

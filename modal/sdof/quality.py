@@ -54,7 +54,7 @@ def refinement_check(frf, bands, power, poles, consts, noise, estimated_noise, k
     keep, _ = regions(bands, frf.frequency_hz)
     strongest = np.argsort(np.max(np.abs(frf.channels[:, keep]) / np.where(noise > 0, noise, 1.0)[:, None],
                                   axis=1))[::-1][:POLE_CHANNELS]
-    fit = fit_bands(frf, bands, power, wn0, z0, strongest, budget=budget)
+    fit = fit_bands(frf, bands, power, wn0, z0, strongest, budget=budget, noise=noise)
     if budget is not None and budget.capped:
         return [no_reference(np.nan)] * n_modes, None
     if residual is not None:

@@ -58,7 +58,7 @@ def nls_fit(frf, bands, power, noise, data=None, band_peak=None, budget=None):
     quick = [starts.quick_start(frf, band, power, noise) for band in bands]
     if all(q is not None for q in quick):
         fit = fit_bands(frf, bands, power, [q[0] for q in quick], [q[1] for q in quick], data=data,
-                        band_peak=band_peak, budget=budget)
+                        band_peak=band_peak, budget=budget, noise=noise)
         if not doubtful(fit, bands) or (budget is not None and budget.spent):
             return fit
     else:
@@ -66,21 +66,25 @@ def nls_fit(frf, bands, power, noise, data=None, band_peak=None, budget=None):
     start = starts.principal_start if frf.n_channels > 1 else starts.start_pole
     careful_starts = [start(frf, band, power, noise) for band in bands]
     careful = fit_bands(frf, bands, power, [s[0] for s in careful_starts], [s[1] for s in careful_starts], data=data,
-                        band_peak=band_peak, budget=budget)
-    if fit is None or fit_cost(careful) <= fit_cost(fit):
+                        band_peak=band_peak, budget=budget, noise=noise)
+    if fit is None or fit_cost(careful, noise) <= fit_cost(fit, noise):
         return careful
     return fit
 
 
-def fit_cost(fit) -> float:
-    """Residual of a band-wise fit summed over channels, each scaled by its largest value."""
+def fit_cost(fit, noise=None) -> float:
+    """Residual of a band-wise fit summed over channels, each over its noise (``noise``, the fit's channels'
+    standard deviations, when known) or else its largest value."""
     if not np.all(np.isfinite(fit.noise_var)):
         return np.inf
     scale = np.where(fit.channel_scale > 0, fit.channel_scale, 1.0)  # max |H| of each channel on the lines
+    if noise is not None and np.shape(noise) == scale.shape and np.all(np.isfinite(noise) & (noise > 0)):
+        scale = np.asarray(noise, float)
     return float(np.sum(fit.noise_var / scale**2))
 
 
-def fit_bands(frf, bands, power, omega_n0, damping_ratio0, channels=None, data=None, band_peak=None, budget=None):
+def fit_bands(frf, bands, power, omega_n0, damping_ratio0, channels=None, data=None, band_peak=None, budget=None,
+              noise=None):
     """:func:`modal.nls.fit_modes` of every band's mode together, with collapsed modes reseated.
 
     A weak mode whose start lies on a noise spike can collapse there inside the
@@ -93,7 +97,8 @@ def fit_bands(frf, bands, power, omega_n0, damping_ratio0, channels=None, data=N
     reported fit is the better least-squares optimum of the same model. ``data``: the
     :func:`band_data` of these bands and channels, when the caller has it; ``band_peak``: its
     :func:`band_peaks`. ``budget``: an :class:`~modal.work_budget.EvaluationBudget` each fit takes what is left
-    of (no restart once it is spent).
+    of (no restart once it is spent). ``noise``: each of the FRF's channels' noise standard deviation, when
+    known: the channels are weighed by it (:func:`modal.nls.fit_modes`'s ``channel_noise``).
     """
     omega, response, region = band_data(frf, bands, channels) if data is None else data
     weight = line_weight(frf, bands)
@@ -102,11 +107,13 @@ def fit_bands(frf, bands, power, omega_n0, damping_ratio0, channels=None, data=N
     influence, overlapping = band_influence(frf, bands, channels)
     common = band_relative_error(frf, bands, channels)
     scale = None if band_peak is None else band_peak.max(axis=0)  # max |H| of each channel on the lines
+    if noise is not None:
+        noise = np.asarray(noise, float) if channels is None else np.asarray(noise, float)[channels]
     with np.errstate(all="ignore"):
         fit = fit_modes(omega, response, power, omega_n0, damping_ratio0, region=region, line_weight=weight,
                         channel_scale=scale, whitening=whitening, correlated_lags=lags,
                         record_influence=influence, overlapping_records=overlapping, relative_error=common,
-                        max_evaluations=None if budget is None else budget.for_fit())
+                        max_evaluations=None if budget is None else budget.for_fit(), channel_noise=noise)
     if budget is not None:
         budget.spend(fit)
     if len(bands) < 2:
@@ -131,10 +138,11 @@ def fit_bands(frf, bands, power, omega_n0, damping_ratio0, channels=None, data=N
             restart = fit_modes(omega, response, power, start_wn, start_zeta, region=region, line_weight=weight,
                                 channel_scale=scale, whitening=whitening, correlated_lags=lags,
                                 record_influence=influence, overlapping_records=overlapping,
-                                relative_error=common, max_evaluations=None if budget is None else budget.for_fit())
+                                relative_error=common, max_evaluations=None if budget is None else budget.for_fit(),
+                                channel_noise=noise)
         if budget is not None:
             budget.spend(restart)
-        if fit_cost(restart) < fit_cost(fit):
+        if fit_cost(restart, noise) < fit_cost(fit, noise):
             fit = restart
     return fit
 
@@ -180,7 +188,7 @@ def with_shift(cov, pole_shift, constant_shift):
     return cov + d[:, :, None] * d[:, None, :]
 
 
-def without_window_bias(frf, bands, power, data, band_peak, fit, budget=None):
+def without_window_bias(frf, bands, power, data, band_peak, fit, budget=None, noise=None):
     """The fit of the model convolved with the estimate's lag window (:mod:`modal.leakage`), when its window
     biases these modes: the data less the window's bias of the fitted modes, refitted, a few rounds (a fixed
     point; the bias changes little with the poles, each round takes its error down by the bias's own
@@ -188,7 +196,7 @@ def without_window_bias(frf, bands, power, data, band_peak, fit, budget=None):
 
     Returns (data, fit, note): the corrected lines of the bands, their fit, and what was done (a sentence for
     the result's settings), or the arguments unchanged and None when the FRF carries no lag window or it
-    does not bias these modes. ``budget``: as for :func:`fit_bands` (no round once it is spent).
+    does not bias these modes. ``budget``, ``noise``: as for :func:`fit_bands` (no round once it is spent).
     """
     model = frf.noise_model
     if model is None or not bias_matters(model.lag_window, model.sample_interval_s, fit.omega_n,
@@ -208,7 +216,7 @@ def without_window_bias(frf, bands, power, data, band_peak, fit, budget=None):
             return data, first, None
         corrected = (omega, response - bias, region)
         fit = fit_bands(frf, bands, power, fit.omega_n, fit.damping_ratio, data=corrected, band_peak=band_peak,
-                        budget=budget)
+                        budget=budget, noise=noise)
         if not (np.all(np.isfinite(fit.omega_n)) and np.all(np.isfinite(fit.damping_ratio))):
             return data, first, None
     with np.errstate(all="ignore"):

@@ -9,17 +9,35 @@ from modal.errors import ArchiveError
 from modal.synthetic import add_noise, modal_frf
 
 
-def _equal(a, b):
+#: two runs of the same arithmetic on another CPU or BLAS build differ in their last digits: the recomputed circle
+#: fit's ζ by 1 ulp, the half-power ζ by 7.5e-13 (the crossings' difference loses digits). The errors are central
+#: differences over relative steps of 1e-6, which scale that by 1e6: measured 5e-10 (circle) and 1.6e-7
+#: (half-power ζ's error) between two machines. A changed algorithm moves the numbers by far more than this
+#: relative difference
+ROUNDING = 1e-6
+
+
+def _equal(a, b, rtol=0.0):
+    """``a`` and ``b`` of the same types and structure, their numbers equal (within ``rtol`` relative to each
+    array's largest |value|, or each number's own)."""
     if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
-        return np.array_equal(np.asarray(a), np.asarray(b), equal_nan=True) and np.asarray(a).dtype == np.asarray(b).dtype
+        a, b = np.asarray(a), np.asarray(b)
+        if a.dtype != b.dtype or a.shape != b.shape:
+            return False
+        if rtol == 0 or not np.issubdtype(a.dtype, np.number):
+            return np.array_equal(a, b, equal_nan=True)
+        scale = np.nanmax(np.abs(a)) if np.any(np.isfinite(a)) else 0.0
+        return bool(np.all((np.isnan(a) & np.isnan(b)) | (np.abs(a - b) <= rtol * scale)))
     if hasattr(a, "__dataclass_fields__"):
-        return type(a) is type(b) and all(_equal(getattr(a, k), getattr(b, k)) for k in a.__dataclass_fields__)
+        return type(a) is type(b) and all(_equal(getattr(a, k), getattr(b, k), rtol) for k in a.__dataclass_fields__)
     if isinstance(a, (tuple, list)):
-        return type(a) is type(b) and len(a) == len(b) and all(_equal(x, y) for x, y in zip(a, b))
+        return type(a) is type(b) and len(a) == len(b) and all(_equal(x, y, rtol) for x, y in zip(a, b))
     if isinstance(a, dict):
-        return type(b) is dict and a.keys() == b.keys() and all(_equal(a[k], b[k]) for k in a)
+        return type(b) is dict and a.keys() == b.keys() and all(_equal(a[k], b[k], rtol) for k in a)
     if isinstance(a, float) and np.isnan(a):
         return isinstance(b, float) and np.isnan(b)
+    if rtol and isinstance(a, (float, complex)) and type(a) is type(b):
+        return abs(a - b) <= rtol * abs(a)
     return type(a) is type(b) and a == b
 
 
@@ -117,15 +135,16 @@ def test_an_archive_written_before_classes_moved_still_loads():
     back = read_archive(path)
     frf = add_noise(modal_frf(np.linspace(40.0, 60.0, 81), [50.0], [0.02], [1.0], kind="mobility"), 1e-3, seed=1)
     omega, h = frf.omega_rad_s, frf.response
-    # the classes load from their new homes, and today's code computes the same numbers, bit for bit
-    assert type(back["circle"]) is CircleEstimate and _equal(back["circle"], circle_fit_curve(omega, h, 1e-3))
-    assert type(back["halfpower"]) is HalfPowerEstimate and _equal(back["halfpower"], half_power_curve(omega, h, 1, 1e-3))
+    # the classes load from their new homes, and today's code computes the same numbers, to rounding
+    assert type(back["circle"]) is CircleEstimate and _equal(back["circle"], circle_fit_curve(omega, h, 1e-3), ROUNDING)
+    assert (type(back["halfpower"]) is HalfPowerEstimate
+            and _equal(back["halfpower"], half_power_curve(omega, h, 1, 1e-3), ROUNDING))
     assert back["missing"] == MissingMode(51.5, 0.01, 0, 40.0, 25.0, (0,))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # whatever the flags say, they are the same flags
         again = identify(frf, "circle", driving_point=True)
     # the archived single channel was then assumed to be a driving point (flag driving_point_assumed); a
-    # driving point is now known or declared: declared, the numbers are the same, bit for bit
+    # driving point is now known or declared: declared, the numbers are the same, to rounding
     old = back["identify"]
     assert [set(m.flags) - {"driving_point_assumed"} for m in old.modes] == [set(m.flags) for m in again.modes]
     assert all("driving_point_assumed" in m.flags for m in old.modes)
@@ -139,7 +158,7 @@ def test_an_archive_written_before_classes_moved_still_loads():
         settings = {k: v for k, v in result.settings.items() if k not in ("max_evaluations", "evaluations")}
         return replace(result, modes=tuple(replace(m, flags=()) for m in result.modes), settings=settings)
 
-    assert _equal(numbers(old), numbers(again))
+    assert _equal(numbers(old), numbers(again), ROUNDING)
 
 
 @pytest.mark.parametrize("old", sorted(__import__("modal.archive", fromlist=["RENAMED_CLASSES"]).RENAMED_CLASSES))

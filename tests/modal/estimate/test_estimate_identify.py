@@ -160,3 +160,27 @@ def test_single_hits_of_a_repeated_test_do_not_cry_model_inadequate():
         total += len(result)
         flagged += sum("model_inadequate" in m.flags for m in result)
     assert total == 12 and flagged == 0
+
+
+@pytest.mark.parametrize("method", ["nls", "global"])
+def test_a_response_channel_of_noise_only_leaves_the_others_modes_alone(method):
+    # a hammer test whose second accelerometer is unplugged (its channel white noise): each channel was fitted
+    # over its own max |H|, so the dead channel's noise, of the order of its max, outweighed the good channel's
+    # 1e-3 and took the poles: nls put the 40 Hz mode at 40.58 ± 0.31 Hz (truth 40 Hz, 0.0013 with the channels
+    # weighed by their noise), every mode flagged. Weighed by their noise (maximum likelihood), the dead channel
+    # adds nothing: the poles are the good channel's, within 4 of their standard errors, unflagged
+    from modal.synthetic import DigitalModes as Plant, impact_record
+
+    plant = Plant([40.0, 95.0], [0.03, 0.02], [[1.0, 0.5], [0.6, -0.8]], 2048.0)
+    signals = impact_record(plant, [0.5, 2.5, 4.5, 6.5], 8.0, force_noise=0.002, response_noise=0.002,
+                            seed=2).record.signals.copy()
+    signals[2] = 1e-3 * np.random.default_rng(0).standard_normal(signals.shape[1])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", modal.ModalWarning)
+        frf = modal.estimate_frf(signals[0], signals[1:], 2048.0, impact=True, window="force", kind="accelerance",
+                                 response_quantity="acceleration")
+    result = _fit(frf, method=method, driving_point=0)
+    fn = np.array([m.natural_frequency_hz for m in result.modes])
+    std = np.array([m.std.natural_frequency_hz for m in result.modes])
+    assert fn.size == 2 and np.all(np.abs(fn - [40.0, 95.0]) < 4 * std) and np.all(std < 0.01), (fn, std)
+    assert all(m.flags == ("not_driving_point",) for m in result.modes), [m.flags for m in result.modes]
