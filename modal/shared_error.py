@@ -14,13 +14,19 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["CommonError", "JoinedError", "MAX_FACTOR_SIZE", "MAX_FACTOR_BYTES", "FACTOR_TOLERANCE", "SKETCH_COLUMNS"]
+__all__ = ["CommonError", "JoinedError", "MAX_FACTOR_SIZE", "MAX_EIGEN_SIZE", "MAX_FACTOR_BYTES", "FACTOR_TOLERANCE",
+           "SKETCH_COLUMNS"]
 
 #: the factor of a set of lines comes from an eigendecomposition of the smaller of its two Gram matrices, lines ×
 #: lines (the covariance) or rows × rows (records × window samples), of at most this size (1024²: 0.3 s at the
 #: worst); a fit's band of tens to hundreds of lines is always within it, every line of a long record with
 #: hundreds of hits' samples is not (that fit goes without it)
 MAX_FACTOR_SIZE = 1024
+#: a Gram matrix whose rank exceeds the random sketch's columns (:func:`_eigen`) is decomposed whole up to this
+#: size (a 4-hit test of 8 s records with a 138-sample force window: 552 rows, 0.2 s); beyond (every line of
+#: 16384-sample records with 3 hits of 266 force-window samples, 798 rows of rank 276: 1.5 s a fit, and a factor
+#: of 36 MB per channel), no factor is formed
+MAX_EIGEN_SIZE = 640
 #: a factor of more bytes than this (rows kept × lines) is not formed: its fit goes without it
 MAX_FACTOR_BYTES = 64 * 2**20
 #: eigenvalues of the covariance below this fraction squared of the largest are dropped (their variance is 1e-8
@@ -103,8 +109,8 @@ class CommonError:
     def factor(self, keep=None) -> np.ndarray | None:
         """P, shape (n_factors, n_kept) complex, on the lines ``keep`` (bool mask or indices; default all):
         E[η_k η*_l] = Σ_r P_rk conj(P_rl), with the eigenvalues below :data:`FACTOR_TOLERANCE` squared of the
-        largest dropped. None where both Gram matrices exceed :data:`MAX_FACTOR_SIZE` or P
-        :data:`MAX_FACTOR_BYTES`.
+        largest dropped. None where both Gram matrices exceed :data:`MAX_FACTOR_SIZE`, the smaller's rank exceeds
+        the sketch's and its size :data:`MAX_EIGEN_SIZE` (:func:`_eigen`), or P :data:`MAX_FACTOR_BYTES`.
 
         Fewer lines than rows (a fit's band): P = Λ^½ Vᴴ from the lines' covariance V Λ Vᴴ, W(k − l) Σ_i g_i(k)
         g_i*(l). Else from the rows' Gram matrix, whose entry of rows (i, n) and (j, m) is
@@ -130,7 +136,10 @@ class CommonError:
         if n_lines <= n_rows:
             covariance = (self.window_transform(np.subtract.outer(self.lines, self.lines))
                           * (self.gains.T @ self.gains.conj()))
-            power, vectors = _eigen(covariance)
+            eigen = _eigen(covariance)
+            if eigen is None:
+                return None
+            power, vectors = eigen
             kept = _kept(power)
             if kept.sum() * n_lines * 16 > MAX_FACTOR_BYTES:
                 return None
@@ -148,7 +157,10 @@ class CommonError:
             transforms = np.fft.fft(on_grid[i] * on_grid.conj(), axis=-1)  # (n_records j, N)
             gram[i] = transforms[:, difference].transpose(1, 0, 2)
         gram *= np.multiply.outer(self.amplitude, self.amplitude)[None, :, None, :]
-        power, vectors = _eigen(gram.reshape(n_rows, n_rows))
+        eigen = _eigen(gram.reshape(n_rows, n_rows))
+        if eigen is None:
+            return None
+        power, vectors = eigen
         kept = _kept(power)
         if kept.sum() * self.n_lines * 16 > MAX_FACTOR_BYTES:
             return None
@@ -164,7 +176,7 @@ class CommonError:
         return out
 
 
-def _eigen(matrix: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _eigen(matrix: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
     """The eigenvalues (ascending) and eigenvectors of a Hermitian positive semi-definite ``matrix`` that carry it
     but for what :data:`FACTOR_TOLERANCE` may drop: its rank is a few dozen where it is hundreds wide (a force
     window's few dozen samples span as few directions over a band).
@@ -173,8 +185,8 @@ def _eigen(matrix: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     (Halko, Martinsson & Tropp 2011), holds its range when what Q leaves out, tr(M) − tr(Qᴴ M Q) (the rows'
     squared norm Q misses, for M = L Lᴴ), is below what the tolerance may drop; then M's eigenpairs are Qᴴ M Q's,
     their vectors times Q. The sketch doubles once if it does not; then (a rank of hundreds, where sketches cost
-    more) the eigendecomposition of ``matrix`` itself (0.25 s for a band of 700 lines, against the sketch's two
-    products)."""
+    more) the eigendecomposition of ``matrix`` itself, up to :data:`MAX_EIGEN_SIZE` wide; None beyond (its
+    factor of hundreds of rows over thousands of lines would not fit the fits' memory either)."""
     size = matrix.shape[0]
     total = float(np.trace(matrix).real)
     columns = min(SKETCH_COLUMNS, size)
@@ -185,7 +197,7 @@ def _eigen(matrix: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         if total - float(np.sum(power)) <= FACTOR_TOLERANCE**2 * power[-1] * size:
             return power, q @ vectors
         columns *= 2
-    return np.linalg.eigh(matrix)
+    return np.linalg.eigh(matrix) if size <= MAX_EIGEN_SIZE else None
 
 
 def _kept(power: np.ndarray) -> np.ndarray:
