@@ -27,10 +27,11 @@ SYSTEM = DigitalModes([12.0, 31.0], [0.02, 0.015], [[1.0, 0.6], [0.5, -0.8]], SA
 CASES = {"8": ([0.5, 8.5, 16.5, 24.5], 33.5), "16": ([0.5, 17.5, 34.5], 51.5)}
 
 
-def run(case: str, records: int) -> str:
-    """One line of results for ``case`` over ``records`` draws of the noise."""
-    hits, duration = CASES[case]
-    n = int(duration * SAMPLE_RATE_HZ)
+def constants_errors(hits, duration_s: float, records: int) -> tuple[list[float], list[float], list[float], bool]:
+    """(|error| / reported error of the driving point's constants, both modes; CPU s of each estimate; of each
+    identification; whether every estimate carried the shared error) over ``records`` draws of the noise, for
+    hits at the times ``hits`` (s) in a record of ``duration_s``."""
+    n = int(duration_s * SAMPLE_RATE_HZ)
     force = hammer_force(n, SAMPLE_RATE_HZ, hits, amplitude_n=100.0)
     response = SYSTEM.respond(force)
     ratios, estimating, identifying, carried = [], [], [], True
@@ -51,6 +52,12 @@ def run(case: str, records: int) -> str:
             mode = min(result, key=lambda m: abs(m.natural_frequency_hz - fn))
             error = np.atleast_1d(mode.modal_constant)[0] - SYSTEM.modal_constant[0, k]
             ratios.append(abs(error) / np.atleast_1d(mode.std.modal_constant)[0])
+    return ratios, estimating, identifying, carried
+
+
+def run(case: str, records: int) -> str:
+    """One line of results for ``case`` over ``records`` draws of the noise."""
+    ratios, estimating, identifying, carried = constants_errors(*CASES[case], records)
     return (f"case {case}: shared error {'carried' if carried else 'not carried'}, constants' |e|/s RMS "
             f"{np.sqrt(np.mean(np.square(ratios))):.2f}, estimate {np.median(estimating[1:]):.3f} CPU-s, "
             f"identify {np.median(identifying[1:]):.3f} CPU-s (medians over {records - 1} records)")
