@@ -10,7 +10,7 @@ be a hundred MB.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -74,7 +74,6 @@ class CommonError:
     support: np.ndarray
     amplitude: np.ndarray
     length: int
-    _last: tuple | None = field(default=None, init=False, repr=False)  # (lines, their factor) last formed
 
     def __post_init__(self) -> None:
         for name, dtype in (("gains", complex), ("lines", np.int64), ("support", np.int64), ("amplitude", float)):
@@ -119,8 +118,9 @@ class CommonError:
         The last lines' factor is kept (read-only): a band's fits ask for it several times.
         """
         key = None if keep is None else np.arange(self.n_lines)[keep].tobytes()
-        if self._last is not None and self._last[0] == key:
-            return self._last[1]
+        last = self.__dict__.get("_last")  # (lines, their factor) last formed: no field, not archived
+        if last is not None and last[0] == key:
+            return last[1]
         part = self if keep is None else self.cropped(keep)
         factor = part._factor()
         if factor is not None:

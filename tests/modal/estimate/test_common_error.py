@@ -154,3 +154,22 @@ def test_three_hits_of_sixteen_seconds_report_their_constants_errors():
     # 4.8 over these 20 records and both modes; the fits now form the factor on their bands. Calibrated: 1 (as
     # above, standard error 0.08), held within 0.75-1.3
     assert 0.75 <= _constants_rms("16", 20) <= 1.3
+
+
+def test_an_archive_keeps_it_and_a_joined_one(tmp_path):
+    # the generators are the model's fields (the last band's factor, kept for the fits, is none): an archive
+    # written and read back gives the same factor on any lines
+    from modal.archive import read_archive, write_archive
+    from modal.noise_model import NoiseModel
+    from modal.shared_error import JoinedError
+
+    rng = np.random.default_rng(0)
+    common = CommonError(rng.standard_normal((3, 50)) + 1j * rng.standard_normal((3, 50)), np.arange(50),
+                         np.arange(10), np.linspace(1.0, 0.5, 10), 128)
+    band = slice(5, 20)
+    common.factor(band)
+    for shared in (common, JoinedError((common, common.cropped(np.arange(50)[::-1])), (1, 2))):
+        write_archive(tmp_path / "a.h5", {"model": NoiseModel(3, 2.0, None, None, 1e-3, relative_error=shared)})
+        back = read_archive(tmp_path / "a.h5").items["model"].relative_error
+        assert type(back) is type(shared)
+        np.testing.assert_array_equal(back.factor(band), shared.factor(band))
