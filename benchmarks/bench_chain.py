@@ -209,6 +209,12 @@ CELLS = {c.name: c for c in [
       for short, window, long in (("exp", "exponential", "exponential window τ = 0.5 s"),
                                   ("force", "force", "force window"))
       for hits in (3, 6, 12) for outputs in counts],
+    # 16384-sample records (hits 17 s apart): the force window's 266 samples × 3 hits are 798 rows of 8193 lines,
+    # the excitation's shared error formed per fit band (modal.estimate.common_error.CommonError)
+    Cell("hammer-force-3-ch3-16k", "hammer, 3 hits 17 s apart (16384-sample records), force window, "
+         "3 accelerometers in one file", hammer_cell(3, "force", None, spacing_s=17.0, n_outputs=3)),
+    Cell("hammer-force-3-ch3-16k-global", "hammer-force-3-ch3-16k, global method (the factor on every line)",
+         hammer_cell(3, "force", None, spacing_s=17.0, n_outputs=3), {"method": "global"}),
     Cell("random-hann-ch3", "random, 120 s, Hann, default segments, one shaker, 3 accelerometers",
          random_cell(120.0, n_outputs=3)),
     # two shakers: band-wise nls over the six channels, and the default for a poly-reference grid (global)

@@ -219,11 +219,11 @@ class FRF:
             if order is not None and variance is not None:
                 object.__setattr__(self, "noise_model", replace(self.noise_model, variance_model=variance[order]))
             common = self.noise_model.relative_error
-            if common is not None and common.shape[-1] != freq.size:
-                raise FRFValidationError(f"{src}: field 'noise_model' has a relative error over {common.shape[-1]} "
+            if common is not None and common.n_lines != freq.size:
+                raise FRFValidationError(f"{src}: field 'noise_model' has a relative error over {common.n_lines} "
                                          f"lines; expected {freq.size} (one per line)")
             if order is not None and common is not None:
-                object.__setattr__(self, "noise_model", replace(self.noise_model, relative_error=common[..., order]))
+                object.__setattr__(self, "noise_model", replace(self.noise_model, relative_error=common.cropped(order)))
         if self.exponential_decay_s is not None:
             object.__setattr__(self, "exponential_decay_s", positive_number(
                 "exponential_decay_s", self.exponential_decay_s, "time in s", FRFValidationError, src))

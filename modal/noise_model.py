@@ -28,6 +28,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .errors import FRFValidationError
+from .shared_error import CommonError, JoinedError, frozen as _frozen
 
 __all__ = ["NoiseModel", "window_line_correlation", "lag_window", "input_noise_split", "MAX_LAGS", "CORRELATION_FLOOR",
            "MEASURED_CORRELATION_RECORDS", "MAX_INFLUENCE_VALUES"]
@@ -87,12 +88,14 @@ class NoiseModel:
     influence_withheld : bool
         The records' influences would have been kept but exceed the memory budget
         (:data:`MAX_INFLUENCE_VALUES`).
-    relative_error : ndarray, shape (n_factors, n_freq) or (n_channels, n_factors, n_freq), complex, or None
+    relative_error : CommonError or JoinedError, or None
         A short excitation window (a hammer's): the excitation noise's error, H_o η with η relative
-        (dimensionless, whatever the FRF's kind), as a factor P of its covariance, η = Pᵀ ξ with ξ standard
-        complex: E[η_k η*_l] = Σ_r P_rk conj(P_rl) (:mod:`modal.estimate.common_error`). 2-D: one η for every
-        output; 3-D: each channel's own factor over one ξ (a joined estimate: channels from independent
-        records take disjoint factors, :mod:`modal.roving`). None otherwise.
+        (dimensionless, whatever the FRF's kind), as what generates its covariance
+        (:mod:`modal.estimate.common_error`); a fit asks it for a factor P on its lines (``factor(keep)``),
+        η = Pᵀ ξ with ξ standard complex: E[η_k η*_l] = Σ_r P_rk conj(P_rl). A
+        :class:`~modal.shared_error.CommonError`: one η for every output; a
+        :class:`~modal.shared_error.JoinedError`: each channel's own (a joined estimate: channels from
+        independent records take disjoint factors, :mod:`modal.roving`). None otherwise.
     """
 
     averages: int
@@ -125,13 +128,15 @@ class NoiseModel:
             if variance.ndim != 1 or np.any(np.isinf(variance)) or np.any(variance < 0):
                 raise FRFValidationError("field 'variance_model' must hold one variance >= 0 (or NaN) per line")
             object.__setattr__(self, "variance_model", variance)
-        for name, rows in (("record_influence", "records"), ("relative_error", "factors")):
-            if getattr(self, name) is not None:
-                value = _frozen(getattr(self, name), complex)
-                if value.ndim not in (2, 3) or not np.all(np.isfinite(value)):
-                    raise FRFValidationError(f"field '{name}' must be a finite array of {rows} × lines "
-                                             f"(or channels × {rows} × lines)")
-                object.__setattr__(self, name, value)
+        if self.record_influence is not None:
+            value = _frozen(self.record_influence, complex)
+            if value.ndim not in (2, 3) or not np.all(np.isfinite(value)):
+                raise FRFValidationError("field 'record_influence' must be a finite array of records × lines "
+                                         "(or channels × records × lines)")
+            object.__setattr__(self, "record_influence", value)
+        if self.relative_error is not None and not isinstance(self.relative_error, (CommonError, JoinedError)):
+            raise FRFValidationError(f"field 'relative_error' is a {type(self.relative_error).__name__}; expected "
+                                     "a CommonError or JoinedError (modal.estimate.common_error)")
         if not (isinstance(self.overlapping_records, (int, np.integer)) and self.overlapping_records >= 0):
             raise FRFValidationError(f"field 'overlapping_records' is {self.overlapping_records!r}; "
                                      "expected an integer >= 0")
@@ -159,7 +164,7 @@ class NoiseModel:
         """
         variance = None if self.variance_model is None else self.variance_model[keep]
         influence = None if self.record_influence is None else self.record_influence[..., keep]
-        common = None if self.relative_error is None else self.relative_error[..., keep]
+        common = None if self.relative_error is None else self.relative_error.cropped(keep)
         if self.line_correlation is None:
             return replace(self, variance_model=variance, record_influence=influence, relative_error=common)
         lines = np.flatnonzero(keep)
@@ -303,14 +308,3 @@ def _nonnegative_fit(design: np.ndarray, target: np.ndarray) -> tuple[float, flo
         if cost < best_cost:
             best, best_cost = ((value, 0.0) if column == 0 else (0.0, value)), cost
     return best
-
-
-def _frozen(value, dtype) -> np.ndarray:
-    """``value`` as a read-only array of ``dtype``: itself when it is one already (a noise model made from
-    another by ``replace``, whose arrays may be tens of MB: a common error factor of 552 rows × 4097 lines), else
-    a copy, so that no caller's array is frozen or shared."""
-    if isinstance(value, np.ndarray) and value.dtype == np.dtype(dtype) and not value.flags.writeable:
-        return value
-    copy = np.array(value, dtype=dtype)
-    copy.setflags(write=False)
-    return copy

@@ -24,6 +24,7 @@ import numpy as np
 from .errors import FormatError
 from .estimate import EstimatedFRF
 from .noise_model import NoiseModel
+from .shared_error import CommonError, JoinedError
 
 __all__ = ["RovingEstimate", "roving_points", "join_estimates", "LAG_WINDOW_TOLERANCE", "CORRELATION_TOLERANCE"]
 
@@ -235,29 +236,14 @@ def _joined_noise_model(models, responses) -> tuple[NoiseModel | None, list[str]
     return joined, dropped
 
 
-#: channels × factors × lines of a joined relative error at most (64 MiB); above, none is carried
-MAX_RELATIVE_VALUES = 1 << 22
-
-
-def _joined_relative_error(models, responses) -> np.ndarray | None:
-    """Each joined channel's excitation-noise factor over one ξ, (n_channels, n_factors, n_lines): a point's
-    factor in its own block of factors (the points' records are independent), zero in the others'; None unless
-    every point carries one (and a variance model and line correlation), or above :data:`MAX_RELATIVE_VALUES`."""
-    if any(m.relative_error is None or m.relative_error.ndim != 2 or m.variance_model is None
+def _joined_relative_error(models, responses) -> JoinedError | None:
+    """Each joined point's excitation-noise error, its channels' own over its own ξ (the points' records are
+    independent; a fit forms their factors on its lines, :meth:`~modal.shared_error.JoinedError.factor`); None
+    unless every point carries one (and a variance model and line correlation)."""
+    if any(not isinstance(m.relative_error, CommonError) or m.variance_model is None
            or m.line_correlation is None for m in models):
         return None
-    n_factors = sum(m.relative_error.shape[0] for m in models)
-    n_channels = sum(h.shape[0] for h in responses)
-    n_lines = models[0].relative_error.shape[1]
-    if n_channels * n_factors * n_lines > MAX_RELATIVE_VALUES:
-        return None
-    out = np.zeros((n_channels, n_factors, n_lines), complex)
-    channel = factor = 0
-    for model, response in zip(models, responses):
-        rows = model.relative_error.shape[0]
-        out[channel:channel + response.shape[0], factor:factor + rows] = model.relative_error
-        channel, factor = channel + response.shape[0], factor + rows
-    return out
+    return JoinedError(tuple(m.relative_error for m in models), tuple(h.shape[0] for h in responses))
 
 
 def _response_part(model, response) -> tuple[np.ndarray, np.ndarray]:
@@ -265,19 +251,19 @@ def _response_part(model, response) -> tuple[np.ndarray, np.ndarray]:
 
     Several outputs: the estimate carries only that already (its excitation noise is ``relative_error``). One
     output: its model mixes both, variance (a + b|H|²)/S_xx and covariance of lines k, k + m
-    ρ_m,k σ_k σ_k+m, of which the excitation noise's is H_k conj(H_k+m) Σ_r P_rk conj(P_r,k+m); what is left
+    ρ_m,k σ_k σ_k+m, of which the excitation noise's is H_k conj(H_k+m) E[η_k η*_k+m]; what is left
     is the response noise's (on lines where the mixed model does not hold, NaN variance, the correlation is
     the response noise's already; a variance left not positive is NaN, which line weights take as unknown)."""
     if response.shape[0] > 1:
         return model.variance_model, model.line_correlation
-    h, factor, total = response[0], model.relative_error, model.variance_model
+    h, common, total = response[0], model.relative_error, model.variance_model
     with np.errstate(invalid="ignore", divide="ignore"):
-        own = total - np.abs(h) ** 2 * np.sum(np.abs(factor) ** 2, axis=0)
+        own = total - np.abs(h) ** 2 * common.lagged(0).real
         own = np.where(own > 0, own, np.nan)
         corr = np.array(model.line_correlation, complex)
         for m in range(1, corr.shape[0] + 1):
             mixed = corr[m - 1, :-m] * np.sqrt(total[:-m] * total[m:])
-            excitation = h[:-m] * np.conj(h[m:]) * np.sum(factor[:, :-m] * np.conj(factor[:, m:]), axis=0)
+            excitation = h[:-m] * np.conj(h[m:]) * common.lagged(m)
             value = (mixed - excitation) / np.sqrt(own[:-m] * own[m:])
             held = np.isfinite(total[:-m]) & np.isfinite(total[m:])
             corr[m - 1, :-m] = np.where(held, np.where(np.isfinite(value), value, 0.0), corr[m - 1, :-m])

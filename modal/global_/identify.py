@@ -29,6 +29,7 @@ from ..quantiles import gamma_upper_inverse
 from ..results import IdentificationResult
 from ..sdof.bands import weight_on_lines, whitening_on_lines
 from ..sdof.refine import correlated_lags
+from ..shared_error import MAX_FACTOR_BYTES
 from ..units import TWO_PI
 from ..work_budget import EvaluationBudget, checked_max_evaluations, default_max_evaluations
 from .plscf import MAX_DAMPING, plscf_poles
@@ -311,12 +312,16 @@ def _line_weighting(frf: FRF, omega_n, damping_ratio):
     carries its lines' noise shape and their correlation (an exponential window correlates its errors over tens of
     lines), its errors may correlate beyond that over a half-power width (the lag covariance then widens the
     errors of several channels), and the excitation's noise is an error every channel shares, a gain error of
-    every line near a mode in the modal constants; None, None, 0, None where the FRF does not carry them."""
+    every line near a mode in the modal constants; None, None, 0, None where the FRF does not carry them (the
+    shared error also where its factor on every line exceeds :data:`~modal.shared_error.MAX_FACTOR_BYTES`, each
+    channel's share of it)."""
     every = np.ones(frf.n_freq, bool)
     model = frf.noise_model
+    common = None if model is None or model.relative_error is None else model.relative_error.factor()
+    if common is not None and common.ndim == 2 and common.nbytes * frf.n_channels > MAX_FACTOR_BYTES:
+        common = None  # each channel's share of it, in the fit's units, would exceed the memory budget
     return (weight_on_lines(frf, every), whitening_on_lines(frf, every),
-            correlated_lags(frf, frf.omega_rad_s, damping_ratio, omega_n),
-            None if model is None else model.relative_error)
+            correlated_lags(frf, frf.omega_rad_s, damping_ratio, omega_n), common)
 
 
 def _poles_above_band(omega, matrix, orders, low_hz, high_hz, taken):

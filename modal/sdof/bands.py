@@ -229,15 +229,16 @@ def band_influence(frf, bands, channels=None):
 def band_relative_error(frf, bands, channels=None):
     """The factor of the channels' errors relative to their FRF (the excitation noise's) on the bands' lines,
     (n_factors, n_lines) or, per channel, (n_channels, n_factors, n_lines) of the ``channels`` fitted, for an
-    FRF whose noise model carries it (:class:`~modal.noise_model.NoiseModel`'s ``relative_error``); else None.
+    FRF whose noise model carries it (:class:`~modal.noise_model.NoiseModel`'s ``relative_error``, formed on
+    these lines: :meth:`~modal.shared_error.CommonError.factor`); else None.
     Several channels share it (their poles' covariance takes it); one channel's modal constants take it as a
     gain error of every line near a mode."""
     model = frf.noise_model
     if model is None or model.relative_error is None:
         return None
     keep, _ = regions(bands, frf.frequency_hz)
-    factor = model.relative_error[..., keep]
-    return factor if factor.ndim == 2 or channels is None else factor[channels]
+    factor = model.relative_error.factor(keep)
+    return factor if factor is None or factor.ndim == 2 or channels is None else factor[channels]
 
 
 #: the last whitenings made (the fits of one identification share them), by noise model and lines

@@ -251,11 +251,14 @@ def test_the_two_coefficient_nonnegative_fit_is_scipys_nnls():
 def test_large_arrays_are_copied_once_then_shared_by_derived_models():
     from dataclasses import replace
 
-    factor = np.ones((552, 4097), complex)  # a common error factor of 36 MB, as a 4-hit 8 s force-window test's
-    model = NoiseModel(4, 3.0, None, None, 1e-3, relative_error=factor)
-    assert model.relative_error is not factor and factor.flags.writeable  # the caller's array is left alone
-    assert not model.relative_error.flags.writeable
+    influence = np.ones((552, 4097), complex)  # records' influences of 36 MB
+    model = NoiseModel(4, 3.0, None, None, 1e-3, record_influence=influence)
+    assert model.record_influence is not influence and influence.flags.writeable  # the caller's array is left alone
+    assert not model.record_influence.flags.writeable
     derived = replace(model, averages=5)  # every crop or scaling of an FRF makes one: no 36 MB copy each time
-    assert derived.relative_error is model.relative_error
-    with pytest.raises(FRFValidationError, match="field 'relative_error' must be a finite array of factors"):
-        NoiseModel(4, 3.0, None, None, 1e-3, relative_error=np.full((2, 5), np.nan))
+    assert derived.record_influence is model.record_influence
+    with pytest.raises(FRFValidationError, match="field 'record_influence' must be a finite array of records"):
+        NoiseModel(4, 3.0, None, None, 1e-3, record_influence=np.full((2, 5), np.nan))
+    # the excitation's shared error is what generates its covariance (modal.shared_error), not a factor
+    with pytest.raises(FRFValidationError, match="field 'relative_error' is a ndarray; expected a CommonError"):
+        NoiseModel(4, 3.0, None, None, 1e-3, relative_error=np.ones((2, 5), complex))
