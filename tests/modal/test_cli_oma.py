@@ -11,7 +11,9 @@ import h5py
 import pytest
 import numpy as np
 
+import modal.cli
 from support.ambient import FN, anchor_record
+from support.cli import run_main
 
 ROOT = Path(__file__).resolve().parents[2]
 REAL = ROOT / "data" / "real" / "pyuff_MPSTD_Set001_2024_10_08_10_27_07.uff"
@@ -28,8 +30,8 @@ def _write(path, rec, channels=None):
 
 
 def _run(*args):
-    return subprocess.run([sys.executable, "-m", "modal", *map(str, args)], capture_output=True, text=True,
-                          timeout=600, cwd=ROOT)
+    """``python -m modal ARGS`` in this process; the README's command below runs in a real subprocess."""
+    return run_main(modal.cli.main, args, cwd=ROOT)
 
 
 def test_json_table_plot_and_archive(tmp_path):

@@ -1,28 +1,37 @@
-"""`python -m modal report` and `modal fit --geometry`, run as users run them (a subprocess)."""
+"""`python -m modal report` and `modal fit --geometry`: the plate's archive made as users make it (a subprocess),
+the rest through ``modal.cli.main`` in-process (the exit codes, messages and files are the point)."""
 import subprocess
 import sys
 
 import numpy as np
 import pytest
 
+import modal.cli
 from modal.archive import read_archive, write_archive
 from modal.io import write_frf
 from modal.synthetic import modal_frf
+from support.cli import run_main
 from support.paths import SYNTHETIC
 
 PLATE_FRF = SYNTHETIC / "plate_frf.uff"
 PLATE_GEOMETRY = SYNTHETIC / "plate_geometry.uff"
 
 
-def run(*args):
+def run_process(*args):
+    """``python -m modal ARGS`` in a subprocess."""
     return subprocess.run([sys.executable, "-m", "modal", *map(str, args)], capture_output=True, text=True,
                           timeout=120)
+
+
+def run(*args):
+    """``python -m modal ARGS`` in this process."""
+    return run_main(modal.cli.main, args)
 
 
 @pytest.fixture(scope="module")
 def plate_archive(tmp_path_factory):
     path = tmp_path_factory.mktemp("plate") / "plate.h5"
-    out = run("fit", PLATE_FRF, "--archive", path, "--geometry", PLATE_GEOMETRY)
+    out = run_process("fit", PLATE_FRF, "--archive", path, "--geometry", PLATE_GEOMETRY)
     assert out.returncode == 0, out.stderr
     return path
 

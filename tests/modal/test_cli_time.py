@@ -12,9 +12,11 @@ import numpy as np
 import pytest
 
 import modal
+import modal.cli
 from support.paths import REAL, ROOT
 from modal.errors import FormatError
 from modal.io.timedata import read_time
+from support.cli import run_main
 from support.timedata import DigitalModes
 
 FS = 1024.0
@@ -22,6 +24,12 @@ PLANT = DigitalModes(np.array([40.0, 95.0]), np.array([0.03, 0.02]), np.array([[
 
 
 def run(*args):
+    """``python -m modal ARGS`` in this process (the exit code and messages are the point here)."""
+    return run_main(modal.cli.main, args, cwd=ROOT)
+
+
+def run_process(*args):
+    """``python -m modal ARGS`` in a subprocess: the time-file commands as a user starts them."""
     env = {**os.environ, "MPLBACKEND": "Agg"}
     return subprocess.run([sys.executable, "-m", "modal", *map(str, args)], capture_output=True, text=True,
                           cwd=ROOT, env=env, timeout=120)
@@ -86,7 +94,7 @@ def test_fit_time_file_finds_the_modes(tmp_path):
     force, resp = _records()
     path = tmp_path / "random.uff"
     write_uff_time(path, force, resp)
-    out = run("fit", path, "--segment-length", 4096, "--json")
+    out = run_process("fit", path, "--segment-length", 4096, "--json")
     assert out.returncode == 0, out.stderr
     doc = json.loads(out.stdout)
     assert doc["kind"] == "receptance" and doc["n_channels"] == 2

@@ -133,12 +133,12 @@ def test_the_archive_and_the_json_carry_the_constants_true_unit(tmp_path, kind, 
     # an FRF in V/V gives constants in V/V (accelerance), (V/V)/s (mobility), (V/V)/s² (receptance). The archive
     # wrote "1/kg" on them (and on their errors), and the line noise in the kind's SI unit
     import json
-    import subprocess
-    import sys
 
     import h5py
 
+    import modal.cli
     from modal.archive import read_archive, write_archive
+    from support.cli import run_main
 
     si = modal_frf(FREQUENCY, [40.0, 120.0], [0.02, 0.01], [1.0, 0.5], kind=kind, response_points=["1+Z"],
                    reference_points=["1+Z"])
@@ -164,7 +164,6 @@ def test_the_archive_and_the_json_carry_the_constants_true_unit(tmp_path, kind, 
     for frf, expected in ((volts, constant), (si, "1/kg")):
         path = tmp_path / f"{expected.replace('/', '_')}.csv"
         write_frf(frf, path)
-        done = subprocess.run([sys.executable, "-m", "modal", "fit", str(path), "--method", "nls", "--json"],
-                              capture_output=True, text=True, timeout=120)
+        done = run_main(modal.cli.main, ["fit", path, "--method", "nls", "--json"])
         assert done.returncode == 0, done.stderr
         assert json.loads(done.stdout)["modal_constant_units"] == expected

@@ -1,4 +1,4 @@
-"""The `influence` command (balancer.influence.cli), run as users run it."""
+"""The `influence` command (balancer.influence.cli): once in a subprocess as users run it, otherwise in-process."""
 from __future__ import annotations
 
 import json
@@ -9,18 +9,26 @@ import sys
 import numpy as np
 import pytest
 
+import balancer.cli
+from support.cli import run_main
 from support.paths import ROOT
 from support.balancing import READINGS
 
 
-def run_cli(*args, cwd=ROOT):
+def run_process(*args, cwd=ROOT):
+    """``python -m balancer ARGS`` in a subprocess, as a user runs it."""
     env = dict(os.environ, PYTHONPATH=str(ROOT), MPLBACKEND="Agg")
     return subprocess.run([sys.executable, "-m", "balancer", *args], capture_output=True, text=True, cwd=cwd, env=env,
                           timeout=120)
 
 
+def run_cli(*args, cwd=ROOT):
+    """``python -m balancer ARGS`` in this process (``balancer.cli.main``, which the subprocess runs too)."""
+    return run_main(balancer.cli.main, args, cwd=cwd, program="balancer")
+
+
 def test_influence_command_line(tmp_path):
-    out = run_cli("influence", str(READINGS), "--method", "minmax", "--grade", "2.5", "--rotor-mass", "100",
+    out = run_process("influence", str(READINGS), "--method", "minmax", "--grade", "2.5", "--rotor-mass", "100",
                   "--speed-rpm", "3000", "--holes", "8", "--json")
     assert out.returncode == 0, out.stderr
     doc = json.loads(out.stdout)
