@@ -15,7 +15,7 @@ from ..parallel import split_over_threads
 from .correlations import decimate, decimation_factor, decimation_filter
 from .screen import check_held, check_units, screen_samples
 
-__all__ = ["Prepared", "prepare", "check_band", "channel_statistics"]
+__all__ = ["Prepared", "prepare", "prepare_unscreened", "check_band", "channel_statistics"]
 
 #: a channel whose standard deviation is below this fraction of the largest channel's is constant
 CONSTANT_CHANNEL = 1e-12
@@ -342,6 +342,16 @@ def prepare(data, sample_rate_hz=None, band_hz=None, quantity: str | None = None
     workers : int, optional
         Threads for the channels' decimation and statistics (default: every usable core).
     """
+    prepared, recorded = prepare_unscreened(data, sample_rate_hz, band_hz, quantity, workers)
+    if screen:  # on the samples as recorded, known finite by now
+        screen_samples(recorded, prepared.original_rate_hz, names=prepared.names, source=prepared.source)
+    return prepared
+
+
+def prepare_unscreened(data, sample_rate_hz=None, band_hz=None, quantity: str | None = None,
+                       workers=None) -> tuple[Prepared, np.ndarray]:
+    """:func:`prepare` without the screen for dropouts and clipping: (the record prepared, its samples as recorded,
+    which the screen reads; known finite)."""
     signals, rate, file_quantity, names, src = _record(data, sample_rate_hz)
     if not (np.isfinite(rate) and rate > 0):
         raise ParameterError(f"{src}: 'sample_rate_hz' is {rate!r}; expected a positive number of samples per second")
@@ -358,7 +368,5 @@ def prepare(data, sample_rate_hz=None, band_hz=None, quantity: str | None = None
     else:
         work = signals
     mean, scale = channel_statistics(work, src, names, workers)
-    if screen:  # on the samples as recorded, known finite by now
-        screen_samples(signals, rate, names, src)
     return Prepared(work, rate / factor, mean, scale, (low, high), factor, rate, quantity or file_quantity, names,
-                    src)
+                    src), signals

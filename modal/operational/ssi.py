@@ -179,7 +179,8 @@ class Perturbation:
         U, V = model.U.astype(np.float32), model.V.astype(np.float32)
         # ΔH is the Hankel matrix of the correlations' deviations (it is linear in them), built in single
         # precision from deviations formed in double
-        d_R = (block_R - np.tensordot(w, block_R, axes=1)[None]).astype(np.float32)
+        d_R = np.subtract(block_R, np.tensordot(w, block_R, axes=1), out=np.empty(block_R.shape, np.float32),
+                          casting="same_kind")
         # each perturbed singular vector's part outside the signal subspace of order n is ΔU₁ = U₂ X + E/σ₁, with
         # X (k − n, n) = (U₂ᵀ ΔH V₁ σ₁ + σ₂ (U₁ᵀ ΔH V₂)ᵀ) / (σ₁² − σ₂²) elementwise (the part inside only rotates
         # the basis, which leaves the eigenvalues and the observed shapes as they are). Entry (i, j) of X, i ≥ n > j,
