@@ -20,9 +20,10 @@ from typing import Callable, Iterable, TypeVar
 
 from .errors import ParameterError
 
-__all__ = ["usable_cores", "thread_count", "shares", "split_over_threads", "map_over_threads"]
+__all__ = ["usable_cores", "thread_count", "shares", "split_over_threads", "map_over_threads", "run_beside"]
 
 T = TypeVar("T")
+S = TypeVar("S")
 Item = TypeVar("Item")
 
 
@@ -99,3 +100,17 @@ def map_over_threads(function: Callable[[Item], T], items: Iterable[Item], worke
         return [function(item) for item in items]
     with ThreadPoolExecutor(max_workers=count) as pool:
         return list(pool.map(function, items))
+
+
+def run_beside(main: Callable[[], T], side: Callable[[], S], workers) -> tuple[T, S]:
+    """``(main(), side())``, ``side`` on a thread of its own while ``main`` runs on this one when there are several
+    ``workers`` (two short steps of one thread each, side by side), else one after the other.
+
+    An exception raised in ``main`` is raised here (once ``side`` is done), else one raised in ``side``.
+    """
+    if thread_count(workers) <= 1:
+        return main(), side()
+    with ThreadPoolExecutor(max_workers=1) as pool:
+        future = pool.submit(side)
+        first = main()
+        return first, future.result()

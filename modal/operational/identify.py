@@ -15,17 +15,18 @@ from __future__ import annotations
 import numpy as np
 
 from ..blas import one_blas_thread
-from ..parallel import map_over_threads, thread_count
+from ..parallel import map_over_threads, run_beside, thread_count
 from ..errors import IdentificationError, ParameterError
 from ..results import IdentificationResult
+from ..shapes import mpc
 from .correlations import choose_references, correlations
-from .inputs import MIN_LAGS_IN_RECORD, Prepared, prepare
+from .inputs import MIN_LAGS_IN_RECORD, Prepared, prepare_unscreened
 from .methods import OMA_METHODS
 from .modes import error_blocks, estimates_from_clusters, resolved
 from .tones import flag_mains_hum, nearly_undamped, separate_tones
 from .result import oma_result
-from .screen import warn_transients, warn_unresponsive
-from .selection import OMAStabilisation, mpc, stabilise
+from .screen import screen_findings, screen_samples, transient_kurtosis, warn_transients, warn_unresponsive
+from .selection import OMAStabilisation, stabilise
 
 __all__ = ["oma", "OMA_METHODS"]
 
@@ -181,9 +182,15 @@ check) are shared among ``workers`` threads instead, one contiguous share each (
     if rotor_speed_hz is not None and not (np.isfinite(rotor_speed_hz) and rotor_speed_hz > 0):
         raise ParameterError(f"'rotor_speed_hz' is {rotor_speed_hz!r}; expected a positive frequency in Hz")
     workers = thread_count(workers)
-    prepared = prepare(data, sample_rate_hz, band_hz, quantity, workers=workers)
-    refs = _references(prepared, reference_channels)
-    record_flags = frozenset({"non_stationary"}) if warn_transients(prepared) else frozenset()
+    prepared, recorded = prepare_unscreened(data, sample_rate_hz, band_hz, quantity, workers=workers)
+    # the screens for dropouts, clipping and transients (each a strided read of the record, one thread) beside the
+    # choice of references (one thread's products); their warnings given here, in the order prepare gives them
+    rate, names, src = prepared.original_rate_hz, prepared.names, prepared.source
+    refs, (findings, transients) = run_beside(
+        lambda: _references(prepared, reference_channels),
+        lambda: (screen_findings(recorded, rate, names, src), transient_kurtosis(prepared)), workers)
+    screen_samples(recorded, rate, names, src, findings=findings)
+    record_flags = frozenset({"non_stationary"}) if warn_transients(prepared, transients) else frozenset()
     if method in ("fdd", "efdd"):
         from .fdd import fdd
 
@@ -246,6 +253,12 @@ def _sort_out(estimates, chosen, clusters, flat, stable, prepared: Prepared, rot
             cluster[members.members] = len(modes)
             modes.append(estimate)
     diagram = OMAStabilisation(flat.order, flat.frequency_hz, flat.damping_ratio,
-                               np.array([mpc(flat.shape[:, i]) for i in range(n_poles)]), stable, cluster,
+                               _pole_mpc(flat.shape), stable, cluster,
                                np.isin(np.arange(n_poles), chosen), tone, method)
     return modes, tones, dropped, diagram
+
+
+def _pole_mpc(shapes: np.ndarray) -> np.ndarray:
+    """The MPC of every pole's shape (columns of ``shapes``) in one pass, a non-finite entry (a channel of a setup
+    that misses the pole) counting as none, as :func:`modal.operational.selection.mpc` leaves it out."""
+    return mpc(np.where(np.isfinite(shapes), shapes, 0).T)

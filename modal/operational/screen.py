@@ -30,7 +30,7 @@ import numpy as np
 from ..errors import ParameterError, QualityWarning, warn
 from .selection import DETERMINED_SIGMAS
 
-__all__ = ["check_units", "screen_samples", "stuck_runs", "unresponsive_channels", "transient_kurtosis",
+__all__ = ["check_units", "screen_samples", "screen_findings", "stuck_runs", "unresponsive_channels", "transient_kurtosis",
            "warn_transients", "held_factor", "check_held", "STRIDE", "MIN_STUCK_SAMPLES", "NODE_SIGMAS", "TRANSIENT_SIGMAS", "TRANSIENT_KURTOSIS"]
 
 #: the sample checks first look at every STRIDE-th sample of each channel
@@ -149,7 +149,8 @@ def _clipped(row: np.ndarray, coarse: np.ndarray):
     return found[0] if found else None
 
 
-def screen_samples(signals: np.ndarray, sample_rate_hz: float, names=(), source: str = "<array>") -> None:
+def screen_samples(signals: np.ndarray, sample_rate_hz: float, names=(), source: str = "<array>",
+                   findings: list[str] | None = None) -> None:
     """Warn of dropouts (runs of :data:`MIN_STUCK_SAMPLES` or more identical samples) and clipping.
 
     Parameters
@@ -159,13 +160,23 @@ def screen_samples(signals: np.ndarray, sample_rate_hz: float, names=(), source:
     sample_rate_hz : float
     names : sequence of str, optional
     source : str
+    findings : list of str, optional
+        :func:`screen_findings` of these samples, when looked for already (on another thread).
 
     Warns
     -----
     QualityWarning
         One per channel with a dropout or a clipped extreme, naming the channel, where and how much.
     """
+    for message in screen_findings(signals, sample_rate_hz, names, source) if findings is None else findings:
+        warn(message, QualityWarning)
+
+
+def screen_findings(signals: np.ndarray, sample_rate_hz: float, names=(), source: str = "<array>") -> list[str]:
+    """The warnings :func:`screen_samples` gives, in order: a clipped channel's as each channel is read, then one per
+    longest dropout, naming the channels that hold it."""
     n = signals.shape[1]
+    messages = []
     stuck: dict[tuple[int, int], list[tuple[int, int, int]]] = {}  # longest run → (channel, runs, samples)
     for ch in range(signals.shape[0]):
         row = signals[ch]
@@ -176,9 +187,9 @@ def screen_samples(signals: np.ndarray, sample_rate_hz: float, names=(), source:
             stuck.setdefault(longest, []).append((ch, len(runs), sum(r[1] for r in runs)))
         overload = _clipped(row, coarse)
         if overload is not None:
-            warn(f"{source}: {overload.describe(_channel_label(names, ch))}, {100 * overload.samples / n:.2g} % of "
-                 "the record: its shape entries are too small and its spectrum distorted where it clipped; lower "
-                 "the gain or use a sensor of a larger range", QualityWarning)
+            messages.append(f"{source}: {overload.describe(_channel_label(names, ch))}, {100 * overload.samples / n:.2g} % of "
+                            "the record: its shape entries are too small and its spectrum distorted where it clipped; lower "
+                            "the gain or use a sensor of a larger range")
     for (first, length), found in stuck.items():
         listing = ("every channel" if len(found) == signals.shape[0] > 1 else
                    ", ".join(_channel_label(names, ch) for ch, _, _ in found))
@@ -186,10 +197,11 @@ def screen_samples(signals: np.ndarray, sample_rate_hz: float, names=(), source:
         value = signals[found[0][0], first]
         more = f"; {count} such runs, {100 * total / n:.2g} % of the record" if count > 1 else \
             f" ({100 * total / n:.2g} % of the record)"
-        warn(f"{source}: {listing} hold{'s' if len(found) == 1 or len(found) == signals.shape[0] else ''} the value {value:.6g} for {length} samples "
-             f"({length / sample_rate_hz:.4g} s) from sample {first + 1}{more}: a dropout or a stuck converter, not "
-             "a response; the correlations and shape entries are biased by that share; cut the record around it or "
-             "leave the channel out", QualityWarning)
+        messages.append(f"{source}: {listing} hold{'s' if len(found) == 1 or len(found) == signals.shape[0] else ''} the value {value:.6g} for {length} samples "
+                        f"({length / sample_rate_hz:.4g} s) from sample {first + 1}{more}: a dropout or a stuck converter, not "
+                        "a response; the correlations and shape entries are biased by that share; cut the record around it or "
+                        "leave the channel out")
+    return messages
 
 
 def unresponsive_channels(result) -> list[int]:
@@ -254,10 +266,11 @@ def transient_kurtosis(prepared) -> tuple[float, float, int]:
     return kurtosis[middle], _gaussian_kurtosis_std(centred), ch
 
 
-def warn_transients(prepared) -> bool:
+def warn_transients(prepared, measured: tuple[float, float, int] | None = None) -> bool:
     """Whether the record holds transients rather than stationary response (:func:`transient_kurtosis` above both
-    :data:`TRANSIENT_SIGMAS` standard errors and :data:`TRANSIENT_KURTOSIS`), warned of."""
-    kurtosis, std, ch = transient_kurtosis(prepared)
+    :data:`TRANSIENT_SIGMAS` standard errors and :data:`TRANSIENT_KURTOSIS`), warned of; ``measured``: its
+    :func:`transient_kurtosis` when measured already (on another thread)."""
+    kurtosis, std, ch = transient_kurtosis(prepared) if measured is None else measured
     excess = kurtosis - 3.0
     if not (excess > TRANSIENT_SIGMAS * std and kurtosis > TRANSIENT_KURTOSIS):
         return False

@@ -26,6 +26,11 @@ from ..parallel import split_over_threads
 
 __all__ = ["SubspaceModel", "PoleSet", "subspace_model", "hankel", "poles_at", "Perturbation", "continuous"]
 
+#: the error bars' terms are formed this many blocks at a time: the blocks' Hankel deviations and their products
+#: (about 1 MB a block for 64 outputs) then stay in the processor's cache, and no temporary is large enough for the
+#: allocator to map it afresh from the system on every call (a 50-block Hankel deviation of 64 outputs: 35-45 MB)
+TERM_BLOCKS = 4
+
 
 @dataclass(frozen=True)
 class PoleSet:
@@ -78,11 +83,17 @@ def hankel(R: np.ndarray, block_rows: int, block_cols: int | None = None) -> np.
     """
     p = block_rows
     q = block_rows if block_cols is None else block_cols
-    # a view (..., p+1, l, r, q) of lags a+1…a+q for block row a, put in order and copied once by the reshape
-    windows = np.lib.stride_tricks.sliding_window_view(R[..., 1:p + q + 1, :, :], q, axis=-3)
     lead = R.shape[:-3]
     l, r = R.shape[-2:]
-    return np.swapaxes(windows, -2, -1).reshape(*lead, (p + 1) * l, q * r)
+    # the lags 1…p+q output by output, (..., l, p+q, r): row o of block row a is then the q·r numbers from lag
+    # a+1 on, one stretch of memory. A view (..., p+1, l, q·r) of those stretches, copied once by the reshape
+    # (stretches of q·r numbers, not of r: several times faster for few references)
+    by_output = np.ascontiguousarray(np.swapaxes(R[..., 1:p + q + 1, :, :], -3, -2))
+    *lead_strides, output_stride, lag_stride, ref_stride = by_output.strides
+    rows = np.lib.stride_tricks.as_strided(by_output, shape=(*lead, p + 1, l, q * r),
+                                           strides=(*lead_strides, lag_stride, output_stride, ref_stride),
+                                           writeable=False)
+    return rows.reshape(*lead, (p + 1) * l, q * r)
 
 
 def subspace_model(R: np.ndarray, block_rows: int, max_order: int, sample_rate_hz: float,
@@ -169,7 +180,8 @@ class Perturbation:
         U, V = model.U.astype(np.float32), model.V.astype(np.float32)
         # ΔH is the Hankel matrix of the correlations' deviations (it is linear in them), built in single
         # precision from deviations formed in double
-        d_R = (block_R - np.tensordot(w, block_R, axes=1)[None]).astype(np.float32)
+        d_R = np.subtract(block_R, np.tensordot(w, block_R, axes=1), out=np.empty(block_R.shape, np.float32),
+                          casting="same_kind")
         # each perturbed singular vector's part outside the signal subspace of order n is ΔU₁ = U₂ X + E/σ₁, with
         # X (k − n, n) = (U₂ᵀ ΔH V₁ σ₁ + σ₂ (U₁ᵀ ΔH V₂)ᵀ) / (σ₁² − σ₂²) elementwise (the part inside only rotates
         # the basis, which leaves the eigenvalues and the observed shapes as they are). Entry (i, j) of X, i ≥ n > j,
@@ -189,38 +201,44 @@ class Perturbation:
         Q = model.Q[:, :top]
         Q32 = Q.astype(np.float32)
 
-        def block_terms(first: int, stop: int):
-            """(inside, E's first rows, Qᵀ E_down, Qᵀ E_up, E_upᵀ U_down, E_upᵀ U_up) of blocks first…stop − 1."""
-            dH = hankel(d_R[first:stop], model.block_rows, model.block_cols)
-            G = dH @ V[:, :top]  # (blocks, p, top): ΔH V₁ for every order up to top
-            UtG = U.T @ G  # (blocks, k, top): Uᵀ ΔH V₁
-            inside = UtG * gap_right
-            inside += (V.T @ (np.swapaxes(dH, 1, 2) @ U[:, :top])) * gap_left
-            E = G - U @ UtG
-            E_up, E_down = E[:, :rows], E[:, l:]
-            E_up_t = np.swapaxes(E_up, 1, 2)
-            return (inside, E[:, :l], Q32.T @ E_down, Q32.T @ E_up, E_up_t @ U[l:, :top], E_up_t @ U[:rows, :top])
+        k = U.shape[1]
+        # every array an order slices is kept as (rows, blocks, columns): an order's rows and columns of all the
+        # blocks are then one matrix ((rows · blocks) × columns, or rows × (blocks · columns)), and each product
+        # with them one call; the blocks' terms are written straight into them
+        self.inside = np.empty((k, n_blocks, top), np.float32)
+        self.E_C = np.empty((l, n_blocks, top))  # E's first rows
+        self.QtE_down = np.empty((top, n_blocks, top))  # Qᵀ E_down
+        self.QtE_up = np.empty((top, n_blocks, top))
+        self.EtU_down = np.empty((top, n_blocks, top))  # E_upᵀ U_down
+        self.EtU_up = np.empty((top, n_blocks, top))  # E_upᵀ U_up
+
+        def block_terms(first: int, stop: int) -> None:
+            """The terms of blocks first…stop − 1, :data:`TERM_BLOCKS` at a time (their Hankel matrices and
+            products then stay in cache)."""
+            for start in range(first, stop, TERM_BLOCKS):
+                end = min(start + TERM_BLOCKS, stop)
+                dH = hankel(d_R[start:end], model.block_rows, model.block_cols)
+                G = dH @ V[:, :top]  # (blocks, p, top): ΔH V₁ for every order up to top
+                UtG = U.T @ G  # (blocks, k, top): Uᵀ ΔH V₁
+                inside = UtG * gap_right
+                inside += (V.T @ (np.swapaxes(dH, 1, 2) @ U[:, :top])) * gap_left
+                E = G - U @ UtG
+                E_up, E_down = E[:, :rows], E[:, l:]
+                E_up_t = np.swapaxes(E_up, 1, 2)
+                for target, term in ((self.inside, inside), (self.E_C, E[:, :l]), (self.QtE_down, Q32.T @ E_down),
+                                     (self.QtE_up, Q32.T @ E_up), (self.EtU_down, E_up_t @ U[l:, :top]),
+                                     (self.EtU_up, E_up_t @ U[:rows, :top])):
+                    target[:, start:end] = np.swapaxes(term, 0, 1)
 
         # the blocks are independent: shared among threads (:mod:`modal.parallel`), each share's products those
         # of one loop
-        parts = split_over_threads(block_terms, n_blocks, workers)
-        inside, E_C, QtE_down, QtE_up, EtU_down, EtU_up = (np.concatenate(terms) if len(parts) > 1 else terms[0]
-                                                          for terms in zip(*parts))
-        # every array an order slices is kept as (rows, blocks, columns): an order's rows and columns of all the
-        # blocks are then one matrix ((rows · blocks) × columns, or rows × (blocks · columns)), and each product
-        # with them one call
-        self.inside = _by_rows(inside)
+        split_over_threads(block_terms, n_blocks, workers)
         # U₂'s projections of order n (Qₙᵀ U₂ down and up) and U_upᵀ U_down, U_upᵀ U_up, whose blocks [n:, :n]
         # give U₂ᵀ (O_down − O_up A): slices of these
         self.QtU_down = Q.T @ model.U[l:]  # (top, k)
         self.QtU_up = Q.T @ model.U[:rows]
         self.UtU_down = model.U[:rows].T @ model.U[l:, :top]  # (k, top)
         self.UtU_up = model.U[:rows].T @ model.U[:rows, :top]
-        self.E_C = _by_rows(E_C, float)  # (l, blocks, top)
-        self.QtE_down = _by_rows(QtE_down, float)  # (top, blocks, top): Qᵀ E_down
-        self.QtE_up = _by_rows(QtE_up, float)
-        self.EtU_down = _by_rows(EtU_down, float)  # E_upᵀ U_down
-        self.EtU_up = _by_rows(EtU_up, float)  # E_upᵀ U_up
 
     def at(self, order: int, indices) -> dict[str, np.ndarray]:
         """Deviations of the poles ``indices`` of :func:`poles_at` (``order``).
@@ -317,7 +335,3 @@ def _real_columns(real: np.ndarray, columns: np.ndarray, dtype=np.float64) -> np
     (a, 2c), the real parts' columns first, then the imaginary parts'."""
     return real @ np.concatenate([columns.real, columns.imag], axis=1).astype(dtype)
 
-
-def _by_rows(x: np.ndarray, dtype=None) -> np.ndarray:
-    """(blocks, rows, columns) -> (rows, blocks, columns), contiguous."""
-    return np.ascontiguousarray(np.swapaxes(x, 0, 1), dtype=dtype)

@@ -6,7 +6,7 @@ import threading
 import pytest
 
 from modal.errors import ParameterError
-from modal.parallel import map_over_threads, shares, split_over_threads, thread_count, usable_cores
+from modal.parallel import map_over_threads, run_beside, shares, split_over_threads, thread_count, usable_cores
 
 
 @pytest.mark.parametrize("n_items, workers", [(50, 2), (7, 3), (2, 8), (1, 4), (64, 1)])
@@ -72,3 +72,33 @@ def test_the_earliest_items_error_is_raised():
 
     with pytest.raises(ValueError, match="item 7$"):
         map_over_threads(fails_from_seven, range(20), 2)
+
+
+def test_a_side_step_runs_beside_the_main_one_on_its_own_thread():
+    barrier = threading.Barrier(2, timeout=10)  # fails unless the two steps run at the same time
+
+    def step(name):
+        barrier.wait()
+        return name, threading.get_ident()
+
+    (main, main_thread), (side, side_thread) = run_beside(lambda: step("main"), lambda: step("side"), 2)
+    assert (main, side) == ("main", "side")
+    assert main_thread == threading.get_ident() != side_thread
+
+
+def test_one_worker_runs_the_side_step_after_the_main_one_here():
+    done = []
+    out = run_beside(lambda: done.append("main") or threading.get_ident(),
+                     lambda: done.append("side") or threading.get_ident(), 1)
+    assert done == ["main", "side"] and out == (threading.get_ident(), threading.get_ident())
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_the_main_steps_error_is_raised_before_the_side_steps(workers):
+    def fails(name):
+        raise ValueError(name)
+
+    with pytest.raises(ValueError, match="main"):
+        run_beside(lambda: fails("main"), lambda: fails("side"), workers)
+    with pytest.raises(ValueError, match="side"):
+        run_beside(lambda: "fine", lambda: fails("side"), workers)

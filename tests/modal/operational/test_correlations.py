@@ -4,7 +4,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from modal.operational.correlations import choose_references, correlations, decimation_factor, decimation_filter
+from modal.operational.correlations import (Correlations, choose_references, correlations, decimation_factor,
+                                            decimation_filter)
 from modal.errors import ParameterError
 
 
@@ -24,6 +25,18 @@ def test_correlations_equal_the_direct_sums_per_block():
     merged, w = c.grouped(2)
     assert w.sum() == c.weights.sum() and np.allclose(np.average(merged, axis=0, weights=w), c.mean)
 
+
+
+def test_a_block_alone_in_its_group_is_kept_as_it_is():
+    # 6 blocks in 5 groups: [0], [1], [2, 3], [4], [5]; a block alone is its group's mean exactly (not rounded
+    # through its weight), two blocks of one weight their plain mean
+    c = Correlations(np.random.default_rng(0).standard_normal((6, 5, 3, 2)), np.array([700.0] * 5 + [701.0]), 50.0,
+                     (0, 1))
+    merged, w = c.grouped(5)
+    assert w.tolist() == [700, 700, 1400, 700, 701]
+    for group, block in ((0, 0), (1, 1), (3, 4), (4, 5)):
+        assert np.array_equal(merged[group], c.blocks[block])
+    assert np.allclose(merged[2], (c.blocks[2] + c.blocks[3]) / 2, rtol=1e-15, atol=1e-15)
 
 def _direct(y, refs, lo, hi, k):
     return y[:, lo + k:hi + k] @ y[refs, lo:hi].T / (hi - lo)
