@@ -318,7 +318,6 @@ def _centred_decimated(signals: np.ndarray, factor: int, src: str, names, worker
     return out
 
 
-
 def _decimated_ones(n: int, factor: int, taps: np.ndarray) -> np.ndarray:
     """:func:`decimate` of ``n`` ones (each output the sum of the taps that meet a sample), found from a record of
     ones a few filter lengths long: its first and last outputs are the long record's edges (the same length modulo
@@ -335,6 +334,7 @@ def _decimated_ones(n: int, factor: int, taps: np.ndarray) -> np.ndarray:
     out[:half] = short[:half]
     out[out.size - (short.size - half):] = short[half:]
     return out
+
 
 def _name(names, ch) -> str:
     return f" ({names[ch]})" if names and ch < len(names) and names[ch] != str(ch) else ""
