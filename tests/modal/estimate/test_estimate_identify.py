@@ -168,7 +168,8 @@ def test_a_response_channel_of_noise_only_leaves_the_others_modes_alone(method):
     # over its own max |H|, so the dead channel's noise, of the order of its max, outweighed the good channel's
     # 1e-3 and took the poles: nls put the 40 Hz mode at 40.58 ± 0.31 Hz (truth 40 Hz, 0.0013 with the channels
     # weighed by their noise), every mode flagged. Weighed by their noise (maximum likelihood), the dead channel
-    # adds nothing: the poles are the good channel's, within 4 of their standard errors, unflagged
+    # adds nothing: the poles are the good channel's, within 4 of their standard errors, unflagged (the global
+    # method's poles come from its LSCF stage and were right before too; its final fit weighs the same way)
     from modal.synthetic import DigitalModes as Plant, impact_record
 
     plant = Plant([40.0, 95.0], [0.03, 0.02], [[1.0, 0.5], [0.6, -0.8]], 2048.0)
