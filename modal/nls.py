@@ -59,6 +59,9 @@ class NLSFit:
         The fit stopped at ``max_evaluations`` before converging: the poles are where it stood then.
     record_errors : bool
         The poles' covariance was measured over the records (``record_influence`` given and usable).
+    weight_scale : ndarray, shape (n_channels,), optional
+        What each channel was fitted over, FRF unit: its ``channel_scale``, or with ``channel_noise`` its noise
+        (at the best channel's peak-to-noise ratio). Fits of the same data compare by Σ noise_var / weight_scale².
     """
 
     omega_n: np.ndarray
@@ -76,6 +79,7 @@ class NLSFit:
     n_evaluations: int = 0
     capped: bool = False
     record_errors: bool = False
+    weight_scale: np.ndarray | None = None
 
 
 class RowResidual:
@@ -575,6 +579,7 @@ def fit_modes(omega: np.ndarray, response: np.ndarray, power: int, omega_n0, dam
         n_evaluations=n_evaluations,
         capped=capped,
         record_errors=record_errors,
+        weight_scale=ch_scale,
     )
 
 

@@ -67,20 +67,17 @@ def nls_fit(frf, bands, power, noise, data=None, band_peak=None, budget=None):
     careful_starts = [start(frf, band, power, noise) for band in bands]
     careful = fit_bands(frf, bands, power, [s[0] for s in careful_starts], [s[1] for s in careful_starts], data=data,
                         band_peak=band_peak, budget=budget, noise=noise)
-    if fit is None or fit_cost(careful, noise) <= fit_cost(fit, noise):
+    if fit is None or fit_cost(careful) <= fit_cost(fit):
         return careful
     return fit
 
 
-def fit_cost(fit, noise=None) -> float:
-    """Residual of a band-wise fit summed over channels, each over its noise (``noise``, the fit's channels'
-    standard deviations, when known) or else its largest value."""
+def fit_cost(fit) -> float:
+    """Residual of a band-wise fit summed over channels, each over what it was fitted over (its noise where known,
+    else its largest value: :attr:`modal.nls.NLSFit.weight_scale`)."""
     if not np.all(np.isfinite(fit.noise_var)):
         return np.inf
-    scale = np.where(fit.channel_scale > 0, fit.channel_scale, 1.0)  # max |H| of each channel on the lines
-    if noise is not None and np.shape(noise) == scale.shape and np.all(np.isfinite(noise) & (noise > 0)):
-        scale = np.asarray(noise, float)
-    return float(np.sum(fit.noise_var / scale**2))
+    return float(np.sum(fit.noise_var / fit.weight_scale**2))
 
 
 def fit_bands(frf, bands, power, omega_n0, damping_ratio0, channels=None, data=None, band_peak=None, budget=None,
@@ -142,7 +139,7 @@ def fit_bands(frf, bands, power, omega_n0, damping_ratio0, channels=None, data=N
                                 channel_noise=noise)
         if budget is not None:
             budget.spend(restart)
-        if fit_cost(restart, noise) < fit_cost(fit, noise):
+        if fit_cost(restart) < fit_cost(fit):
             fit = restart
     return fit
 
