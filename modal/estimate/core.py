@@ -30,7 +30,7 @@ from .common_error import common_error_factor
 from .error_correlation import LEAKAGE_LAGS, MIN_RECORDS, measured_line_correlation
 from .record_influence import MAX_INFLUENCE_VALUES, channel_influence, overlapping_records, record_influence
 from .hits import find_hits, pulse_train, reject_pulses_the_window_cuts
-from .levels import level_dependence, take_dependence
+from .levels import change_dependence, level_dependence, take_dependence
 from .overload import find_overloads
 from .periodic import repeats_every, shortest_period
 from .quiet import quiet_noise
@@ -388,6 +388,22 @@ def _warn_level_dependence(force, response, starts, length, input_window, output
          "together, or hit alike", QualityWarning)
 
 
+def _warn_change_dependence(force, response, starts, hit_numbers, hit_times_s, length, input_window, output_window,
+                            sample_rate_hz, labels, source) -> None:
+    """Warn where one record's hits change FRF part way through beyond the noise
+    (:func:`.levels.change_dependence`)."""
+    test = change_dependence(force, response, starts, length, input_window, output_window, sample_rate_hz)
+    if test is None or not test.changed:
+        return
+    before, after = hit_numbers[test.first_after - 1], hit_numbers[test.first_after]
+    at, where = hit_times_s[test.first_after], labels[len(labels) - response.shape[0] + test.output]
+    warn(f"{source}: the hits' FRF changes between hit {before} and hit {after} (at {at:.3f} s) beyond its noise "
+         f"({where} at {test.frequency_hz:.4g} Hz by {100 * test.change:.0f} %, F-test p = {test.p_value:.2g} "
+         f"against {test.limit:.2g} over {test.n_lines} lines and {test.n_hits - 1} places): the hammer or a sensor "
+         "moved, or the structure changed, during the record, and the average mixes two FRFs; estimate the hits "
+         "before and after apart", QualityWarning)
+
+
 def _warn_take_dependence(force, response, starts, take_of_hit, length, input_window, output_window,
                           sample_rate_hz, labels, take_names, source) -> None:
     """Warn where the takes' hits do not share one FRF beyond the noise (:func:`.levels.take_dependence`)."""
@@ -605,7 +621,10 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
 
     if impact:
         _warn_level_dependence(x[0], y, starts, length, in_w, out_w, fs, labels, source)
-        if bounds.size > 2:  # several takes: do they measure one FRF?
+        if bounds.size <= 2:  # one record: did its FRF change part way through?
+            _warn_change_dependence(x[0], y, starts, np.flatnonzero(hits.accepted) + 1, hit_times, length, in_w,
+                                    out_w, fs, labels, source)
+        else:  # several takes: do they measure one FRF?
             _warn_take_dependence(x[0], y, starts, np.searchsorted(bounds, starts, side="right") - 1, length, in_w,
                                   out_w, fs, labels, names_of_takes, source)
     output_correlation = window_line_correlation(out_w)

@@ -19,6 +19,11 @@ Takes saved in several files are tested the same way against one FRF per take
 (:func:`take_dependence`): F = ((RSS₀ − RSS_T)/(T − 1)) / (RSS_T/(n − T)) ~ F(2(T − 1), 2(n − T)),
 which files of one point that do not measure one FRF fail (a roving point labelled twice, a sensor
 moved or the structure changed between takes).
+
+One record's hits are tested the same way for a change part way through (:func:`change_dependence`): the
+hits before hit j and from it on as two takes, for every j, the family-wise level spread over the n − 1
+places too. A hammer moved to the next point, or a sensor knocked loose, part way through a record gives an
+average of two FRFs as smooth as either, whose fit's residual (and so its error bars) says nothing of it.
 """
 from __future__ import annotations
 
@@ -28,8 +33,8 @@ import numpy as np
 
 from ..quantiles import f_survival
 
-__all__ = ["LevelTest", "TakeTest", "level_dependence", "take_dependence", "FAMILY_LEVEL", "MIN_LEVEL_RATIO",
-           "MIN_HITS", "MATERIAL_CHANGE", "MAX_SPECTRUM_VALUES"]
+__all__ = ["LevelTest", "TakeTest", "ChangeTest", "level_dependence", "take_dependence", "change_dependence",
+           "FAMILY_LEVEL", "MIN_LEVEL_RATIO", "MIN_HITS", "MATERIAL_CHANGE", "MAX_SPECTRUM_VALUES"]
 
 #: chance that a linear structure's record is reported level-dependent (over all its lines and responses), as the
 #: F distribution of Gaussian errors gives it; its far tail, with the few degrees of freedom of a handful of hits,
@@ -49,6 +54,24 @@ MAX_SPECTRUM_VALUES = 1 << 22
 #: lines tested: those where every hit's force spectrum is at least this fraction of its largest (the hammer's
 #: band; above it the force is noise and the FRF undefined)
 FORCE_BAND_FRACTION = 0.1
+
+
+def _records(channel, starts: np.ndarray, length: int) -> np.ndarray:
+    """The hits' records of one channel, (hits, length)."""
+    return np.stack([np.asarray(channel[s:s + length], float) for s in starts])
+
+
+def _force_band(segments: np.ndarray, input_window: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The force records' transforms (hits, lines) and the lines tested: those where every hit's force
+    spectrum is at least :data:`FORCE_BAND_FRACTION` of its largest, without 0 Hz (the mean, not a vibration)
+    and the Nyquist line of an even length (real: one degree of freedom per hit, not two)."""
+    X = np.fft.rfft(segments * input_window, axis=1)
+    power = np.abs(X) ** 2
+    band = np.all(power >= FORCE_BAND_FRACTION**2 * power.max(axis=1, keepdims=True), axis=0)
+    band[0] = False
+    if segments.shape[1] % 2 == 0:
+        band[-1] = False
+    return X, np.flatnonzero(band)
 
 
 @dataclass(frozen=True)
@@ -111,27 +134,21 @@ def level_dependence(force, response, starts, length: int, input_window, output_
     n_lines = length // 2 + 1
     if n < MIN_HITS or n * n_lines * (n_out + 1) > MAX_SPECTRUM_VALUES:
         return None
-    segments = np.stack([np.asarray(force[s:s + length], float) for s in starts])
+    segments = _records(force, starts, length)
     peaks = np.max(np.abs(segments), axis=1)
     if not (np.all(peaks > 0) and peaks.max() >= MIN_LEVEL_RATIO * peaks.min()):
         return None
-    X = np.fft.rfft(segments * input_window, axis=1)  # (hits, lines)
-    power = np.abs(X) ** 2
-    band = np.all(power >= FORCE_BAND_FRACTION**2 * power.max(axis=1, keepdims=True), axis=0)
-    band[0] = False  # 0 Hz: the mean, not a vibration
-    if length % 2 == 0:
-        band[-1] = False  # the Nyquist line is real: one degree of freedom per hit, not two
-    lines = np.flatnonzero(band)
+    X, lines = _force_band(segments, input_window)
     if lines.size == 0:
         return None
     u = np.log(peaks) - np.mean(np.log(peaks))
-    Xb, Pb = X[:, lines], power[:, lines]
+    Xb = X[:, lines]
+    Pb = np.abs(Xb) ** 2
     s_xx, s_ux, s_uu = Pb.sum(axis=0), (u[:, None] * Pb).sum(axis=0), (u[:, None] ** 2 * Pb).sum(axis=0)
     det = s_xx * s_uu - s_ux**2
     best = (np.inf, 0.0, 0)
     for o in range(n_out):
-        rows = np.stack([np.asarray(response[o][s:s + length], float) for s in starts])
-        Y = np.fft.rfft(rows * output_window, axis=1)[:, lines]
+        Y = np.fft.rfft(_records(response[o], starts, length) * output_window, axis=1)[:, lines]
         cross = np.conj(Xb) * Y
         r0, r1 = cross.sum(axis=0), (u[:, None] * cross).sum(axis=0)
         s_yy = (np.abs(Y) ** 2).sum(axis=0)
@@ -203,23 +220,16 @@ def take_dependence(force, response, starts, take_of_hit, length: int, input_win
     n_lines = length // 2 + 1
     if n_takes < 2 or n - n_takes < 2 or n * n_lines * (n_out + 1) > MAX_SPECTRUM_VALUES:
         return None
-    segments = np.stack([np.asarray(force[s:s + length], float) for s in starts])
-    X = np.fft.rfft(segments * input_window, axis=1)
-    power = np.abs(X) ** 2
-    band = np.all(power >= FORCE_BAND_FRACTION**2 * power.max(axis=1, keepdims=True), axis=0)
-    band[0] = False
-    if length % 2 == 0:
-        band[-1] = False
-    lines = np.flatnonzero(band)
+    X, lines = _force_band(_records(force, starts, length), input_window)
     if lines.size == 0:
         return None
-    Xb, Pb = X[:, lines], power[:, lines]
+    Xb = X[:, lines]
+    Pb = np.abs(Xb) ** 2
     member = np.eye(n_takes)[takes]  # (hits, takes)
     s_xx_t = member.T @ Pb  # (takes, lines)
     best = (np.inf, 0.0, 0)
     for o in range(n_out):
-        rows = np.stack([np.asarray(response[o][s:s + length], float) for s in starts])
-        Y = np.fft.rfft(rows * output_window, axis=1)[:, lines]
+        Y = np.fft.rfft(_records(response[o], starts, length) * output_window, axis=1)[:, lines]
         cross = np.conj(Xb) * Y
         s_yy = (np.abs(Y) ** 2).sum(axis=0)
         cross_t = member.T @ cross
@@ -240,3 +250,87 @@ def take_dependence(force, response, starts, take_of_hit, length: int, input_win
         return None
     return TakeTest(p_value=best[0], limit=FAMILY_LEVEL / (lines.size * n_out), frequency_hz=best[1], output=best[2],
                     n_takes=int(n_takes), n_hits=int(n), n_lines=int(lines.size))
+
+
+@dataclass(frozen=True)
+class ChangeTest:
+    """The smallest p of the test for a change part way through one record's hits, and where it was found.
+
+    Attributes
+    ----------
+    p_value, limit, frequency_hz, output
+        As :class:`LevelTest`'s; ``limit`` is spread over the places too.
+    first_after : int
+        The first hit (0-based, of those tested) after the change.
+    change : float
+        At that line, the larger of the two groups' FRFs' distance from the average, relative to the average.
+    n_hits, n_lines : int
+    """
+
+    p_value: float
+    limit: float
+    frequency_hz: float
+    output: int
+    first_after: int
+    change: float
+    n_hits: int
+    n_lines: int
+
+    @property
+    def changed(self) -> bool:
+        return self.p_value < self.limit
+
+
+def change_dependence(force, response, starts, length: int, input_window, output_window,
+                      sample_rate_hz: float) -> ChangeTest | None:
+    """Test one record's hits for a change of FRF part way through (see the module), or None where the test
+    cannot say.
+
+    For each place j the hits before it and from it on are two takes, tested as :func:`take_dependence`
+    tests them, F ~ F(2, 2(n − 2)); the smallest p over the lines, responses and the n − 1 places is
+    compared with :data:`FAMILY_LEVEL` over their number.
+
+    Parameters as :func:`level_dependence`'s, ``starts`` in time order. None with fewer than :data:`MIN_HITS`
+    hits, no line in the force's band, or spectra above :data:`MAX_SPECTRUM_VALUES`.
+    """
+    starts = np.asarray(starts, int)
+    n = starts.size
+    n_out = np.shape(response)[0]
+    if n < MIN_HITS or n * (length // 2 + 1) * (n_out + 1) > MAX_SPECTRUM_VALUES:
+        return None
+    X, lines = _force_band(_records(force, starts, length), input_window)
+    if lines.size == 0:
+        return None
+    Xb, Pb = X[:, lines], np.abs(X[:, lines]) ** 2
+    # the hits before each place j = 1 … n − 1 (rows), summed over the hits by running sums
+    p_before = np.cumsum(Pb, axis=0)[:-1]
+    p_total = p_before[-1] + Pb[-1]
+    p_after = p_total - p_before
+    best = (np.inf, 0.0, 0, 0, 0.0)
+    for o in range(n_out):
+        Y = np.fft.rfft(_records(response[o], starts, length) * output_window, axis=1)[:, lines]
+        cross = np.conj(Xb) * Y
+        s_yy = (np.abs(Y) ** 2).sum(axis=0)
+        c_before = np.cumsum(cross, axis=0)[:-1]
+        c_total = c_before[-1] + cross[-1]
+        c_after = c_total - c_before
+        with np.errstate(divide="ignore", invalid="ignore"):
+            rss0 = s_yy - np.abs(c_total) ** 2 / p_total
+            rss2 = s_yy - np.abs(c_before) ** 2 / p_before - np.abs(c_after) ** 2 / p_after
+            F = (rss0 - rss2) / (rss2 / (n - 2))
+            common = c_total / p_total
+            change = (np.maximum(np.abs(c_before / p_before - common), np.abs(c_after / p_after - common))
+                      / np.abs(common))
+        ok = np.isfinite(F) & (rss2 > 0) & (change >= MATERIAL_CHANGE)
+        if not ok.any():
+            continue
+        p = np.full(F.shape, np.inf)
+        p[ok] = f_survival(2.0, 2.0 * (n - 2), np.maximum(F[ok], 0.0))
+        place, k = np.unravel_index(int(np.argmin(p)), p.shape)
+        if p[place, k] < best[0]:
+            best = (float(p[place, k]), float(lines[k] * sample_rate_hz / length), o, int(place) + 1,
+                    float(change[place, k]))
+    if not np.isfinite(best[0]):
+        return None
+    return ChangeTest(p_value=best[0], limit=FAMILY_LEVEL / (lines.size * n_out * (n - 1)), frequency_hz=best[1],
+                      output=best[2], first_after=best[3], change=best[4], n_hits=int(n), n_lines=int(lines.size))

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import modal
-from modal.estimate.levels import FAMILY_LEVEL, level_dependence
+from modal.estimate.levels import FAMILY_LEVEL, change_dependence, level_dependence
 from modal.synthetic import DigitalModes, impact_record
 
 FS = 1024.0
@@ -97,3 +97,40 @@ def test_takes_that_do_not_measure_one_frf_are_warned_of():
         modal.estimate_frf(np.concatenate([first.signals[0], again.signals[0]]),
                            np.concatenate([first.signals[1:], again.signals[1:]], axis=1), FS, impact=True,
                            window="force", kind="accelerance", take_lengths=[first.n_samples, again.n_samples])
+
+
+def test_a_record_whose_hammer_moved_part_way_through_is_warned_of():
+    # one file, the hammer moved to the next point after hit 3: the six hits' average is of two FRFs, as smooth
+    # as either; nls then gave the 40 Hz mode's constant 0.80 ± 0.09 (the points' 1.0 and 0.6 averaged), a
+    # stiffness 25 % off the first point's, lost the 95 Hz mode (0.5 and -0.8 averaged), and nothing said so
+    first = impact_record(DigitalModes([40.0, 95.0], [0.01, 0.02], [[1.0, 0.5]], FS), [0.5, 4.5, 8.5], 12.0,
+                          seed=1, response_noise=1e-3, force_noise=1e-3).record
+    other = impact_record(DigitalModes([40.0, 95.0], [0.01, 0.02], [[0.6, -0.8]], FS), [0.5, 4.5, 8.5], 12.0,
+                          seed=2, response_noise=1e-3, force_noise=1e-3).record
+    force = np.concatenate([first.signals[0], other.signals[0]])
+    response = np.concatenate([first.signals[1:], other.signals[1:]], axis=1)
+    with pytest.warns(modal.QualityWarning, match=r"the hits' FRF changes between hit 3 and hit 4 \(at 12\.50\d s\)"):
+        modal.estimate_frf(force, response, FS, impact=True, window="force", kind="accelerance")
+    # the test needs four hits (two parameters per line and noise left over): with three it says nothing
+    assert change_dependence(force, response, np.array([512, 4608, 8704]) - 8, 2048, np.ones(2048), np.ones(2048),
+                             FS) is None
+
+
+def test_a_change_within_one_record_is_placed_and_sized():
+    # the sensor's second mode halves from hit 5 of 8 on (a magnet base sliding towards a node)
+    hits = [0.5 + 4 * k for k in range(8)]
+    before = impact_record(DigitalModes([40.0, 95.0], [0.01, 0.02], [[1.0, 0.5]], FS), hits, 33.0, seed=5,
+                           response_noise=1e-3, force_noise=1e-3).record
+    after = impact_record(DigitalModes([40.0, 95.0], [0.01, 0.02], [[1.0, 0.25]], FS), hits, 33.0, seed=5,
+                          response_noise=1e-3, force_noise=1e-3).record
+    cut = int(16.3 * FS)
+    force = before.signals[0]
+    response = np.concatenate([before.signals[1:, :cut], after.signals[1:, cut:]], axis=1)
+    starts = np.array([int(t * FS) - 8 for t in hits])
+    test = change_dependence(force, response, starts, 2048, np.ones(2048), np.ones(2048), FS)
+    assert test.changed and test.first_after == 4
+    # found where the second mode's change tells most: each group's FRF a third of that mode's part off the
+    # average's (0.5 and 0.25 against 0.375), more of the FRF near the zero below it, where the first mode's part
+    # cancels much of the second's
+    assert 70.0 < test.frequency_hz < 130.0
+    assert test.change > 0.25
