@@ -1,4 +1,5 @@
-"""support.cli.run_main: a command line's main in-process gives what its subprocess gives, and leaves no trace."""
+"""support.cli.run_main: a command line's main in-process gives what its subprocess gives, and leaves no trace;
+support.cli.run_module: ``python -m PROGRAM`` in-process."""
 from __future__ import annotations
 
 import subprocess
@@ -6,7 +7,7 @@ import sys
 import warnings
 
 import modal.cli
-from support.cli import run_main
+from support.cli import run_main, run_module
 from support.paths import ROOT, SYNTHETIC
 
 
@@ -33,3 +34,12 @@ def test_printed_warnings_are_captured_and_the_filters_restored():
     done = run_main(main, ["x"])
     assert (done.returncode, done.stdout, done.stderr) == (0, "done\n", "warning: a structural warning\n")
     assert warnings.showwarning is shown and warnings.filters == filters
+
+
+def test_run_module_runs_the_named_programs_main():
+    # `balancer run` reads a scene (a missing file: its one-line error, exit 1); `modal` has no `run` (usage, exit 2)
+    scene = run_module("balancer", "run", "no_such_scene.toml")
+    assert (scene.returncode, scene.stderr) == (1, "error: no_such_scene.toml: no such scene file\n")
+    assert scene.args == ["python", "-m", "balancer", "run", "no_such_scene.toml"]
+    usage = run_module("modal", "run", "no_such_scene.toml")
+    assert usage.returncode == 2 and "python -m modal: error: argument command: invalid choice: 'run'" in usage.stderr

@@ -18,11 +18,14 @@ from modal.io import read_frf
 from modal.plots import MAX_DRAWN_CHANNELS, model_response, plot_fit
 from modal.synthetic import add_noise, modal_frf
 
+from support.cli import run_module
+
 ROOT = Path(__file__).resolve().parents[1]
 REAL = sorted((ROOT / "data" / "real").glob("pyuff_meas_point_*.txt"))
 
 
 def run(module, *args, cwd=None):
+    """``python -m MODULE ARGS`` as a user runs it; the other tests run the command in-process (``run_module``)."""
     return subprocess.run([sys.executable, "-m", module, *map(str, args)], capture_output=True, text=True,
                           cwd=cwd, timeout=180)
 
@@ -145,11 +148,11 @@ def archives(tmp_path_factory, dask_cluster):
 def test_real_beam_plot_archive_and_read_back(archives, tmp_path):
     """The three real beam files fitted with --plot and --archive in one command; the archive read back."""
     assert (archives / "beam.png").stat().st_size > 10_000
-    back = run("modal", "fit", archives / "fit_all.h5", "--json")
+    back = run_module("modal", "fit", archives / "fit_all.h5", "--json")
     assert back.returncode == 0, back.stderr
     assert '"n_channels": 3' in back.stdout
-    one = run("modal", "fit", *REAL, "--frequency-step", "1", "--kind", "accelerance", "--channel", "1",
-              "--plot", tmp_path / "ch1.png")
+    one = run_module("modal", "fit", *REAL, "--frequency-step", "1", "--kind", "accelerance", "--channel", "1",
+                     "--plot", tmp_path / "ch1.png")
     assert one.returncode == 0, one.stderr
 
 
@@ -157,7 +160,7 @@ def test_scene_archive_is_an_frf_input(archives):
     archive = archives / "demo.h5"
     frf = read_frf(archive)
     assert frf.n_channels == 1 and frf.kind == "accelerance"
-    fit = run("modal", "fit", archive)
+    fit = run_module("modal", "fit", archive)
     assert fit.returncode == 0, fit.stderr
     assert "1 channel(s)" in fit.stdout
 
@@ -192,7 +195,7 @@ def test_archive_without_frf_says_what_it_holds(tmp_path):
     path = write_archive(tmp_path / "results.h5", {"identify": result, "speed_rpm": 1500.0})
     with pytest.raises(FormatError, match=r"holds no FRF \(it holds identify \(IdentificationResult\), speed_rpm"):
         read_frf(path)
-    out = run("modal", "fit", path)
+    out = run_module("modal", "fit", path)
     assert out.returncode == 1 and out.stderr.startswith("error: ") and "holds no FRF" in out.stderr
 
 
@@ -263,8 +266,8 @@ def test_contradictions_are_detected():
 # ---- item 9: --driving-point, and the assumption shown in the table --------------------------------------------
 
 def test_driving_point_option_and_unknown_driving_point_in_table(tmp_path):
-    declared = run("modal", "fit", *REAL, "--frequency-step", "1", "--kind", "accelerance", "--driving-point", "1",
-                   "--json")
+    declared = run_module("modal", "fit", *REAL, "--frequency-step", "1", "--kind", "accelerance",
+                          "--driving-point", "1", "--json")
     assert declared.returncode == 0, declared.stderr
     import json
 
@@ -279,25 +282,26 @@ def test_driving_point_option_and_unknown_driving_point_in_table(tmp_path):
     assert all(r["stiffness_n_per_m"] is None for r in rows)
     assert all("driving_point_contradicted" in r["flags"] for r in rows if r["channel"] == 1)
     for wrong in ("0", "4"):
-        bad = run("modal", "fit", *REAL, "--frequency-step", "1", "--kind", "accelerance", "--driving-point", wrong)
+        bad = run_module("modal", "fit", *REAL, "--frequency-step", "1", "--kind", "accelerance", "--driving-point",
+                         wrong)
         assert bad.returncode == 1 and f"--driving-point {wrong}: no such channel; expected a channel number 1..3" \
             in bad.stderr, bad.stderr
     frf = modal_frf(np.linspace(20, 300, 801), [100.0], [0.02], [1.0], kind="receptance")
     from modal.io import write_frf
 
     write_frf(add_noise(frf, 1e-4, seed=2), tmp_path / "plain.csv")  # no point ids: nothing says where it was
-    table = run("modal", "fit", tmp_path / "plain.csv")
+    table = run_module("modal", "fit", tmp_path / "plain.csv")
     assert table.returncode == 0, table.stderr
     assert "driving_point_unknown" in table.stdout and "not_driving_point" not in table.stdout
     assert "k, c, m: n/a, the driving point is unknown" in table.stdout and "--driving-point" in table.stdout
-    unknown = json.loads(run("modal", "fit", tmp_path / "plain.csv", "--json").stdout)
+    unknown = json.loads(run_module("modal", "fit", tmp_path / "plain.csv", "--json").stdout)
     assert unknown["driving_point"]["known_from"] == "unknown" and unknown["driving_point"]["channels"] == []
     assert "--driving-point" in unknown["driving_point"]["how_to_declare"]
     assert all(r["stiffness_n_per_m"] is None and r["mass_kg"] is None for r in unknown["modes"])
-    declared = json.loads(run("modal", "fit", tmp_path / "plain.csv", "--json", "--driving-point", "1").stdout)
+    declared = json.loads(run_module("modal", "fit", tmp_path / "plain.csv", "--json", "--driving-point", "1").stdout)
     assert declared["driving_point"] == {"known_from": "declared", "channels": [1]}
     assert all(r["stiffness_n_per_m"] is not None and not r["flags"] for r in declared["modes"]), declared["modes"]
-    plot = run("modal", "fit", tmp_path / "plain.csv", "--plot", tmp_path / "p.png", "--channel", "2")
+    plot = run_module("modal", "fit", tmp_path / "plain.csv", "--plot", tmp_path / "p.png", "--channel", "2")
     assert plot.returncode == 1 and "--channel 2: no such channel; expected 1..1" in plot.stderr
     assert not (tmp_path / "p.png").exists()
 
@@ -358,7 +362,7 @@ def test_write_errors_name_the_target_not_the_temporary(tmp_path, option, name):
     write_frf(frf, tmp_path / "plain.csv")
     for folder in ("missing", "a_file"):
         target = tmp_path / folder / name
-        out = run("modal", "fit", tmp_path / "plain.csv", option, target)
+        out = run_module("modal", "fit", tmp_path / "plain.csv", option, target)
         assert out.returncode == 1
         assert out.stderr.startswith(f"error: {target}:") and ".tmp" not in out.stderr, out.stderr
 
@@ -396,7 +400,7 @@ def test_overflow_scale_csv_on_the_command_line(tmp_path):
                                kind="mobility"), 0.001, seed=1)
     write_frf(FRF(base.frequency_hz, base.response * (5e306 / np.abs(base.response).max()), kind="mobility"),
               tmp_path / "big.csv")
-    out = run("modal", "fit", tmp_path / "big.csv", "--json", "--plot", tmp_path / "big.png")
+    out = run_module("modal", "fit", tmp_path / "big.csv", "--json", "--plot", tmp_path / "big.png")
     assert out.returncode == 0, out.stderr
     assert "encountered" not in out.stderr and "RuntimeWarning" not in out.stderr  # no bare numpy warnings
     import json
@@ -467,18 +471,18 @@ def _beam_flags(tmp_path):
 def test_scene_refuses_a_flagged_mode_and_says_which_mode_it_used(tmp_path):
     flags = _beam_flags(tmp_path)
     flagged = next(i for i, f in enumerate(flags) if f) + 1
-    refused = run("balancer", "run", _beam_scene(tmp_path, flagged), "--out", tmp_path / "a.h5", cwd=tmp_path)
+    refused = run_module("balancer", "run", _beam_scene(tmp_path, flagged), "--out", tmp_path / "a.h5", cwd=tmp_path)
     assert refused.returncode == 1, refused.stderr
     assert f"mode {flagged} (" in refused.stderr and "is flagged" in refused.stderr
     assert "identify.accept_flagged = true" in refused.stderr
-    accepted = run("balancer", "run", _beam_scene(tmp_path, flagged, "accept_flagged = true"),
-                   "--out", tmp_path / "b.h5", cwd=tmp_path)
+    accepted = run_module("balancer", "run", _beam_scene(tmp_path, flagged, "accept_flagged = true"),
+                          "--out", tmp_path / "b.h5", cwd=tmp_path)
     assert accepted.returncode == 0, accepted.stderr
     assert f"k = 'identified:mode{flagged}.stiffness' (mode {flagged} at " in accepted.stdout
     assert "(accepted: identify.accept_flagged)" in accepted.stdout
     clean = [i + 1 for i, f in enumerate(flags) if not f]
     if clean:  # a clean mode runs without the explicit choice and names itself
-        ok = run("balancer", "run", _beam_scene(tmp_path, clean[0]), "--out", tmp_path / "c.h5", cwd=tmp_path)
+        ok = run_module("balancer", "run", _beam_scene(tmp_path, clean[0]), "--out", tmp_path / "c.h5", cwd=tmp_path)
         assert ok.returncode == 0, ok.stderr
         assert f"(mode {clean[0]} at " in ok.stdout and "flags: none" in ok.stdout
 
@@ -634,137 +638,3 @@ def test_a_plot_names_the_unit_the_frf_carries():
     assert fig.axes[0].get_ylabel() == "|H| [counts/V]"
     assert unit_of.fullmatch(fig.axes[2].get_xlabel()).group(1) == "counts/V·s", fig.axes[2].get_xlabel()
     assert unit_of.fullmatch(plot_fit(frf, _identify(frf)).axes[2].get_xlabel()).group(1) == "m/s/N"
-
-
-# ---- the README's "first real measurement" walkthrough ----------------------------------------------------------
-
-_WORDS = {w: n for n, w in enumerate("zero one two three four five six seven eight nine ten eleven twelve".split())}
-
-
-def _same_as_printed(readme: str, tool: float) -> bool:
-    """A number of the README is the tool's value rounded to the README's digits: within half a unit of its last digit
-    (the tool's own printout rounds to 5-6 significant digits, far finer)."""
-    digits = len(readme.split(".")[1]) if "." in readme else 0
-    return abs(float(readme) - tool) <= 0.5 * 10.0 ** -digits * (1 + 1e-6) + 1e-5 * abs(tool)
-
-
-def _walkthrough_items(section: str) -> dict[int, str]:
-    """The numbered paragraphs of the walkthrough, each as one line of text."""
-    items, current = {}, None
-    for line in section.splitlines():
-        head = re.match(r"(\d+)\. (.*)", line)
-        if head:
-            current = int(head.group(1))
-            items[current] = head.group(2)
-        elif current is not None and line.startswith("   "):
-            items[current] += " " + line.strip()
-        else:
-            current = None
-    return items
-
-
-def _mode_table(stdout: str) -> dict[int, tuple[float, set[str]]]:
-    """The printed mode table: mode number -> (natural frequency in Hz, the flags of every channel)."""
-    modes: dict[int, tuple[float, set[str]]] = {}
-    for line in stdout.splitlines():
-        row = re.match(r"\s+(\d+)\s+([\d.]+) ± .*\s(\S+)$", line)
-        if row:
-            flags = set() if row.group(3) == "-" else set(row.group(3).split(","))
-            number = int(row.group(1))
-            modes[number] = (float(row.group(2)), modes.get(number, (0.0, set()))[1] | flags)
-    return modes
-
-
-#: flags about where the response was measured (the walkthrough's third command is about the driving point);
-#: driving_point_unknown replaced driving_point_assumed where nothing says which channel is the driving point
-_DRIVING_POINT_FLAGS = {"not_driving_point", "driving_point_assumed", "driving_point_unknown"}
-
-
-def test_readme_walkthrough_runs_as_written_and_its_numbers_are_the_tools(tmp_path):
-    """Each command of the README's walkthrough, run as written from the project folder (the venv's python is
-    this interpreter, out/ lies in a temporary folder), exits 0 and gives what the text says: every number and flag
-    the text gives is the one the tool prints, rounded as written."""
-    import glob
-    import importlib.util
-    import json
-    import shlex
-
-    text = (ROOT / "README.md").read_text()
-    section = text.split("## A first real measurement", 1)[1].split("\n## ", 1)[0]
-    block = section.split("```sh\n", 1)[1].split("```", 1)[0]
-    items = _walkthrough_items(section)
-    out = tmp_path / "out"
-    outputs = []
-    for line in block.strip().splitlines():
-        words = shlex.split(line.replace("out/", f"{out.as_posix()}/"))
-        if words[0] == "mkdir":
-            out.mkdir()
-            continue
-        assert words[0] == ".venv/bin/python", line
-        args = [w for word in words[1:] for w in (sorted(glob.glob(word, root_dir=ROOT)) or [word])]
-        done = subprocess.run([sys.executable, *args], capture_output=True, text=True, cwd=ROOT, timeout=180)
-        assert done.returncode == 0, (line, done.stderr)
-        outputs.append(done.stdout)
-    fit, again, driving, hammer = outputs
-    assert (out / "beam.png").stat().st_size > 0 and (out / "beam.h5").exists()
-
-    # 1. the global fit: how many modes, how many clean, each frequency named, and the flags named
-    assert "method: global" in fit
-    modes = _mode_table(fit)
-    count = re.search(r"prints (\w+) modes, (\w+)\s+of them\s+flagged `(\w+)`.*Apart from that flag, (\w+) clean ones",
-                      items[1], re.S)
-    common = count.group(3)
-    flagged = [f for f, flags in modes.values() if common in flags]
-    clean = [f for f, flags in modes.values() if not flags - _DRIVING_POINT_FLAGS - {common}]
-    count = (count.group(1), count.group(2), count.group(4))
-    assert ([_WORDS[c] for c in count] == [len(modes), len(flagged), len(clean)]), (items[1], modes)
-    named = re.findall(r"\d+\.\d+(?= Hz|,| and)", items[1])
-    assert len(named) == len(modes), (named, modes)
-    for (f_tool, _), f_readme in zip(sorted(modes.values()), sorted(named, key=float)):
-        assert _same_as_printed(f_readme, f_tool), (f_readme, f_tool)
-    flags_named = set(re.findall(r"`(\w+)`", items[1])) - {"auto"}
-    assert flags_named == set().union(*(flags for _, flags in modes.values())) - _DRIVING_POINT_FLAGS
-    # 2. the archive fitted again gives the same modes
-    again_hz = sorted({m["natural_frequency_hz"] for m in json.loads(again)["modes"]})
-    assert np.allclose(again_hz, sorted(f for f, _ in modes.values()), atol=1e-3), again_hz
-    # 3. file 1 declared a driving point: its constants (those the text quotes) change sign, every mode is flagged
-    # driving_point_contradicted and none has k, c, m (driving_point_unknown is what the text says an undeclared
-    # driving point gives: the first command's files hold no point ids and declare none)
-    named = set(re.findall(r"`(\w+)`", items[3]))
-    assert "k [N/m]" in driving and all(flag in driving for flag in named - {"driving_point_unknown"})
-    assert "driving_point_unknown" in named and "driving_point_unknown" not in driving
-    assert all("driving_point_unknown" in flags for _, flags in modes.values()), modes
-    rows = [line.split() for line in driving.splitlines() if re.match(r"\s+\d+\s+\d", line)]
-    quoted = re.search(r"\(([-\d., ]+) 1/kg", items[3]).group(1).split(", ")
-    assert len(rows) == len(quoted) == 6, (rows, quoted)
-    for row, constant in zip(rows, quoted):
-        assert _same_as_printed(constant, complex(row[7]).real), (constant, row)
-        assert row[8:11] == ["n/a"] * 3 and "driving_point_contradicted" in row[-1], row
-    # 4. the hammer scene: the truth is the generator's, the printed k, c, M are the tool's, and the text's claim
-    # about them holds
-    spec = importlib.util.spec_from_file_location("generate", ROOT / "data" / "synthetic" / "generate.py")
-    generate = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(generate)
-    hits = re.findall(r"(\w+) hits", items[4])
-    assert hits and all((_WORDS[n] if n in _WORDS else int(n)) == len(generate.HAMMER_HIT_TIMES_S) for n in hits), hits
-    assert f"{len(generate.HAMMER_HIT_TIMES_S)} average(s)" in hammer and "0 hit(s) rejected" in hammer
-    truth, printed = items[4].split("It prints")
-    balls = 2 * 0.02  # the scene's [adb] n x m: the test was made with the balls in
-    true = {"k": generate.RIG_STIFFNESS_N_PER_M, "c": generate.RIG_DAMPING_N_S_PER_M, "M": generate.RIG_MASS_KG - balls}
-    units = {"k": "N/m", "c": "N s/m", "M": "kg"}
-    within = _WORDS[re.search(r"each within (\w+) standard error", printed).group(1)]
-    for name in true:
-        assert _same_as_printed(re.search(rf"\b{name} = ([\d.]+) {units[name]}", truth).group(1), true[name])
-        value, std = re.search(rf"\b{name} = ([\d.]+) ± ([\d.]+) {units[name]}", printed).groups()
-        tool_value, tool_std = re.search(rf"\b{name} = ([\d.e+]+) {units[name]} \(± ([\d.e+]+)\)", hammer).groups()
-        assert _same_as_printed(value, float(tool_value)) and _same_as_printed(std, float(tool_std)), (name, hammer)
-        assert abs(float(tool_value) - true[name]) < within * float(tool_std), (name, tool_value, true[name])
-    assert (out / "hammer.h5").exists() and (out / "hammer_plots" / "frf_estimate.png").exists()
-
-
-def test_the_documentation_list_names_every_doc():
-    """The README's list of documentation names every page in docs/, and only pages that exist."""
-    text = (ROOT / "README.md").read_text()
-    section = text.split("## Documentation and benchmarks", 1)[1].split("\n## ", 1)[0]
-    listed = set(re.findall(r"^- `docs/([\w.-]+\.md)`", section, flags=re.M))
-    assert listed == {p.name for p in (ROOT / "docs").glob("*.md")}

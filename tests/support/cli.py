@@ -3,7 +3,8 @@
 A subprocess pays Python, numpy and the package's imports again (0.3-1.5 CPU-s a call); where a test's
 point is the exit code and the messages, ``main(argv)`` in-process gives the same: the console scripts
 and ``python -m`` call that function. Each entry point keeps real subprocess tests of its own
-(tests/modal/test_cli.py, tests/test_first_use.py, tests/balancer/influence/test_cli.py).
+(tests/modal/test_cli.py, tests/test_first_use.py, tests/test_readme_walkthrough.py,
+tests/balancer/influence/test_cli.py).
 """
 from __future__ import annotations
 
@@ -59,3 +60,27 @@ def run_main(main: Callable[[list[str]], int], args: Sequence[object], cwd: str 
             if not isinstance(exc.code, (int, type(None))):
                 print(exc.code, file=err)
     return subprocess.CompletedProcess(["python", "-m", program, *argv], int(code), out.getvalue(), err.getvalue())
+
+
+def run_module(program: str, *args: object, cwd: str | os.PathLike | None = None) -> subprocess.CompletedProcess:
+    """``python -m PROGRAM ARGS`` in this process: :func:`run_main` with that program's ``main``.
+
+    Parameters
+    ----------
+    program : {"modal", "balancer"}
+        The package whose command line runs (``modal.cli.main`` or ``balancer.cli.main``).
+    *args : object
+        The arguments, each passed as ``str(arg)``.
+    cwd : path-like, optional
+        The working directory during the call.
+
+    Returns
+    -------
+    subprocess.CompletedProcess
+        As :func:`run_main` returns it.
+    """
+    import balancer.cli
+    import modal.cli
+
+    main = {"modal": modal.cli.main, "balancer": balancer.cli.main}[program]
+    return run_main(main, args, cwd=cwd, program=program)
