@@ -104,6 +104,9 @@ def decimation_filter(factor: int) -> np.ndarray:
 #: outputs per row of the decimation's matrix products (:func:`decimate`): rows of 10-16 outputs were within
 #: 15 % of each other in time, 12 the fastest for factors 2-30 (10⁶ samples, one thread)
 DECIMATION_ROW_OUTPUTS = 12
+#: samples of a channel :func:`decimate` centres and filters at a time (their products then read them from cache:
+#: a quarter faster than over the whole channel, 2¹⁵-2¹⁶ the fastest)
+DECIMATION_PIECE = 1 << 16
 
 
 def decimate(signals: np.ndarray, factor: int, taps: np.ndarray | None = None, mean=None,
@@ -114,8 +117,8 @@ def decimate(signals: np.ndarray, factor: int, taps: np.ndarray | None = None, m
 
     Output m is ``Σ_t g[t] x[m·factor + t − h]``, g the taps reversed and h half their number less one. With
     the (zero-padded) channel cut into rows of B·factor samples (B = :data:`DECIMATION_ROW_OUTPUTS`), a row of
-    B outputs is a fixed (banded Toeplitz) linear map of that row and the next: two matrix products per
-    channel, (rows × B·factor)(B·factor × B), read straight from the padded channel with no overlapping copy.
+    B outputs is a fixed (banded Toeplitz) linear map of that row and the next: two matrix products,
+    (rows × B·factor)(B·factor × B), on the rows of the centred channel as they lie (no overlapping copy).
     They do 2·B·factor multiplications per output where the filter needs 10·factor + 1 (the zeros of the band
     are multiplied too), but at BLAS's rate: half the time of scipy's polyphase loop (upfirdn).
 
@@ -157,18 +160,26 @@ def decimate(signals: np.ndarray, factor: int, taps: np.ndarray | None = None, m
         t = c * row + v - i * factor
         maps.append(np.where((t >= 0) & (t < taps.size), g[np.clip(t, 0, taps.size - 1)], 0.0))
     n_rows = -(-n_out // width)
-    padded = np.empty(max((n_rows + terms - 1) * row, -(-(lead + n) // row) * row))
-    rows = padded.reshape(-1, row)
+    # the channel is centred into a short buffer a piece at a time (the rows of about DECIMATION_PIECE samples
+    # and the terms − 1 rows after them), which both products then read from cache
+    piece_rows = max(1, DECIMATION_PIECE // row)
+    buffer = np.empty((piece_rows + terms - 1) * row)
     outputs = np.empty((n_rows, width))
-    more = np.empty_like(outputs)
+    more = np.empty((piece_rows, width))
     shift = np.zeros(n_channels) if mean is None else np.asarray(mean, float)
-    padded[:lead] = 0.0
-    padded[lead + n:] = 0.0
     for ch in range(n_channels):
-        np.subtract(signals[ch], shift[ch], out=padded[lead:lead + n])
-        np.matmul(rows[:n_rows], maps[0], out=outputs)
-        for c in range(1, terms):
-            outputs += np.matmul(rows[c:c + n_rows], maps[c], out=more)
+        for r0 in range(0, n_rows, piece_rows):
+            r1 = min(r0 + piece_rows, n_rows)
+            first = r0 * row - lead  # the sample the buffer starts at (zeros before 0 and from n on)
+            piece = buffer[:(r1 - r0 + terms - 1) * row]
+            lo, hi = max(first, 0), min(first + piece.size, n)
+            piece[:lo - first] = 0.0
+            piece[max(hi, lo) - first:] = 0.0
+            np.subtract(signals[ch, lo:hi], shift[ch], out=piece[lo - first:hi - first])
+            rows = piece.reshape(-1, row)
+            np.matmul(rows[:r1 - r0], maps[0], out=outputs[r0:r1])
+            for c in range(1, terms):
+                outputs[r0:r1] += np.matmul(rows[c:c + r1 - r0], maps[c], out=more[:r1 - r0])
         out[ch] = outputs.reshape(-1)[:n_out]
     return out
 
