@@ -120,7 +120,8 @@ def decimate(signals: np.ndarray, factor: int, taps: np.ndarray | None = None, m
     B outputs is a fixed (banded Toeplitz) linear map of that row and the next: two matrix products,
     (rows × B·factor)(B·factor × B), on the rows of the centred channel as they lie (no overlapping copy).
     They do 2·B·factor multiplications per output where the filter needs 10·factor + 1 (the zeros of the band
-    are multiplied too), but at BLAS's rate: half the time of scipy's polyphase loop (upfirdn).
+    are multiplied too), but at BLAS's rate: a third to a half of the time of scipy's polyphase loop (upfirdn;
+    10⁶ samples, factors 2-30, one thread).
 
     Parameters
     ----------
