@@ -119,7 +119,7 @@ def decimate(signals: np.ndarray, factor: int, taps: np.ndarray | None = None, m
     the (zero-padded) channel cut into rows of B·factor samples (B = :data:`DECIMATION_ROW_OUTPUTS`), a row of
     B outputs is a fixed (banded Toeplitz) linear map of that row and the next: two matrix products,
     (rows × B·factor)(B·factor × B), on the rows of the centred channel as they lie (no overlapping copy).
-    They do 2·B·factor multiplications per output where the filter needs 10·factor + 1 (the zeros of the band
+    They do 2·B·factor multiplications per output where the filter needs 10·factor + 1 (the banded maps' zeros
     are multiplied too), but at BLAS's rate: a third to a half of the time of scipy's polyphase loop (upfirdn;
     10⁶ samples, factors 2-30, one thread).
 
