@@ -30,7 +30,8 @@ structural mode's band reached against the limit.
 hard case for a rule on near-zero damping. ``--lone N``: tones with no structural mode near them (between modes,
 at 50 Hz, above the highest mode; steady or wandering; running speed unknown or not theirs, seeds 7800+).
 ``--method`` chooses the estimator for each (fdd and efdd, which give no error bars, not for ``--calibration``).
-``--speed``: modalbal's CPU and wall time on larger records (samples × channels).
+``--speed``: modalbal's CPU and wall time on larger records (samples × channels). ``--thread-cpu``: on the same
+records, the time an idle machine's cores would take, measured on a loaded one (:func:`thread_cpu`).
 """
 from __future__ import annotations
 
@@ -336,6 +337,10 @@ def lone_calls(n_records: int, method: str = "ssi") -> str:
     return "\n".join(lines)
 
 
+SPEED_RECORDS = ((100_000, 8, 100.0), (100_000, 64, 100.0), (1_000_000, 8, 100.0), (1_000_000, 64, 100.0),
+                 (1_000_000, 64, 600.0))  # (samples, channels, rate [Hz]): the last decimated by 5 to the band first
+
+
 def speed(runs: int = 3) -> str:
     """CPU and wall time of ``modal.oma`` per record size (median of ``runs`` after one warm-up call), SSI,
     band 1-30 Hz at 100 Hz (and one record at 600 Hz, decimated first), with one thread and with the default (every usable core, :mod:`modal.parallel`),
@@ -357,9 +362,7 @@ def speed(runs: int = 3) -> str:
         warnings.simplefilter("ignore")
         warm = ambient_modal_response(FN, ZETA, np.random.default_rng(1).standard_normal((8, 6)), 100.0, 20_000)
         modal.oma(warm.signals, 100.0, band_hz=BAND)
-        # the last record sampled 6 times faster than the others: decimated by 5 to the band first
-        for n, ch, rate in ((100_000, 8, 100.0), (100_000, 64, 100.0), (1_000_000, 8, 100.0), (1_000_000, 64, 100.0),
-                            (1_000_000, 64, 600.0)):
+        for n, ch, rate in SPEED_RECORDS:
             rng = np.random.default_rng(1)
             shapes = rng.standard_normal((ch, 6))
             rec = ambient_modal_response(FN, ZETA, shapes, rate, n, noise=0.1, seed=2)
@@ -376,6 +379,78 @@ def speed(runs: int = 3) -> str:
     return "\n".join(lines)
 
 
+def thread_cpu(runs: int = 3) -> str:
+    """The CPU time on the critical path of ``modal.oma`` with every usable core, per record of :func:`speed`:
+    the calling thread's CPU plus, for each pool of threads it starts (:mod:`modal.parallel`), the busiest
+    thread's CPU (median of ``runs`` after one warm-up call).
+
+    Each share and item is timed with ``time.thread_time()``, which counts only the CPU a thread was given: when
+    other processes hold the cores the wall time measures them, this sum the code (an idle machine's wall time,
+    memory bandwidth shared between the threads aside). Run it with another tree's interpreter, as :func:`speed`,
+    to time that tree's code. (``run_beside``'s side thread counts in full, as if it ran after the caller's
+    step beside it: an upper bound.)"""
+    import importlib
+    import threading
+
+    import modal.parallel as parallel
+    from modal.synthetic import ambient_modal_response
+
+    pools: list[dict] = []
+
+    def timed(function):
+        def inner(*args):
+            start = time.thread_time()
+            try:
+                return function(*args)
+            finally:
+                me = threading.get_ident()
+                pools[-1][me] = pools[-1].get(me, 0.0) + time.thread_time() - start
+        return inner
+
+    def pooled(original, at):  # the pool's function (argument ``at``) timed on each thread, one record per call
+        def inner(*args):
+            pools.append({})
+            args = list(args)
+            args[at] = timed(args[at])
+            return original(*args)
+        return inner
+
+    patched = {"split_over_threads": pooled(parallel.split_over_threads, 0),
+               "map_over_threads": pooled(parallel.map_over_threads, 0), "run_beside": pooled(parallel.run_beside, 1)}
+    modules = [importlib.import_module(f"modal.operational.{name}") for name in
+               ("correlations", "identify", "inputs", "modes", "ssi", "tones")]
+    saved = [(module, name, getattr(module, name)) for module in modules for name in patched if hasattr(module, name)]
+    lines = [f"modal from {Path(modal.__file__).resolve().parent.parent}, "
+             f"{parallel.usable_cores()} usable core(s), median of {runs}, load {os.getloadavg()[0]:.1f}", "",
+             "| samples × channels | rate [Hz] | critical path [s] | calling thread [s] | pools' busiest threads [s] |",
+             "|---|---|---|---|---|"]
+    try:
+        for module, name, _ in saved:
+            setattr(module, name, patched[name])
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            for n, ch, rate in SPEED_RECORDS:
+                rng = np.random.default_rng(1)
+                rec = ambient_modal_response(FN, ZETA, rng.standard_normal((ch, 6)), rate, n, noise=0.1, seed=2)
+                modal.oma(rec.signals, rate, band_hz=BAND)
+                sums = []
+                for _ in range(runs):
+                    pools.clear()
+                    start = time.thread_time()
+                    modal.oma(rec.signals, rate, band_hz=BAND)
+                    caller = time.thread_time() - start
+                    me = threading.get_ident()
+                    busiest = sum(max([t for thread, t in pool.items() if thread != me] or [0.0]) for pool in pools)
+                    sums.append((caller + busiest, caller, busiest))
+                total, caller, busiest = (statistics.median(column) for column in zip(*sums))
+                lines.append(f"| {n} × {ch} | {rate:g} | {total:.3f} | {caller:.3f} | {busiest:.3f} |")
+                del rec
+    finally:
+        for module, name, original in saved:
+            setattr(module, name, original)
+    return "\n".join(lines)
+
+
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--records", type=int, default=10)
@@ -389,6 +464,7 @@ def main(argv=None) -> None:
     parser.add_argument("--light", type=int, default=0)
     parser.add_argument("--lone", type=int, default=0)
     parser.add_argument("--speed", action="store_true")
+    parser.add_argument("--thread-cpu", dest="thread_cpu", action="store_true")
     args = parser.parse_args(argv)
     if args.records:
         print(compare(args.records))
@@ -407,6 +483,9 @@ def main(argv=None) -> None:
     if args.speed:
         print()
         print(speed())
+    if args.thread_cpu:
+        print()
+        print(thread_cpu())
 
 
 if __name__ == "__main__":

@@ -101,14 +101,88 @@ def decimation_filter(factor: int) -> np.ndarray:
     return firwin(2 * DECIMATION_HALF_LENGTH * factor + 1, 1.0 / factor, window=("kaiser", DECIMATION_KAISER_BETA))
 
 
-def decimate(signals: np.ndarray, factor: int, taps: np.ndarray | None = None) -> np.ndarray:
-    """Low-pass filter (``taps``, by default :func:`decimation_filter`; linear phase, polyphase) and keep every
-    ``factor``-th sample."""
+#: outputs per row of the decimation's matrix products (:func:`decimate`): rows of 10-16 outputs were within
+#: 15 % of each other in time, 12 the fastest for factors 2-30 (10⁶ samples, one thread)
+DECIMATION_ROW_OUTPUTS = 12
+#: samples of a channel :func:`decimate` centres and filters at a time (their products then read them from cache:
+#: a quarter faster than over the whole channel, 2¹⁵-2¹⁶ the fastest)
+DECIMATION_PIECE = 1 << 16
+
+
+def decimate(signals: np.ndarray, factor: int, taps: np.ndarray | None = None, mean=None,
+             out: np.ndarray | None = None) -> np.ndarray:
+    """Low-pass filter each channel (``taps``, by default :func:`decimation_filter`) and keep every
+    ``factor``-th sample: scipy's ``resample_poly(signals, 1, factor, axis=1, window=taps)`` to double-precision
+    rounding (the same ``ceil(n_samples / factor)`` outputs, the record taken as zero beyond its ends).
+
+    Output m is ``Σ_t g[t] x[m·factor + t − h]``, g the taps reversed and h half their number less one. With
+    the (zero-padded) channel cut into rows of B·factor samples (B = :data:`DECIMATION_ROW_OUTPUTS`), a row of
+    B outputs is a fixed (banded Toeplitz) linear map of that row and the next: two matrix products,
+    (rows × B·factor)(B·factor × B), on the rows of the centred channel as they lie (no overlapping copy).
+    They do 2·B·factor multiplications per output where the filter needs 10·factor + 1 (the banded maps' zeros
+    are multiplied too), but at BLAS's rate: a third to a half of the time of scipy's polyphase loop (upfirdn;
+    10⁶ samples, factors 2-30, one thread).
+
+    Parameters
+    ----------
+    signals : ndarray, shape (n_channels, n_samples)
+        Single or double precision.
+    factor : int
+        Keep every ``factor``-th sample; 1 or less returns ``signals`` as they are.
+    taps : ndarray, optional
+        The FIR filter's taps (odd in number: the linear-phase filter :func:`decimation_filter` gives).
+    mean : ndarray, shape (n_channels,), optional
+        Each channel's mean, taken off (in double precision) before the filter.
+    out : ndarray, shape (n_channels, ceil(n_samples / factor)), optional
+        Double-precision array to write into.
+
+    Returns
+    -------
+    ndarray, shape (n_channels, ceil(n_samples / factor))
+        Double precision, in the units of ``signals``.
+    """
     if factor <= 1:
         return signals
-    from scipy.signal import resample_poly
-
-    return resample_poly(signals, 1, factor, axis=1, window=decimation_filter(factor) if taps is None else taps)
+    taps = decimation_filter(factor) if taps is None else np.asarray(taps, float)
+    n_channels, n = signals.shape
+    n_out = -(-n // factor)
+    if out is None:
+        out = np.empty((n_channels, n_out))
+    lead = (taps.size - 1) // 2  # zeros before the first sample (the filter's delay)
+    g = taps[::-1]
+    width = max(DECIMATION_ROW_OUTPUTS, -(-(taps.size - factor) // factor))  # rows 2 products cover
+    row = width * factor
+    terms = -(-((width - 1) * factor + taps.size) // row)
+    # term c maps row r + c to row r's outputs: T[c][v, i] = g[c·row + v − i·factor]
+    v = np.arange(row)[:, None]
+    i = np.arange(width)[None, :]
+    maps = []
+    for c in range(terms):
+        t = c * row + v - i * factor
+        maps.append(np.where((t >= 0) & (t < taps.size), g[np.clip(t, 0, taps.size - 1)], 0.0))
+    n_rows = -(-n_out // width)
+    # the channel is centred into a short buffer a piece at a time (the rows of about DECIMATION_PIECE samples
+    # and the terms − 1 rows after them), which both products then read from cache
+    piece_rows = max(1, DECIMATION_PIECE // row)
+    buffer = np.empty((piece_rows + terms - 1) * row)
+    outputs = np.empty((n_rows, width))
+    more = np.empty((piece_rows, width))
+    shift = np.zeros(n_channels) if mean is None else np.asarray(mean, float)
+    for ch in range(n_channels):
+        for r0 in range(0, n_rows, piece_rows):
+            r1 = min(r0 + piece_rows, n_rows)
+            first = r0 * row - lead  # the sample the buffer starts at (zeros before 0 and from n on)
+            piece = buffer[:(r1 - r0 + terms - 1) * row]
+            lo, hi = max(first, 0), min(first + piece.size, n)
+            piece[:lo - first] = 0.0
+            piece[max(hi, lo) - first:] = 0.0
+            np.subtract(signals[ch, lo:hi], shift[ch], out=piece[lo - first:hi - first])
+            rows = piece.reshape(-1, row)
+            np.matmul(rows[:r1 - r0], maps[0], out=outputs[r0:r1])
+            for c in range(1, terms):
+                outputs[r0:r1] += np.matmul(rows[c:c + r1 - r0], maps[c], out=more[:r1 - r0])
+        out[ch] = outputs.reshape(-1)[:n_out]
+    return out
 
 
 def _segment_length(max_lag: int, n_samples: int) -> int:

@@ -296,43 +296,19 @@ def _refuse_non_finite(signals: np.ndarray, ch: int, src: str, names) -> None:
 
 
 def _centred_decimated(signals: np.ndarray, factor: int, src: str, names, workers=None) -> np.ndarray:
-    """Each channel less its mean (in double precision), decimated by ``factor``: one channel at a time, so that
-    no double-precision copy of the whole record is made (a 10⁶ × 64 record's would be 512 MB); the channels
-    shared among ``workers`` threads.
-
-    The filter is linear: a channel x less its mean μ decimates to D x − μ D 1, D 1 the decimated record of
-    ones (1 but at the filter's edges, where an offset would ring). So each channel is filtered as it is stored
-    and its mean taken off after, with no centred copy of it made, and the filter is designed once."""
+    """Each channel less its mean (in double precision), decimated by ``factor`` (:func:`decimate`): one channel
+    at a time, so that no double-precision copy of the whole record is made (a 10⁶ × 64 record's would be
+    512 MB); the channels shared among ``workers`` threads, the filter designed once."""
     _check_shape(signals, src)
     n_channels, n = signals.shape
     taps = decimation_filter(factor)
-    ones = _decimated_ones(n, factor, taps)  # D 1
-    out = np.empty((n_channels, ones.size))  # resample_poly keeps ceil(n / factor) samples
+    out = np.empty((n_channels, -(-n // factor)))
 
     def decimate_channels(first: int, stop: int) -> None:
-        for ch in range(first, stop):
-            mean = _finite_mean(signals, ch, src, names)
-            np.subtract(decimate(signals[ch:ch + 1], factor, taps)[0], mean * ones, out=out[ch])
+        means = [_finite_mean(signals, ch, src, names) for ch in range(first, stop)]
+        decimate(signals[first:stop], factor, taps, mean=means, out=out[first:stop])
 
     split_over_threads(decimate_channels, n_channels, workers)
-    return out
-
-
-def _decimated_ones(n: int, factor: int, taps: np.ndarray) -> np.ndarray:
-    """:func:`decimate` of ``n`` ones (each output the sum of the taps that meet a sample), found from a record of
-    ones a few filter lengths long: its first and last outputs are the long record's edges (the same length modulo
-    ``factor``: the same phase of the last output), its middle one their constant interior, the same number to
-    the bit (every interior output sums the same taps in the same order). A 10⁶-sample record's took 10-30 ms of
-    one thread."""
-    short_n = 4 * taps.size + factor
-    short_n += (n - short_n) % factor
-    if n <= short_n:
-        return decimate(np.ones((1, n)), factor, taps)[0]
-    short = decimate(np.ones((1, short_n)), factor, taps)[0]
-    half = short.size // 2
-    out = np.full(-(-n // factor), short[half])  # resample_poly keeps ceil(n / factor) samples
-    out[:half] = short[:half]
-    out[out.size - (short.size - half):] = short[half:]
     return out
 
 

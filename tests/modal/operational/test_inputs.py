@@ -89,18 +89,6 @@ def test_decimated_record_is_the_centred_channels_filtered():
     assert np.allclose(prepared.scale, np.sqrt(np.mean(centred**2, axis=1)), rtol=1e-12)
 
 
-
-@pytest.mark.parametrize("factor", [2, 5, 8, 12])
-@pytest.mark.parametrize("n_samples", [7, 260, 1_001, 40_003, 99_999])
-def test_decimated_ones_are_those_of_the_whole_record_of_ones(factor, n_samples):
-    # D 1 (which takes each channel's mean off after its filter) from a short record of ones: its edges and its
-    # constant interior, every length and phase of the last output, the same numbers to the bit
-    from modal.operational.correlations import decimate, decimation_filter
-    from modal.operational.inputs import _decimated_ones
-
-    taps = decimation_filter(factor)
-    assert np.array_equal(_decimated_ones(n_samples, factor, taps), decimate(np.ones((1, n_samples)), factor, taps)[0])
-
 def test_bad_sample_of_a_record_to_be_decimated_is_named():
     signals = _record(n_channels=3, n_samples=40_000)
     signals[2, 1234] = np.nan
