@@ -31,7 +31,7 @@ from scipy.ndimage import binary_dilation, median_filter
 from ..errors import QualityWarning, warn
 from .excitation_noise import POWERED_LINE_FRACTION
 
-__all__ = ["ChanceTest", "chance_tests", "warn_unrelated", "RELATED_SIGMAS", "MIN_RECORDS"]
+__all__ = ["ChanceTest", "chance_tests", "warn_unrelated", "RELATED_SIGMAS", "MIN_RECORDS", "MIN_LINES"]
 
 #: a channel whose mean coherence is more than this many standard errors above chance is related to the force.
 #: Under no relation the mean over hundreds of lines is nearly normal: 5 standard errors are passed by chance
@@ -47,6 +47,9 @@ RELATED_SIGMAS = 5.0
 TONE_RATIO = 3.0
 TONE_HALF_WIDTH = 8
 TONE_SPREAD = 2
+#: driven lines below which the test is not made: the mean of fewer is not near normal (with 3 records one line's
+#: coherence is Beta(1, 2), skewness 0.57), and a force of a few lines (a sine) is not what it is made for
+MIN_LINES = 16
 #: records (segments or hits) below which the test is not made: with q + 1 records or fewer the coherence is
 #: 1 (or nearly) on every line whatever the channel holds
 MIN_RECORDS = 3
@@ -85,6 +88,12 @@ class ChanceTest:
         return (self.mean_coherence - self.chance) / self.chance_se
 
     @property
+    def detectable_share(self) -> float:
+        """The share of the driven lines that, fully coherent, would lift the mean to
+        :data:`RELATED_SIGMAS` standard errors above chance: how much relation the test can see."""
+        return min(1.0, RELATED_SIGMAS * self.chance_se / (1.0 - self.chance))
+
+    @property
     def unrelated(self) -> bool:
         """Not above chance by :data:`RELATED_SIGMAS` standard errors."""
         return self.sigmas < RELATED_SIGMAS
@@ -114,8 +123,8 @@ def chance_tests(sums, multiple_coherence: np.ndarray, output_correlation: np.nd
     Returns
     -------
     list of ChanceTest
-        One per output; empty with fewer than :data:`MIN_RECORDS` records, or q + 1 effective records or
-        fewer, or no driven line.
+        One per output; empty with fewer than :data:`MIN_RECORDS` records, q + 1 effective records or
+        fewer, or fewer than :data:`MIN_LINES` driven lines.
     """
     n_in = sums.sxx.shape[0]
     n_eff = sums.n_records / overlap_factor
@@ -123,15 +132,21 @@ def chance_tests(sums, multiple_coherence: np.ndarray, output_correlation: np.nd
         return []
     power = np.einsum("iif->if", sums.sxx).real
     n_lines = power.shape[1]
-    driven = np.all(power >= POWERED_LINE_FRACTION * power.max(axis=1, keepdims=True), axis=0) & np.all(power > 0, 0)
-    driven[0] = driven[-1] = False  # 0 Hz and the Nyquist line: real spectra, another distribution
+    # 0 Hz and the Nyquist line have real spectra (another distribution), and a force's offset leaks into
+    # line 1 under a Hann window: the lines counted, and the force's largest, are those from line 2 on
+    inner = np.zeros(n_lines, bool)
+    inner[2:-1] = True
+    if not np.any(inner):
+        return []
+    largest = power[:, inner].max(axis=1, keepdims=True)
+    driven = inner & np.all(power >= POWERED_LINE_FRACTION * largest, axis=0) & np.all(power > 0, axis=0)
     # a tone in a force (mains hum, a shaker's harmonic) is no excitation of the structure, and a dead channel
     # that picks up the same hum is coherent with it there: such lines are not counted
     local = median_filter(power, size=(1, 2 * TONE_HALF_WIDTH + 1), mode="nearest")
     tone = np.any(power > TONE_RATIO * local, axis=0)
     driven &= ~binary_dilation(tone, iterations=TONE_SPREAD)
     lines = int(driven.sum())
-    if lines == 0:
+    if lines < MIN_LINES:
         return []
     chance = n_in / n_eff
     variance = n_in * (n_eff - n_in) / (n_eff ** 2 * (n_eff + 1))
@@ -183,9 +198,9 @@ def warn_unrelated(tests: list[ChanceTest], names, n_inputs: int, impact: bool, 
         name = names[test.output]
         warn(f"{source}: {name} shows no relation to {force}: mean coherence {test.mean_coherence:.3g} over its "
              f"{test.lines} driven lines, chance {test.chance:.3g} ± {test.chance_se:.2g} with {test.records} "
-             f"{records} ({test.sigmas:+.1f} standard errors; a response of the structure lies far above unless "
-             "buried in its noise): an unplugged or dead sensor, a cable at another input, a channel listed that "
-             "was not measured, or a response the data cannot tell from noise; its FRF is noise (fits weigh it by "
-             "that noise): check the sensor and its cable", QualityWarning)
+             f"{records} ({test.sigmas:+.1f} standard errors; a response would show with about "
+             f"{100 * test.detectable_share:.2g} % of these lines coherent): an unplugged or dead sensor, a cable at "
+             "another input, a channel listed that was not measured, or a response buried in its noise; its FRF is "
+             "noise (fits weigh it by that noise): check the sensor and its cable", QualityWarning)
         found.append(test.as_dict(name))
     return found
