@@ -26,7 +26,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.ndimage import binary_dilation, median_filter
 
 from ..errors import QualityWarning, warn
 from .excitation_noise import POWERED_LINE_FRACTION
@@ -142,9 +141,10 @@ def chance_tests(sums, multiple_coherence: np.ndarray, output_correlation: np.nd
     driven = inner & np.all(power >= POWERED_LINE_FRACTION * largest, axis=0) & np.all(power > 0, axis=0)
     # a tone in a force (mains hum, a shaker's harmonic) is no excitation of the structure, and a dead channel
     # that picks up the same hum is coherent with it there: such lines are not counted
-    local = median_filter(power, size=(1, 2 * TONE_HALF_WIDTH + 1), mode="nearest")
+    padded = np.pad(power, ((0, 0), (TONE_HALF_WIDTH, TONE_HALF_WIDTH)), mode="edge")
+    local = np.median(np.lib.stride_tricks.sliding_window_view(padded, 2 * TONE_HALF_WIDTH + 1, axis=1), axis=2)
     tone = np.any(power > TONE_RATIO * local, axis=0)
-    driven &= ~binary_dilation(tone, iterations=TONE_SPREAD)
+    driven &= np.convolve(tone, np.ones(2 * TONE_SPREAD + 1), mode="same") == 0
     lines = int(driven.sum())
     if lines < MIN_LINES:
         return []
