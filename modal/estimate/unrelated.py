@@ -7,8 +7,8 @@ relation, and for Gaussian noise in the response (conditioned on the force's spe
 mean q/n, variance q(n − q)/(n²(n + 1)) (Goodman 1963; Bendat & Piersol, *Random Data*, ch. 9). Overlapping
 segments share records: n is taken as n over Welch's variance factor (:func:`.spectra.overlap_variance_factor`).
 
-One line decides little (with 30 records chance reaches 0.1 on 4 lines in 100, and a real channel whose noise
-equals its peak has median coherence 0.06-0.08); the mean over the L driven lines does. Its standard error
+One line decides little (with 30 records chance reaches 0.1 on 5 lines in 100, and a real channel whose noise
+equals its peak has median coherence 0.06-0.08, benchmarks/REPORT.md); the mean over the L driven lines does. Its standard error
 under no relation is σ/√L times √(1 + 2 Σ_m r̄_m), r̄_m the mean correlation of the coherence of lines k and
 k + m. The cross-spectrum S_yx of lines k and k + m, given the force, correlates by c_out(m) g_km, the response
 window's line correlation (:func:`modal.noise_model.window_line_correlation`) times the force's own over the
@@ -41,8 +41,8 @@ RELATED_SIGMAS = 5.0
 #: tone (mains hum, a shaker's harmonic), and lines within TONE_SPREAD of it are not counted (a Hann window's main
 #: lobe). The lines are chosen from the force alone, and under no relation the coherence given the force is
 #: Beta whatever it is: dropping lines costs a related channel a little evidence, and leaves chance as it was. A
-#: random force's line averaged over 3 records exceeds 3 times its median with probability 0.006 (15 records:
-#: 1e-8); a hammer's spectrum is smooth over far more lines
+#: random force's line averaged over 3 records exceeds 3 times its median with probability 0.014 (15 records:
+#: 1e-7); a hammer's spectrum is smooth over far more lines
 TONE_RATIO = 3.0
 TONE_HALF_WIDTH = 8
 TONE_SPREAD = 2
