@@ -169,6 +169,7 @@ def join_estimates(estimates: Sequence[EstimatedFRF], point_sources,
                                          [np.atleast_2d(e.response) for e in estimates])
     rejected = [dict(item, take_name=item.get("take_name", e.source)) for e in estimates for item in e.rejected]
     overloads = [dict(item, channel=f"{e.source}: {item['channel']}") for e in estimates for item in e.overloads]
+    unrelated = [dict(item, channel=f"{e.source}: {item['channel']}") for e in estimates for item in e.unrelated]
     points = ", ".join(f"{point} ({', '.join(files)})" for point, files in point_sources)
     averages = [e.averages for e in estimates]
     note = (f"roving hammer: {len(estimates)} hit points {points}, each estimated from its own file(s) "
@@ -182,6 +183,7 @@ def join_estimates(estimates: Sequence[EstimatedFRF], point_sources,
         coherence=stacked("coherence"), multiple_coherence=stacked("multiple_coherence"), averages=min(averages),
         rejected=rejected, estimator=first.estimator, window=first.window, sample_rate_hz=first.sample_rate_hz,
         segment_length=first.segment_length, overlap=first.overlap, n_inputs=1, hit_times_s=(), overloads=overloads,
+        unrelated=unrelated,
         point_sources=tuple((p, tuple(f)) for p, f in point_sources), join_note=note)
 
 

@@ -36,6 +36,7 @@ from .periodic import repeats_every, shortest_period
 from .quiet import quiet_noise
 from .takes import find_hits_in_takes, hit_labels, segment_starts, take_bounds
 from .takes import take_names as _take_names
+from .unrelated import chance_tests, warn_unrelated
 from .windows import WINDOWS, exponential_window, force_window, segment_window
 
 __all__ = ["EstimatedFRF", "estimate_frf", "RESPONSE_QUANTITIES"]
@@ -94,6 +95,11 @@ class EstimatedFRF(FRF):
         full scale) anywhere in the record: ``channel``, ``how`` (``"flat tops"`` or
         ``"full scale"``), ``level`` (in the channel's unit), ``samples``, ``longest_run``.
         Impact records reject the hits they touch; continuous records warn.
+    unrelated : list of dict
+        Response channels unrelated to the force (a dead or unplugged sensor: their coherence no higher
+        than chance, :mod:`modal.estimate.unrelated`), warned: ``channel``, ``mean_coherence`` (over the
+        ``lines`` driven lines), ``chance`` and ``chance_se`` (its mean and standard error under no
+        relation), ``records``.
     """
 
     coherence: np.ndarray | None = None
@@ -108,6 +114,7 @@ class EstimatedFRF(FRF):
     n_inputs: int = 1
     hit_times_s: tuple = ()
     overloads: list = field(default_factory=list)
+    unrelated: list = field(default_factory=list)
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -645,6 +652,8 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
     factor = spectra.overlap_variance_factor(out_w, step) if not impact else 1.0
     estimate = {"H1": spectra.h1, "H2": spectra.h2, "Hv": spectra.hv}[estimator]
     frf3, coherence3, multiple, variance3 = estimate(sums, source)
+    unrelated = warn_unrelated(chance_tests(sums, multiple, output_correlation, factor),
+                               labels[x.shape[0]:], x.shape[0], impact, source)
     n_out, n_in, n_lines = frf3.shape
     frequency = np.fft.rfftfreq(length, 1.0 / fs)
     response_lines = frf3.reshape(n_out * n_in, n_lines)
@@ -709,4 +718,5 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
         hit_times_s=hit_times,
         overloads=[{"channel": labels[o.channel], "how": o.how, "level": o.level, "samples": o.samples,
                     "longest_run": o.longest_run} for o in overloads],
+        unrelated=unrelated,
     )

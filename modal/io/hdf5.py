@@ -129,6 +129,7 @@ def _write_estimate(group, frf) -> None:
     group.attrs["window"] = frf.window
     group.attrs["rejected"] = json.dumps(frf.rejected)
     group.attrs["overloads"] = json.dumps(frf.overloads)
+    group.attrs["unrelated"] = json.dumps(frf.unrelated)
 
 
 def _read_estimate(group, frf: FRF, source: str) -> FRF:
@@ -166,6 +167,7 @@ def _read_estimate(group, frf: FRF, source: str) -> FRF:
         extras["window"] = _str_attr(group.attrs.get("window", "rect"))
         extras["rejected"] = json.loads(_str_attr(group.attrs.get("rejected", "[]")))
         extras["overloads"] = json.loads(_str_attr(group.attrs.get("overloads", "[]")))
+        extras["unrelated"] = json.loads(_str_attr(group.attrs.get("unrelated", "[]")))
     except (ValueError, TypeError) as exc:
         raise FormatError(f"{source}: group {group.name}: the estimate's coherence or noise cannot be read ({exc}); "
                           "expected arrays shaped like 'response'") from None

@@ -180,6 +180,7 @@ def test_a_response_channel_of_noise_only_leaves_the_others_modes_alone(method):
         warnings.simplefilter("ignore", modal.ModalWarning)
         frf = modal.estimate_frf(signals[0], signals[1:], 2048.0, impact=True, window="force", kind="accelerance",
                                  response_quantity="acceleration")
+    assert [u["channel"] for u in frf.unrelated] == ["response 2"]  # and the estimate says which channel is dead
     result = _fit(frf, method=method, driving_point=0)
     fn = np.array([m.natural_frequency_hz for m in result.modes])
     std = np.array([m.std.natural_frequency_hz for m in result.modes])
