@@ -8,14 +8,14 @@ mean q/n, variance q(n − q)/(n²(n + 1)) (Goodman 1963; Bendat & Piersol, *Ran
 segments share records: n is taken as n over Welch's variance factor (:func:`.spectra.overlap_variance_factor`).
 
 One line decides little (with 30 records chance reaches 0.1 on 5 lines in 100, and a real channel whose noise
-equals its peak has median coherence 0.06-0.08, benchmarks/REPORT.md); the mean over the L driven lines does. Its standard error
-under no relation is σ/√L times √(1 + 2 Σ_m r̄_m), r̄_m the mean correlation of the coherence of lines k and
-k + m. The cross-spectrum S_yx of lines k and k + m, given the force, correlates by c_out(m) g_km, the response
-window's line correlation (:func:`modal.noise_model.window_line_correlation`) times the force's own over the
-records, g_km = Σ conj(X_k) X_{k+m} / √(S_xx,k S_xx,k+m); the squared magnitudes of correlated complex Gaussians
-correlate by the square of that, r_km = |c_out(m) g_km|². Hann on random excitation: |c(1)|⁴ = 16/81 and
-|c(2)|⁴ = 1/1296, a factor 1.40 (L/1.4 independent lines); a rectangular window 1; an exponential window on
-a hammer's smooth force spectrum (g ≈ 1) several.
+equals its peak has median coherence 0.06-0.08, benchmarks/REPORT.md); the mean over the L driven lines does. Its
+standard error under no relation is σ/√L times √(1 + 2 Σ_m r̄_m), r̄_m the mean correlation of the coherence of
+lines k and k + m. The cross-spectrum S_yx of lines k and k + m, given the force, correlates by c_out(m) g_km, the
+response window's line correlation (:func:`modal.noise_model.window_line_correlation`) times the force's own over
+the records, g_km = Σ conj(X_k) X_{k+m} / √(S_xx,k S_xx,k+m); the squared magnitudes of correlated complex
+Gaussians correlate by the square of that, r_km = |c_out(m) g_km|². Hann on random excitation: |c(1)|⁴ = 16/81 and
+|c(2)|⁴ = 1/1296, a factor 1.40 (L/1.4 independent lines); a rectangular window 1; an exponential window on a
+hammer's smooth force spectrum (g ≈ 1) several.
 
 A channel is unrelated when its mean coherence lies less than :data:`RELATED_SIGMAS` standard errors above
 chance: a channel of the structure's response has the modes' lines coherent and lies tens to hundreds of
