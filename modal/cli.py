@@ -253,7 +253,8 @@ def _frf(args) -> int:
     if args.json:
         doc = {"file": args.path[0] if len(args.path) == 1 else list(args.path), "out": args.out, "kind": frf.kind, "n_channels": frf.n_channels,
                "n_lines": frf.n_freq, "averages": frf.averages, "estimator": frf.estimator, "window": frf.window,
-               "exponential_decay_s": frf.exponential_decay_s, "rejected": frf.rejected, "warnings": said,
+               "exponential_decay_s": frf.exponential_decay_s, "rejected": frf.rejected,
+               "overloads": frf.overloads, "unrelated": frf.unrelated, "warnings": said,
                "response_points": list(frf.response_points or []),
                "reference_points": list(frf.reference_points or [])}
         json.dump(jsonable(doc), sys.stdout, indent=1, allow_nan=False)

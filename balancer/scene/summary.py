@@ -38,6 +38,8 @@ def frf_digest(result) -> dict:
     if isinstance(result, EstimatedFRF):  # estimated from a time record in the scene
         d["estimate"] = {"source": result.source, "estimator": result.estimator, "window": result.window,
                          "averages": result.averages, "rejected": [dict(r) for r in result.rejected],
+                         "overloads": [dict(o) for o in result.overloads],
+                         "unrelated": [dict(u) for u in result.unrelated],
                          "excitation_points": list(result.reference_points or ()),
                          "response_points": list(result.response_points or ())}
     return d

@@ -262,7 +262,10 @@ def test_clipping_is_reported_on_the_command_line(tmp_path):
     out = run("frf", path, "--out", tmp_path / "s.h5", "--json")
     assert out.returncode == 0, out.stderr
     assert "warning: " in out.stderr and "response a1 clipped at 3 (flat tops" in out.stderr
-    assert any("response a1 clipped at 3 (flat tops" in w for w in json.loads(out.stdout)["warnings"])
+    doc = json.loads(out.stdout)
+    assert any("response a1 clipped at 3 (flat tops" in w for w in doc["warnings"])
+    # and as data beside the warnings: the channel, how, and how long
+    assert [(o["channel"], o["how"]) for o in doc["overloads"]] == [("response a1", "flat tops")] and doc["unrelated"] == []
 
 
 def test_a_hammer_record_fitted_without_impact_says_so(tmp_path):
