@@ -406,9 +406,9 @@ def _warn_change_dependence(force, response, starts, hit_numbers, hit_times_s, l
     at, where = hit_times_s[test.first_after], labels[len(labels) - response.shape[0] + test.output]
     warn(f"{source}: the hits' FRF changes between hit {before} and hit {after} (at {at:.3f} s) beyond its noise "
          f"({where} at {test.frequency_hz:.4g} Hz by {100 * test.change:.0f} %, F-test p = {test.p_value:.2g} "
-         f"against {test.limit:.2g} over {test.n_lines} lines and {test.n_hits - 1} places): the hammer or a sensor "
-         "moved, or the structure changed, during the record, and the average mixes two FRFs; estimate the hits "
-         "before and after apart", QualityWarning)
+         f"against {test.limit:.2g} over {test.n_lines} {'resonant ' if test.resonant else ''}lines and "
+         f"{test.n_hits - 1} places): the hammer or a sensor moved, or the structure changed, during the record, "
+         "and the average mixes two FRFs; estimate the hits before and after apart", QualityWarning)
 
 
 def _warn_take_dependence(force, response, starts, take_of_hit, length, input_window, output_window,

@@ -34,7 +34,8 @@ import numpy as np
 from ..quantiles import f_survival
 
 __all__ = ["LevelTest", "TakeTest", "ChangeTest", "level_dependence", "take_dependence", "change_dependence",
-           "FAMILY_LEVEL", "MIN_LEVEL_RATIO", "MIN_HITS", "MATERIAL_CHANGE", "MAX_SPECTRUM_VALUES"]
+           "FAMILY_LEVEL", "MIN_LEVEL_RATIO", "MIN_HITS", "MATERIAL_CHANGE", "MAX_SPECTRUM_VALUES",
+           "RESONANT_POWER_RATIO"]
 
 #: chance that a linear structure's record is reported level-dependent (over all its lines and responses), as the
 #: F distribution of Gaussian errors gives it; its far tail, with the few degrees of freedom of a handful of hits,
@@ -47,6 +48,10 @@ MIN_LEVEL_RATIO = 1.5
 #: others) is not reported, however significant: a hit's record that holds the previous hit's ringing at 1 %
 #: (a lightly damped mode, hits a few seconds apart, little noise) is no nonlinearity worth a warning
 MATERIAL_CHANGE = 0.02
+#: a response's line whose power summed over the hits is at least this many times its median over the force's band
+#: is resonant (:func:`change_dependence` also tests those lines alone: a resonance stands 20-60 dB out of its
+#: neighbours, the median line is off resonance)
+RESONANT_POWER_RATIO = 10.0
 #: hits needed: two parameters per line and degrees of freedom left for the noise
 MIN_HITS = 4
 #: hits × lines × channels of spectra the test holds at most (64 MiB of complex values); above, it is not run
@@ -259,12 +264,17 @@ class ChangeTest:
     Attributes
     ----------
     p_value, limit, frequency_hz, output
-        As :class:`LevelTest`'s; ``limit`` is spread over the places too.
+        As :class:`LevelTest`'s; ``limit`` that of the family the smallest p (against its limit) was found in,
+        spread over the places too.
     first_after : int
         The first hit (0-based, of those tested) after the change.
     change : float
         At that line, the larger of the two groups' FRFs' distance from the average, relative to the average.
-    n_hits, n_lines : int
+    n_hits : int
+    n_lines : int
+        Lines of that family, summed over the responses.
+    resonant : bool
+        Found among the resonant lines (the second family of :func:`change_dependence`).
     """
 
     p_value: float
@@ -275,6 +285,7 @@ class ChangeTest:
     change: float
     n_hits: int
     n_lines: int
+    resonant: bool = False
 
     @property
     def changed(self) -> bool:
@@ -287,8 +298,14 @@ def change_dependence(force, response, starts, length: int, input_window, output
     cannot say.
 
     For each place j the hits before it and from it on are two takes, tested as :func:`take_dependence`
-    tests them, F ~ F(2, 2(n − 2)); the smallest p over the lines, responses and the n − 1 places is
-    compared with :data:`FAMILY_LEVEL` over their number.
+    tests them, F ~ F(2, 2(n − 2)). The smallest p is sought in two families, each at half of
+    :data:`FAMILY_LEVEL` over its number of tests (lines × places, summed over the responses): every line of
+    the force's band, and the resonant lines alone (a response's power summed over the hits at least
+    :data:`RESONANT_POWER_RATIO` times its median over the band), where a moved hammer or sensor changes most
+    and a family of a few dozen lines asks for a change a few times smaller. Choosing lines by their summed
+    power leaves the test's null distribution as it is: with Gaussian errors F is independent of
+    Σ|Y_k|² = |Σ X̄_k Y_k|²/S_xx + RSS₀ (the fitted part and the residual's two parts are independent, and a
+    ratio of independent χ² is independent of their sum).
 
     Parameters as :func:`level_dependence`'s, ``starts`` in time order. None with fewer than :data:`MIN_HITS`
     hits, no line in the force's band, or spectra above :data:`MAX_SPECTRUM_VALUES`.
@@ -306,7 +323,7 @@ def change_dependence(force, response, starts, length: int, input_window, output
     p_before = np.cumsum(Pb, axis=0)[:-1]
     p_total = p_before[-1] + Pb[-1]
     p_after = p_total - p_before
-    best = (np.inf, 0.0, 0, 0, 0.0)
+    found, resonant_lines = [], 0
     for o in range(n_out):
         Y = np.fft.rfft(_records(response[o], starts, length) * output_window, axis=1)[:, lines]
         cross = np.conj(Xb) * Y
@@ -321,16 +338,22 @@ def change_dependence(force, response, starts, length: int, input_window, output
             common = c_total / p_total
             change = (np.maximum(np.abs(c_before / p_before - common), np.abs(c_after / p_after - common))
                       / np.abs(common))
+        resonant = s_yy >= RESONANT_POWER_RATIO * np.median(s_yy)
+        resonant_lines += int(resonant.sum())
         ok = np.isfinite(F) & (rss2 > 0) & (change >= MATERIAL_CHANGE)
-        if not ok.any():
-            continue
         p = np.full(F.shape, np.inf)
         p[ok] = f_survival(2.0, 2.0 * (n - 2), np.maximum(F[ok], 0.0))
-        place, k = np.unravel_index(int(np.argmin(p)), p.shape)
-        if p[place, k] < best[0]:
-            best = (float(p[place, k]), float(lines[k] * sample_rate_hz / length), o, int(place) + 1,
-                    float(change[place, k]))
-    if not np.isfinite(best[0]):
+        found.append((p, np.where(resonant[None, :], p, np.inf), change))
+    best = None
+    for family, n_tests in ((0, lines.size * n_out), (1, resonant_lines)):
+        limit = FAMILY_LEVEL / 2 / (max(n_tests, 1) * (n - 1))
+        for o, item in enumerate(found):
+            p = item[family]
+            place, k = np.unravel_index(int(np.argmin(p)), p.shape)
+            if np.isfinite(p[place, k]) and (best is None or p[place, k] / limit < best[0] / best[1]):
+                best = (float(p[place, k]), limit, float(lines[k] * sample_rate_hz / length), o, int(place) + 1,
+                        float(item[2][place, k]), n_tests, bool(family))
+    if best is None:
         return None
-    return ChangeTest(p_value=best[0], limit=FAMILY_LEVEL / (lines.size * n_out * (n - 1)), frequency_hz=best[1],
-                      output=best[2], first_after=best[3], change=best[4], n_hits=int(n), n_lines=int(lines.size))
+    return ChangeTest(p_value=best[0], limit=best[1], frequency_hz=best[2], output=best[3], first_after=best[4],
+                      change=best[5], n_hits=int(n), n_lines=int(best[6]), resonant=best[7])
