@@ -250,6 +250,13 @@ def assemble_modes(estimates: Sequence[ModeEstimate], *, method: str, source: st
         contradicted = np.asarray(driving, bool) & np.any(below_zero, axis=0)
         if contradicted.any():
             modes = [_contradicted(mode, contradicted, single) for mode in modes]
+        inverted = np.asarray(driving, bool) & np.all(below_zero, axis=0)
+        if inverted.any():
+            # every mode below zero is what a sign error gives, not a transfer FRF (whose constants change sign)
+            said = (" (here every mode's constant lies below zero: the force and the response point opposite ways, "
+                    "a sensor mounted the other way round, a negative sensitivity or point ids whose directions "
+                    "disagree; with one channel's sign turned, k, c, m follow)")
+            details = [{**(detail or {}), "driving_point_contradicted": said} for detail in details]
     for mode, detail in zip(modes, details):
         serious = serious_flags(mode.flags)
         if serious:

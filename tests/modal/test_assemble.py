@@ -161,6 +161,14 @@ def test_a_driving_point_whose_constants_change_sign_gives_no_k_c_m_for_any_mode
     texts = [str(w.message) for w in said]
     assert any("mode near 100 Hz is flagged (driving_point_contradicted: the channel taken as a driving point" in t
                for t in texts), texts
+    # a transfer FRF's constants change sign; a sign error turns them all: the warning says which it looks like
+    assert not any("every mode's constant lies below zero" in t for t in texts)
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        assemble([estimate(100.0, const=(-0.5,)), estimate(300.0, const=(-0.8,))])
+    texts = [str(w.message) for w in said]
+    assert len(texts) == 2 and all("every mode's constant lies below zero: the force and the response point "
+                                   "opposite ways" in t for t in texts), texts
 
 
 def test_a_driving_points_constant_within_three_errors_of_zero_contradicts_nothing():
