@@ -26,6 +26,7 @@ from modal.errors import ModalWarning, ParameterError
 from modal.io import write_frf
 from modal.synthetic import add_noise, modal_frf
 
+from support.cli import run_module
 from support.daskcluster import free_port, start_worker, wait_for_workers
 
 FREQ = np.linspace(20.0, 200.0, 301)  # 0.6 Hz lines; the modes are 2.4 and 5 Hz wide (>= 4 lines per bandwidth)
@@ -54,6 +55,12 @@ def write_files(folder: Path, n: int, start: int = 0) -> list[Path]:
 def run_cli(*args, cwd=None):
     return subprocess.run([sys.executable, "-m", "modal", "batch", *map(str, args)], capture_output=True, text=True,
                           cwd=cwd, timeout=300)
+
+
+def run_here(*args):
+    """``modal batch ARGS`` in this process (support.cli): the tests whose subject is not the process; those
+    that read Dask's log on stderr, or the process itself, use :func:`run_cli`."""
+    return run_module("modal", "batch", *args)
 
 
 def read_table(path: Path) -> list[dict[str, str]]:
@@ -262,7 +269,7 @@ def test_hundred_files_with_two_broken_then_rerun_reuses_everything(dask_cluster
     out = tmp_path / "res.h5"
     options = ("--out", out, "--table", tmp_path / "table.csv", "--scheduler", dask_cluster[0], "--json",
                "--method", "nls")
-    first = run_cli(folder, *options)
+    first = run_here(folder, *options)
     assert first.returncode == 1, first.stderr
     doc = json.loads(first.stdout)
     assert (doc["files"], doc["fitted"], doc["reused"]) == (102, 100, 0)
@@ -277,7 +284,7 @@ def test_hundred_files_with_two_broken_then_rerun_reuses_everything(dask_cluster
     assert len(archive["files"]) == 102 and archive["batch"].n_failed == 2
     assert sorted(archive["batch"].failed_files) == sorted([str(truncated), str(garbage)])
 
-    second = run_cli(folder, *options)
+    second = run_here(folder, *options)
     assert second.returncode == 1, second.stderr
     again = json.loads(second.stdout)
     # every unchanged file reused, nothing fitted (the two broken files are reported again from the archive)

@@ -22,7 +22,10 @@ from support.daskcluster import free_port
 DASHBOARD_PORT = 8787
 
 
-def write_inputs(folder: Path, n: int = 6) -> Path:
+def write_inputs(folder: Path, n: int = 1) -> Path:
+    """``n`` FRF files in ``folder``. One is enough for the tests here, whose subject is the cluster (its ports,
+    its dashboard, its close): a worker fits it in its fitting process and keeps that open until the cluster
+    closes, the other worker idles; each file more on the other worker would only start a second such process."""
     folder.mkdir()
     for k in range(n):
         write_frf(mobility(seed=k), folder / f"f{k}.uff")
@@ -174,6 +177,6 @@ def test_the_embedded_cluster_leaves_the_callers_environment_as_it_was(tmp_path)
     before = dict(os.environ)
     with open_client(workers=1) as client:
         assert client.submit(usable_cores, pure=False).result() == 1
-        result = fit_files(write_inputs(tmp_path / "in", n=1), client=client)
+        result = fit_files(write_inputs(tmp_path / "in"), client=client)
     assert result.fitted == 1
     assert dict(os.environ) == before

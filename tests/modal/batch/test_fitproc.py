@@ -3,8 +3,6 @@ time limit per file (``--file-timeout``): a pathological file is listed as faile
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
 import time
 from pathlib import Path
 
@@ -18,11 +16,13 @@ from modal.fitting import FitOptions
 from modal.io import write_frf
 
 from support.batchfiles import FRF_MODES_HZ, mobility, write_hanging_hdf5, write_many_modes
+from support.cli import run_module
 
 
 def run_cli(*args):
-    return subprocess.run([sys.executable, "-m", "modal", "batch", *map(str, args)], capture_output=True, text=True,
-                          timeout=300)
+    """``modal batch ARGS`` in this process (support.cli): the fits run in the cluster's fitting processes either
+    way; test_batch.py and test_cluster.py run the command as a subprocess."""
+    return run_module("modal", "batch", *args)
 
 
 def session_members(sid: int) -> list[int]:

@@ -9,8 +9,6 @@ import signal
 import socket
 import subprocess
 import sys
-import textwrap
-import time
 from pathlib import Path
 
 import pytest
@@ -50,48 +48,28 @@ def assert_archive_true(out: Path, truth: dict[str, tuple[float, float]]) -> Non
         assert found == pytest.approx(truth[fit.source], abs=0.05), fit.source
 
 
-_PAUSED_RUN = """
-import sys, time
-from pathlib import Path
-from modal.batch import iter_fit
-
-folder, out, client, running, go = sys.argv[1:6]
-for k, outcome in enumerate(iter_fit(folder, out=out, client=client)):
-    if k == 0:  # a file done, the rest in flight or to come: hold the run here
-        Path(running).write_text("running")
-        while not Path(go).exists():
-            time.sleep(0.02)
-"""
-
-
 def test_a_second_run_refuses_at_once_naming_the_first_which_finishes_unharmed(dask_cluster, tmp_path):
+    """The first run is this process's, held after its first file (the generator waits for its next ``next``:
+    the rest in flight or to come); the second is ``modal batch`` in a process of its own."""
     truth = write_files(tmp_path / "in", range(12))
-    out, running, go = tmp_path / "r.h5", tmp_path / "running", tmp_path / "go"
-    first = subprocess.Popen([sys.executable, "-c", textwrap.dedent(_PAUSED_RUN), str(tmp_path / "in"), str(out),
-                              dask_cluster[0], str(running), str(go)], stderr=subprocess.PIPE, text=True)
+    out = tmp_path / "r.h5"
+    first = iter_fit(tmp_path / "in", out=out, client=dask_cluster[0])
     try:
-        deadline = time.monotonic() + 120
-        while not running.exists():
-            assert first.poll() is None and time.monotonic() < deadline, first.stderr.read() if first.stderr else ""
-            time.sleep(0.05)
+        assert next(first).status == "fitted"
         second = subprocess.run([sys.executable, "-m", "modal", "batch", tmp_path / "in", "--out", out,
                                  "--workers", "1"], capture_output=True, text=True, timeout=120)
         # the first run is still held: the second finished without waiting for it
-        assert first.poll() is None
         assert second.returncode == 1
         holder = json.loads(lock_path(out).read_text())
-        assert holder["pid"] == first.pid and holder["host"] == socket.gethostname()
-        assert second.stderr == (f"error: {out}: another modal batch run is writing it (pid {first.pid} on "
+        assert holder["pid"] == os.getpid() and holder["host"] == socket.gethostname()
+        assert second.stderr == (f"error: {out}: another modal batch run is writing it (pid {os.getpid()} on "
                                  f"{socket.gethostname()}, started {holder['started']}: {holder['command']}); "
                                  f"wait for it to finish or choose another --out (lock {lock_path(out)})\n")
         assert not out.exists() and not (tmp_path / "r.csv").exists()  # nothing written by the second
-        go.write_text("go")
-        assert first.wait(timeout=120) == 0, first.stderr.read()
+        rest = list(first)  # the first run goes on to its end
     finally:
-        if first.poll() is None:
-            first.kill()
-            first.wait()
-        first.stderr.close()
+        first.close()
+    assert len(rest) == 11 and all(o.status == "fitted" for o in rest)
     assert_archive_true(out, truth)
     assert not lock_path(out).exists() and not (tmp_path / "r.h5.parts").exists()
 
@@ -137,7 +115,7 @@ def test_an_archive_replaced_by_one_without_the_results_is_an_error_and_keeps_no
     assert out.read_bytes() == replaced and not lock_path(out).exists()
 
 
-def test_a_lock_left_by_a_killed_run_is_taken_over(tmp_path):
+def test_a_lock_left_by_a_killed_run_is_taken_over(dask_cluster, tmp_path):
     out = tmp_path / "r.h5"
     script = f"""
 import os, signal
@@ -152,7 +130,7 @@ os.kill(os.getpid(), signal.SIGKILL)
     write_files(tmp_path / "in", range(2))
     with pytest.warns(ModalWarning, match=rf"taking over from a run that ended without releasing its lock "
                                           rf"\(pid {left['pid']} on"):
-        result = fit_files(tmp_path / "in", out=out, workers=1)
+        result = fit_files(tmp_path / "in", out=out, client=dask_cluster[0])
     assert result.fitted == 2 and not lock_path(out).exists()
 
 
