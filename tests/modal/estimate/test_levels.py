@@ -77,15 +77,22 @@ def test_the_test_says_nothing_where_it_cannot():
     assert level_dependence(same.signals[0], same.signals[1:], starts, 2048, window, window, FS) is None
 
 
-def test_takes_that_do_not_measure_one_frf_are_warned_of():
-    # two takes of three hits each, the second with the hammer at another point of the structure: averaged as
-    # takes of one test they mixed two FRFs, and nothing said so
+def _two_points():
+    """Three hits at one point, then three with the hammer at another (the structure's other shape there):
+    each part's record, and the two joined (force, responses)."""
     first = impact_record(DigitalModes([40.0, 95.0], [0.01, 0.02], [[1.0, 0.5]], FS), [0.5, 4.5, 8.5], 12.0,
                           seed=1, response_noise=1e-3, force_noise=1e-3).record
     other = impact_record(DigitalModes([40.0, 95.0], [0.01, 0.02], [[0.6, -0.8]], FS), [0.5, 4.5, 8.5], 12.0,
                           seed=2, response_noise=1e-3, force_noise=1e-3).record
     force = np.concatenate([first.signals[0], other.signals[0]])
     response = np.concatenate([first.signals[1:], other.signals[1:]], axis=1)
+    return first, other, force, response
+
+
+def test_takes_that_do_not_measure_one_frf_are_warned_of():
+    # two takes of three hits each, the second with the hammer at another point of the structure: averaged as
+    # takes of one test they mixed two FRFs, and nothing said so
+    first, other, force, response = _two_points()
     with pytest.warns(modal.QualityWarning, match=r"the takes' FRFs differ beyond their noise \(a.csv, b.csv"):
         modal.estimate_frf(force, response, FS, impact=True, window="force", kind="accelerance",
                            take_lengths=[first.n_samples, other.n_samples], take_names=["a.csv", "b.csv"])
@@ -103,12 +110,7 @@ def test_a_record_whose_hammer_moved_part_way_through_is_warned_of():
     # one file, the hammer moved to the next point after hit 3: the six hits' average is of two FRFs, as smooth
     # as either; nls then gave the 40 Hz mode's constant 0.80 ± 0.09 (the points' 1.0 and 0.6 averaged), a
     # stiffness 25 % off the first point's, lost the 95 Hz mode (0.5 and -0.8 averaged), and nothing said so
-    first = impact_record(DigitalModes([40.0, 95.0], [0.01, 0.02], [[1.0, 0.5]], FS), [0.5, 4.5, 8.5], 12.0,
-                          seed=1, response_noise=1e-3, force_noise=1e-3).record
-    other = impact_record(DigitalModes([40.0, 95.0], [0.01, 0.02], [[0.6, -0.8]], FS), [0.5, 4.5, 8.5], 12.0,
-                          seed=2, response_noise=1e-3, force_noise=1e-3).record
-    force = np.concatenate([first.signals[0], other.signals[0]])
-    response = np.concatenate([first.signals[1:], other.signals[1:]], axis=1)
+    _, _, force, response = _two_points()
     with pytest.warns(modal.QualityWarning, match=r"the hits' FRF changes between hit 3 and hit 4 \(at 12\.50\d s\)"):
         modal.estimate_frf(force, response, FS, impact=True, window="force", kind="accelerance")
     # the test needs four hits (two parameters per line and noise left over): with three it says nothing
