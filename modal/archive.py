@@ -250,13 +250,14 @@ def _name_units(name: str) -> tuple[str, ...]:
     return tuple(unit for suffix, unit in _UNIT_SUFFIXES if lower.endswith(suffix))
 
 
-def _check_units(group, obj) -> None:
+def _check_units(group, obj, children=None) -> None:
     """Refuse a dataclass's number stored without the unit :func:`write_node` gives it (the class's
     ``archive_units()``, else the unit its name's suffix says, as ``kg`` for ``mass_kg``): an archive of another
     tool under the same names, or one edited by hand, would be read in the wrong unit. A field named with a unit
-    suffix must carry it; one whose unit the class gives may carry none (archives of earlier versions)."""
+    suffix must carry it; one whose unit the class gives may carry none (archives of earlier versions).
+    ``children``: the group's members by name, as the reader already opened them."""
     explicit = obj.archive_units() if callable(getattr(obj, "archive_units", None)) else {}
-    for name, node in group.items():
+    for name, node in (group.items() if children is None else children.items()):
         if not isinstance(node, h5py.Dataset) or _str_type(node) not in _NUMBER_TYPES:
             continue
         unit = node.attrs.get("units")
@@ -305,7 +306,8 @@ def read_node(node) -> Any:
         return read_frf_group(node, source=node.file.filename)
     if kind == "dataclass":
         cls = _class_from(str(node.attrs["__class__"]))
-        values = {name: read_node(node[name]) for name in node.keys()}
+        children = {name: node[name] for name in node.keys()}
+        values = {name: read_node(child) for name, child in children.items()}
         init = {f.name: values[f.name] for f in dataclasses.fields(cls) if f.init and f.name in values}
         missing = [f.name for f in dataclasses.fields(cls) if f.init and f.name not in values
                    and f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING]
@@ -320,7 +322,7 @@ def read_node(node) -> Any:
         for f in dataclasses.fields(cls):
             if not f.init and f.name in values:
                 object.__setattr__(obj, f.name, values[f.name])
-        _check_units(node, obj)
+        _check_units(node, obj, children)
         return obj
     if kind == "none":
         return None
