@@ -250,15 +250,16 @@ def _name_units(name: str) -> tuple[str, ...]:
     return tuple(unit for suffix, unit in _UNIT_SUFFIXES if lower.endswith(suffix))
 
 
-def _check_units(group, obj, children=None) -> None:
+def _check_units(group, obj, children=None, kinds=None) -> None:
     """Refuse a dataclass's number stored without the unit :func:`write_node` gives it (the class's
     ``archive_units()``, else the unit its name's suffix says, as ``kg`` for ``mass_kg``): an archive of another
     tool under the same names, or one edited by hand, would be read in the wrong unit. A field named with a unit
     suffix must carry it; one whose unit the class gives may carry none (archives of earlier versions).
-    ``children``: the group's members by name, as the reader already opened them."""
+    ``children``, ``kinds``: the group's members by name, as the reader already opened them, and their types."""
     explicit = obj.archive_units() if callable(getattr(obj, "archive_units", None)) else {}
     for name, node in (group.items() if children is None else children.items()):
-        if not isinstance(node, h5py.Dataset) or _str_type(node) not in _NUMBER_TYPES:
+        kind = _str_type(node) if kinds is None else kinds[name]
+        if not isinstance(node, h5py.Dataset) or kind not in _NUMBER_TYPES:
             continue
         unit = node.attrs.get("units")
         unit = unit.decode() if isinstance(unit, bytes) else unit
@@ -292,8 +293,9 @@ def _check_number(node, kind: str) -> None:
                            "number (an archive of another tool, or edited?)")
 
 
-def read_node(node) -> Any:
-    """Rebuild the Python object stored at an HDF5 node by :func:`write_node`.
+def read_node(node, kind: str | None = None) -> Any:
+    """Rebuild the Python object stored at an HDF5 node by :func:`write_node` (``kind``: its ``__type__``, when
+    the caller has read it).
 
     Raises
     ------
@@ -301,13 +303,14 @@ def read_node(node) -> Any:
         A result's number stored with another unit than the one the toolkit writes, or with none
         (:func:`_check_units`).
     """
-    kind = _str_type(node)
+    kind = _str_type(node) if kind is None else kind
     if kind == "frf":
         return read_frf_group(node, source=node.file.filename)
     if kind == "dataclass":
         cls = _class_from(str(node.attrs["__class__"]))
         children = {name: node[name] for name in node.keys()}
-        values = {name: read_node(child) for name, child in children.items()}
+        kinds = {name: _str_type(child) for name, child in children.items()}
+        values = {name: read_node(child, kinds[name]) for name, child in children.items()}
         init = {f.name: values[f.name] for f in dataclasses.fields(cls) if f.init and f.name in values}
         missing = [f.name for f in dataclasses.fields(cls) if f.init and f.name not in values
                    and f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING]
@@ -322,7 +325,7 @@ def read_node(node) -> Any:
         for f in dataclasses.fields(cls):
             if not f.init and f.name in values:
                 object.__setattr__(obj, f.name, values[f.name])
-        _check_units(node, obj, children)
+        _check_units(node, obj, children, kinds)
         return obj
     if kind == "none":
         return None
