@@ -118,17 +118,22 @@ def test_a_record_whose_hammer_moved_part_way_through_is_warned_of():
                              FS) is None
 
 
+def _sensor_changed(n_hits: int, second_mode: float, seed: int):
+    """``n_hits`` hits 4 s apart whose sensor's second constant falls from 0.5 to ``second_mode`` from hit
+    n/2 + 1 on: the force, the response and each hit's first sample (8 before its trigger)."""
+    hits = [0.5 + 4 * k for k in range(n_hits)]
+    duration = 4.0 * n_hits + 1.0
+    before, after = (impact_record(DigitalModes([40.0, 95.0], [0.01, 0.02], [[1.0, second]], FS), hits, duration,
+                                   seed=seed, response_noise=1e-3, force_noise=1e-3).record
+                     for second in (0.5, second_mode))
+    cut = int((4.0 * (n_hits // 2) + 0.3) * FS)  # between hit n/2 and the next
+    response = np.concatenate([before.signals[1:, :cut], after.signals[1:, cut:]], axis=1)
+    return before.signals[0], response, np.array([int(t * FS) - 8 for t in hits])
+
+
 def test_a_change_within_one_record_is_placed_and_sized():
     # the sensor's second mode halves from hit 5 of 8 on (a magnet base sliding towards a node)
-    hits = [0.5 + 4 * k for k in range(8)]
-    before = impact_record(DigitalModes([40.0, 95.0], [0.01, 0.02], [[1.0, 0.5]], FS), hits, 33.0, seed=5,
-                           response_noise=1e-3, force_noise=1e-3).record
-    after = impact_record(DigitalModes([40.0, 95.0], [0.01, 0.02], [[1.0, 0.25]], FS), hits, 33.0, seed=5,
-                          response_noise=1e-3, force_noise=1e-3).record
-    cut = int(16.3 * FS)
-    force = before.signals[0]
-    response = np.concatenate([before.signals[1:, :cut], after.signals[1:, cut:]], axis=1)
-    starts = np.array([int(t * FS) - 8 for t in hits])
+    force, response, starts = _sensor_changed(8, 0.25, seed=5)
     test = change_dependence(force, response, starts, 2048, np.ones(2048), np.ones(2048), FS)
     assert test.changed and test.first_after == 4
     # found where the second mode's change tells most: each group's FRF a third of that mode's part off the
@@ -145,17 +150,10 @@ def test_the_resonant_lines_find_a_change_every_lines_family_misses(monkeypatch)
     # resonant family at half the level finds it (against 4.4e-7)
     import modal.estimate.levels as levels
 
-    hits = [0.5 + 4 * k for k in range(4)]
-    before = impact_record(DigitalModes([40.0, 95.0], [0.01, 0.02], [[1.0, 0.5]], FS), hits, 17.0, seed=4,
-                           response_noise=1e-3, force_noise=1e-3).record
-    after = impact_record(DigitalModes([40.0, 95.0], [0.01, 0.02], [[1.0, 0.2]], FS), hits, 17.0, seed=4,
-                          response_noise=1e-3, force_noise=1e-3).record
-    cut = int(8.3 * FS)
-    response = np.concatenate([before.signals[1:, :cut], after.signals[1:, cut:]], axis=1)
-    starts = np.array([int(t * FS) - 8 for t in hits])
+    force, response, starts = _sensor_changed(4, 0.2, seed=4)
     window = np.ones(2048)
-    test = change_dependence(before.signals[0], response, starts, 2048, window, window, FS)
+    test = change_dependence(force, response, starts, 2048, window, window, FS)
     assert test.changed and test.resonant and test.first_after == 2
     monkeypatch.setattr(levels, "RESONANT_POWER_RATIO", np.inf)  # no resonant line: every line's family alone ...
     monkeypatch.setattr(levels, "FAMILY_LEVEL", 2 * FAMILY_LEVEL)  # ... at the whole level
-    assert not change_dependence(before.signals[0], response, starts, 2048, window, window, FS).changed
+    assert not change_dependence(force, response, starts, 2048, window, window, FS).changed
