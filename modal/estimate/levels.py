@@ -323,7 +323,10 @@ def change_dependence(force, response, starts, length: int, input_window, output
     p_before = np.cumsum(Pb, axis=0)[:-1]
     p_total = p_before[-1] + Pb[-1]
     p_after = p_total - p_before
-    found, resonant_lines = [], 0
+    # every test has the same degrees of freedom, so the smallest p of a family is that of its largest F: each
+    # family's largest F (and where) is kept per response, and p computed for it alone
+    largest = [None, None]  # per family: (F, output, place, line index, change)
+    resonant_lines = 0
     for o in range(n_out):
         Y = np.fft.rfft(_records(response[o], starts, length) * output_window, axis=1)[:, lines]
         cross = np.conj(Xb) * Y
@@ -340,19 +343,20 @@ def change_dependence(force, response, starts, length: int, input_window, output
                       / np.abs(common))
         resonant = s_yy >= RESONANT_POWER_RATIO * np.median(s_yy)
         resonant_lines += int(resonant.sum())
-        ok = np.isfinite(F) & (rss2 > 0) & (change >= MATERIAL_CHANGE)
-        p = np.full(F.shape, np.inf)
-        p[ok] = f_survival(2.0, 2.0 * (n - 2), np.maximum(F[ok], 0.0))
-        found.append((p, np.where(resonant[None, :], p, np.inf), change))
+        F = np.where(np.isfinite(F) & (rss2 > 0) & (change >= MATERIAL_CHANGE), np.maximum(F, 0.0), -np.inf)
+        for family, tested in enumerate((F, np.where(resonant[None, :], F, -np.inf))):
+            place, k = np.unravel_index(int(np.argmax(tested)), tested.shape)
+            if np.isfinite(tested[place, k]) and (largest[family] is None or tested[place, k] > largest[family][0]):
+                largest[family] = (float(tested[place, k]), o, int(place), int(k), float(change[place, k]))
     best = None
     for family, n_tests in ((0, lines.size * n_out), (1, resonant_lines)):
+        if largest[family] is None:
+            continue
+        F_max, o, place, k, size = largest[family]
+        p = float(f_survival(2.0, 2.0 * (n - 2), np.array([F_max]))[0])
         limit = FAMILY_LEVEL / 2 / (max(n_tests, 1) * (n - 1))
-        for o, item in enumerate(found):
-            p = item[family]
-            place, k = np.unravel_index(int(np.argmin(p)), p.shape)
-            if np.isfinite(p[place, k]) and (best is None or p[place, k] / limit < best[0] / best[1]):
-                best = (float(p[place, k]), limit, float(lines[k] * sample_rate_hz / length), o, int(place) + 1,
-                        float(item[2][place, k]), n_tests, bool(family))
+        if best is None or p / limit < best[0] / best[1]:
+            best = (p, limit, float(lines[k] * sample_rate_hz / length), o, place + 1, size, n_tests, bool(family))
     if best is None:
         return None
     return ChangeTest(p_value=best[0], limit=best[1], frequency_hz=best[2], output=best[3], first_after=best[4],
