@@ -231,7 +231,7 @@ def test_the_two_coefficient_nonnegative_fit_is_scipys_nnls():
     # convex with two independent columns, so its minimiser is unique: equal to the solvers' rounding)
     from scipy.optimize import nnls
 
-    from modal.noise_model import _nonnegative_fit
+    from modal.noise_model import _nonnegative_fit, _nonnegative_fit_of_sums
 
     rng = np.random.default_rng(7)
     held = set()
@@ -244,8 +244,32 @@ def test_the_two_coefficient_nonnegative_fit_is_scipys_nnls():
         fitted = np.array(_nonnegative_fit(design, target))
         assert np.all(fitted >= 0)
         np.testing.assert_allclose(fitted, expected, rtol=1e-9, atol=1e-12 * np.abs(target).max())
+        # input_noise_split's rounds solve it from the sums alone (normal equations of the unit-scaled columns,
+        # rounding ~1e-16 / (1 - rho^2) relative, used while 1 - rho^2 >= 1e-6)
+        sums = np.array([design[:, 0] @ design[:, 0], design[:, 0] @ design[:, 1], design[:, 1] @ design[:, 1],
+                         design[:, 0] @ target, design[:, 1] @ target, target @ target])
+        from_sums = _nonnegative_fit_of_sums(sums)
+        if from_sums is not None:
+            np.testing.assert_allclose(from_sums, expected, rtol=1e-9, atol=1e-12 * np.abs(target).max())
         held.add(tuple(expected == 0))
     assert held == {(False, False), (True, False), (False, True), (True, True)}  # every active set was met
+
+
+def test_input_noise_split_is_the_same_in_any_unit():
+    # a receptance in m/N makes |H|² ~1e-12 and residual powers ~1e-20 or less: the fit (squared weights, sums
+    # of their products) must neither overflow nor lose the small column, so scaling the residual by s and |H|²
+    # by u scales a by s and b by s/u, to rounding; the response-noise-only case (b = 0) included
+    from modal.noise_model import input_noise_split
+
+    rng = np.random.default_rng(11)
+    h = rng.exponential(1.0, 4000) ** 4
+    for a, b in ((1.0, 0.3), (0.0, 2.0), (1.0, 0.0)):
+        residual = (a + b * h) * rng.chisquare(8, h.size) / 8
+        reference = np.array(input_noise_split(residual, h))
+        assert reference[0] >= 0 and reference[1] >= 0 and (b == 0) == (reference[1] < 0.05 * max(b, 1.0))
+        for s, u in ((1e-30, 1e-24), (1e20, 1e-24), (1e-30, 1e10), (1e60, 1e-60)):
+            scaled = np.array(input_noise_split(residual * s, h * u))
+            np.testing.assert_allclose(scaled, reference * [s, s / u], rtol=1e-9, atol=1e-12 * s * reference.max())
 
 
 def test_large_arrays_are_copied_once_then_shared_by_derived_models():

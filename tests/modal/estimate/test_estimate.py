@@ -357,6 +357,44 @@ def test_an_impact_record_with_force_and_response_swapped_is_refused_naming_both
     assert est.averages == 3  # the right way round: the three hits
 
 
+def test_a_hammer_record_swapped_and_estimated_as_continuous_is_warned_naming_the_pulsed_response():
+    # without impact=True the impact path's refusal never ran: the ringing accelerometer became the excitation
+    # and H1 the inverse of the structure's FRF, with no word (a fit then printed three flagged "modes")
+    from modal.synthetic import impact_record
+
+    plant = DigitalModes([40.0, 95.0], [0.01, 0.02], [[1.0, 0.5]], FS)
+    record = impact_record(plant, [0.5, 4.5, 8.5], 12.0, seed=2, response_noise=1e-3, force_noise=1e-3).record
+    force, response = record.signals[0], record.signals[1]
+    with pytest.warns(QualityWarning, match=r"response 1 is \d+ short pulse\(s\) .* while the excitation is none: "
+                                            r"the force and response channels look swapped"):
+        modal.estimate_frf(response, force, FS, kind="accelerance", segment_length=1024)
+    with warnings.catch_warnings(record=True) as caught:  # the right way round: only the hint to use impact=True
+        warnings.simplefilter("always")
+        modal.estimate_frf(force, response, FS, kind="accelerance", segment_length=1024)
+    assert not [w for w in caught if "look swapped" in str(w.message)]
+    assert [w for w in caught if "estimate it as an impact record" in str(w.message)]
+
+
+def test_a_shaker_record_with_a_lightly_damped_response_is_no_pulse_train():
+    # a random force has no sample above 8 robust standard deviations, so the responses are not screened; a
+    # swept sine's response swells at each resonance, which must not read as hits either way
+    from modal.estimate.hits import pulse_train
+
+    rng = np.random.default_rng(3)
+    plant = DigitalModes([40.0, 95.0], [0.002, 0.005], [[1.0, 0.5], [0.4, -0.9]], FS)
+    t = np.arange(int(40 * FS)) / FS
+    sweep = np.sin(2 * np.pi * (5.0 * t + 0.5 * (195.0 / 40.0) * t**2))  # 5 → 200 Hz in 40 s
+    for force in (rng.standard_normal(t.size), sweep):
+        response = plant.respond(force, "acceleration")
+        response += 1e-3 * response.std() * rng.standard_normal(response.shape)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            modal.estimate_frf(force, response, FS, kind="accelerance", segment_length=4096)
+        assert not [w for w in caught if "pulse" in str(w.message)], [str(w.message) for w in caught]
+        # and were they screened (an excitation with a few excursions), they would pass
+        assert not any(pulse_train(channel, FS).impulsive for channel in response)
+
+
 @pytest.mark.parametrize("records, warned", [(1, "one record"), (2, "2 records"), (3, None)])
 def test_a_continuous_record_of_fewer_than_three_records_is_warned(records, warned):
     # with one or two records each line's noise rests on 0 or 1 degree of freedom: fits of 2-record estimates
@@ -393,3 +431,30 @@ def test_two_shakers_driven_by_nearly_one_signal_are_warned(correlation, warned)
         assert len(said) == 1 and said[0].startswith("mimo.csv: force 1+Z and force 2+Z are 99.8 % coherent")
     else:
         assert said == []
+
+
+def test_runs_with_one_blas_thread_and_gives_the_callers_setting_back(monkeypatch, plant):
+    """The estimate's products are small or one vector long (the noise split's sums over the lines): a BLAS
+    thread per core only waits for its threads (modal/blas.py), so the call runs with one, whatever the
+    caller set, and the caller's setting holds again after."""
+    from threadpoolctl import threadpool_info, threadpool_limits
+
+    import modal.noise_model
+
+    seen = []
+    real = modal.noise_model._nonnegative_fit_of_sums
+
+    def spy(sums):  # each round of the noise split, from its BLAS dot products
+        seen.append({lib["num_threads"] for lib in threadpool_info() if lib["user_api"] == "blas"})
+        return real(sums)
+
+    monkeypatch.setattr(modal.noise_model, "_nonnegative_fit_of_sums", spy)
+    rng = np.random.default_rng(5)
+    force = rng.standard_normal(16384)
+    response = plant.respond(force)
+    response += 0.01 * response.std() * rng.standard_normal(response.shape)
+    with threadpool_limits(2, user_api="blas"):
+        modal.estimate_frf(force, response, FS, segment_length=1024)
+        after = {lib["num_threads"] for lib in threadpool_info() if lib["user_api"] == "blas"}
+    assert seen and all(threads == {1} for threads in seen)
+    assert after == {2}
