@@ -19,6 +19,10 @@ __all__ = ["join_takes"]
 #: sample rates of two takes that differ by less than this fraction are one rate (a file's time step
 #: is often kept to 6–9 digits)
 RATE_TOLERANCE = 1e-6
+#: two takes whose samples agree to this fraction of each channel's peak are one take saved twice (a
+#: re-export at another precision: 6 significant digits round by 5e-7 of the value); two hits never agree
+#: so, their noise alone differing by far more, and their hits falling at other samples
+SAME_SAMPLES_TOLERANCE = 1e-6
 
 
 def join_takes(records: Sequence[TimeRecord]) -> TimeRecord:
@@ -56,6 +60,7 @@ def join_takes(records: Sequence[TimeRecord]) -> TimeRecord:
         if record.full_scale != first.full_scale:
             raise FormatError(f"{src}: full scale {record.full_scale!r} where {first.source} has "
                               f"{first.full_scale!r}; expected one recorder setting in every take")
+    _refuse_same_samples(records)
     sources = tuple(record.source for record in records)
     return TimeRecord(
         signals=np.concatenate([record.signals for record in records], axis=1),
@@ -63,3 +68,23 @@ def join_takes(records: Sequence[TimeRecord]) -> TimeRecord:
         source=f"{sources[0]} (+{len(sources) - 1} file{'s' if len(sources) > 2 else ''})",
         full_scale=first.full_scale, take_lengths=tuple(record.n_samples for record in records),
         take_sources=sources)
+
+
+def _refuse_same_samples(records: Sequence[TimeRecord]) -> None:
+    """Refuse two takes holding the same samples (:data:`SAME_SAMPLES_TOLERANCE`) in different bytes: one take
+    exported twice (as CSV and again at another precision, or in two formats) would be averaged with itself,
+    its noise looking smaller than it is. Byte-identical copies are refused before reading
+    (:func:`modal.io._common.refuse_copies`)."""
+    for j, later in enumerate(records):
+        for earlier in records[:j]:
+            if later.signals.shape != earlier.signals.shape:
+                continue
+            a, b = np.asarray(earlier.signals, float), np.asarray(later.signals, float)
+            peak = np.maximum(np.abs(a).max(axis=1), np.abs(b).max(axis=1))
+            head = slice(0, min(64, a.shape[1]))  # most pairs differ at once
+            if np.any(np.abs(a[:, head] - b[:, head]).max(axis=1) > SAME_SAMPLES_TOLERANCE * peak):
+                continue
+            if np.all(np.abs(a - b).max(axis=1) <= SAME_SAMPLES_TOLERANCE * peak):
+                raise FormatError(f"{later.source}: holds the same samples as {earlier.source} (to "
+                                  f"{SAME_SAMPLES_TOLERANCE:g} of each channel's peak); expected each take once (one "
+                                  "take saved twice is averaged with itself: its noise looks smaller than it is)")

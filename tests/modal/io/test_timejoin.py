@@ -14,7 +14,9 @@ PLANT = DigitalModes([40.0, 95.0], [0.03, 0.02], [[1.0, 0.5], [0.6, -0.8]], 1024
 
 
 def _take(seed, source):
-    return replace(impact_record(PLANT, [0.5], 2.0, seed=seed, names=["hammer", "a1", "a2"]).record, source=source)
+    # noise as every measured take has (noiseless takes of one hit time would be the same samples)
+    return replace(impact_record(PLANT, [0.5], 2.0, seed=seed, names=["hammer", "a1", "a2"], force_noise=1e-3,
+                                 response_noise=1e-3).record, source=source)
 
 
 def test_takes_are_joined_end_to_end_and_say_where_each_ends():
@@ -57,3 +59,17 @@ def test_files_measured_at_different_points_are_pointed_to_the_frf_route():
     with pytest.raises(FormatError) as info:
         join_takes([_take(1, "a.csv"), other_unit])
     assert "roving" not in str(info.value)  # other units: not the same test moved, another record
+
+
+def test_one_take_saved_twice_at_another_precision_is_refused():
+    # a copy is refused by its bytes before reading; the same take exported again with 7 significant digits
+    # (a CSV and a re-export, or two formats) has other bytes and would be averaged with itself
+    first = _take(1, "a.csv")
+    again = replace(first, signals=np.array([[float(f"{v:.7g}") for v in channel] for channel in first.signals]),
+                    source="a_again.csv")
+    with pytest.raises(FormatError) as info:
+        join_takes([first, _take(2, "b.csv"), again])
+    message = str(info.value)
+    assert message.startswith("a_again.csv: holds the same samples as a.csv") and "\n" not in message
+    # two takes of one hit time and plant differ by their noise alone, and are two takes
+    assert join_takes([first, _take(2, "b.csv")]).take_lengths == (first.n_samples,) * 2
