@@ -1,8 +1,9 @@
 """Plots drawn by forked plotting processes while the scene runs on (balancer.scene.plotter).
 
-Each forking case runs in a fresh interpreter: the test process may have threads alive (Dask
-clients of other tests), and run_scene then rightly declines to fork. The serial drawing they are
-compared with is one run of the demo scene in the test process (serial_demo).
+Each forking case runs in a fresh interpreter's process (a child of one forked per case, the fixture
+``fresh``): the test process may have threads alive (Dask clients of other tests), and run_scene then
+rightly declines to fork. The serial drawing they are compared with is one run of the demo scene in the
+test process (serial_demo).
 """
 from __future__ import annotations
 
@@ -33,10 +34,20 @@ demo = {str(DEMO)!r}
 """
 
 
-def _run(tmp_path: Path, body: str) -> dict:
-    script = PRELUDE + body + "\nprint(json.dumps(out))\n"
-    proc = subprocess.run([sys.executable, "-c", script], cwd=tmp_path, capture_output=True, text=True, timeout=300,
-                          env={**os.environ, "MPLBACKEND": "Agg"})
+@pytest.fixture(scope="module")
+def fresh():
+    """A fresh interpreter that has run :data:`PRELUDE` and forks a copy of itself for each case
+    (support.forkserver): each case's process is the one ``python -c PRELUDE + case`` would be, without
+    paying the interpreter's start and the prelude's imports again."""
+    from support.forkserver import ForkServer
+
+    server = ForkServer(PRELUDE, env={**os.environ, "MPLBACKEND": "Agg"})
+    yield server
+    server.close()
+
+
+def _run(fresh, tmp_path: Path, body: str) -> dict:
+    proc = fresh.run(body + "\nprint(json.dumps(out))\n", cwd=tmp_path, timeout=300)
     assert proc.returncode == 0, proc.stderr[-2000:]
     return json.loads(proc.stdout.strip().splitlines()[-1])
 
@@ -63,11 +74,11 @@ def serial_demo(tmp_path_factory):
     return run, folder / "a", len(forks)
 
 
-def test_plots_from_child_processes_are_the_same_files_and_the_parent_never_draws(tmp_path, serial_demo):
+def test_plots_from_child_processes_are_the_same_files_and_the_parent_never_draws(fresh, tmp_path, serial_demo):
     # the forked run in a fresh interpreter: the parent computes while its plotting process imports
     # matplotlib's figure machinery (about 0.6 s), so the parent itself must not import it, or the two costs
     # add up instead of overlapping; the serial run (serial_demo) draws in its own process
-    out = _run(tmp_path, """
+    out = _run(fresh, tmp_path, """
 forked = run_scene(demo, out="b.h5", plots_dir="b", plot_jobs=2)
 out = {"forked": list(forked.plot_paths), "forks": forks[0], "parent_drew": "matplotlib.figure" in sys.modules}
 """)
@@ -81,10 +92,10 @@ out = {"forked": list(forked.plot_paths), "forks": forks[0], "parent_drew": "mat
     assert not list((tmp_path / "b").glob("*.tmp"))
 
 
-def test_a_failing_plot_in_a_child_is_reported(tmp_path):
+def test_a_failing_plot_in_a_child_is_reported(fresh, tmp_path):
     # the identify plot is the one handed to a child as soon as its stage is done (no child
     # is running yet then), so the failure happens in the child and must reach the caller
-    out = _run(tmp_path, """
+    out = _run(fresh, tmp_path, """
 from balancer.scene import plots
 def broken(results):
     raise ValueError("no figure today")
@@ -99,10 +110,10 @@ except RuntimeError as exc:
     assert "identify" in out["error"] and "ValueError: no figure today" in out["error"]
 
 
-def test_a_failing_stage_leaves_no_plots_drawn_early(tmp_path):
+def test_a_failing_stage_leaves_no_plots_drawn_early(fresh, tmp_path):
     # the identify plot is drawn by a child while the later stages run; when one of them
     # fails, the run writes nothing: no archive and no plot (as without plot_jobs)
-    out = _run(tmp_path, """
+    out = _run(fresh, tmp_path, """
 from balancer.scene import stages
 def broken(scene, **kwargs):
     raise SceneError("mounts: broken on purpose")
@@ -238,7 +249,7 @@ def test_the_command_line_draws_the_same_files_from_its_early_plotting_process(t
         assert (serial_folder / name).read_bytes() == (tmp_path / "b" / name).read_bytes(), name
 
 
-def test_an_early_plotting_process_reports_a_failed_figure_and_is_dismissed_when_unused(tmp_path):
+def test_an_early_plotting_process_reports_a_failed_figure_and_is_dismissed_when_unused(fresh, tmp_path):
     # taken over by a run: a figure that fails there reaches the caller with its stage; not taken over (no
     # plots, or the run failed first): dismiss_early ends it and no child process is left behind
     script = f"""
@@ -264,8 +275,7 @@ except ChildProcessError:
     out["children"] = "none"
 print(json.dumps(out))
 """
-    proc = subprocess.run([sys.executable, "-c", script], cwd=tmp_path, capture_output=True, text=True, timeout=300,
-                          env={**os.environ, "MPLBACKEND": "Agg"})
+    proc = fresh.run(script, cwd=tmp_path, timeout=300)
     assert proc.returncode == 0, proc.stderr[-2000:]
     out = json.loads(proc.stdout.strip().splitlines()[-1])
     assert out["started"] and out["taken"] and out["second"]
