@@ -8,16 +8,12 @@ import pytest
 
 from support.forkserver import ForkServer
 
-#: a preload that changes state the scripts then see, and wraps os.fork as test_plotter's prelude does
+#: a preload that makes state the scripts then see, and counts the forks made through os.fork (as
+#: tests/balancer/scene/test_plotter.py's prelude does): the server's own forks must not count
 PRELUDE = """
 import os, sys
-seen = []
-forks = [0]
-_fork = os.fork
-def counting_fork():
-    forks[0] += 1
-    return _fork()
-os.fork = counting_fork
+seen, forks = [], [0]
+os.fork = lambda fork=os.fork: forks.__setitem__(0, forks[0] + 1) or fork()
 print("the preload's own output")
 """
 
