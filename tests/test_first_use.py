@@ -113,8 +113,10 @@ def test_method_all_draws_every_method():
 
 @pytest.fixture(scope="module")
 def archives(tmp_path_factory, dask_cluster):
-    """Run every command that writes an archive, once, as a user would (subprocesses); the batch on the
-    session's Dask cluster (tests/modal/batch/test_cluster.py and test_formats.py run the embedded one)."""
+    """Run every command that writes an archive, once; the batch on the session's Dask cluster
+    (tests/modal/batch/test_cluster.py and test_formats.py run the embedded one). A process of its own, as a
+    user runs it, for one command of each kind: the fit with its plot, the batch (whose stderr holds what
+    Dask logs) and the scene with its plotting process; the others call the same ``main`` here."""
     out = tmp_path_factory.mktemp("archives")
     beam = [*REAL, "--frequency-step", "1", "--kind", "accelerance"]
     # a hammer record (the shipped real time file has no force channel: it cannot give an FRF)
@@ -125,21 +127,22 @@ def archives(tmp_path_factory, dask_cluster):
     uff = out / "hammer.uff"
     write_time(impact_record(plant, [0.5, 2.5, 4.5], 6.0, force_noise=0.002, response_noise=0.002,
                              names=["1+Z", "1+Z", "2+Z"]).record, uff)
+    # name: (in a process of its own, program, *arguments)
     commands = {
-        "fit_all.h5": ("modal", "fit", *beam, "--method", "all", "--plot", out / "beam.png",
+        "fit_all.h5": (True, "modal", "fit", *beam, "--method", "all", "--plot", out / "beam.png",
                        "--archive", out / "fit_all.h5"),
-        "fit_global.h5": ("modal", "fit", *beam, "--method", "global", "--archive", out / "fit_global.h5"),
+        "fit_global.h5": (False, "modal", "fit", *beam, "--method", "global", "--archive", out / "fit_global.h5"),
         # one group per file, copied from per-file parts (issue 18)
-        "batch.h5": ("modal", "batch", *beam, "--method", "all", "--scheduler", dask_cluster[0],
+        "batch.h5": (True, "modal", "batch", *beam, "--method", "all", "--scheduler", dask_cluster[0],
                      "--out", out / "batch.h5"),
-        "estimate.h5": ("modal", "frf", uff, "--impact", "--out", out / "estimate.h5"),
-        "demo.h5": ("balancer", "run", ROOT / "data" / "synthetic" / "demo_scene.toml", "--out", out / "demo.h5",
+        "estimate.h5": (False, "modal", "frf", uff, "--impact", "--out", out / "estimate.h5"),
+        "demo.h5": (True, "balancer", "run", ROOT / "data" / "synthetic" / "demo_scene.toml", "--out", out / "demo.h5",
                     "--plots", out / "demo_plots"),
-        "balance.h5": ("balancer", "run", ROOT / "data" / "synthetic" / "balance_scene.toml",
+        "balance.h5": (False, "balancer", "run", ROOT / "data" / "synthetic" / "balance_scene.toml",
                        "--out", out / "balance.h5", "--plots", out / "balance_plots"),
     }
-    for name, (module, *args) in commands.items():
-        done = run(module, *args, cwd=out)
+    for name, (own_process, module, *args) in commands.items():
+        done = (run if own_process else run_module)(module, *args, cwd=out)
         assert done.returncode == 0, f"{name}: {done.stderr}"
         assert "Traceback" not in done.stderr
     return out

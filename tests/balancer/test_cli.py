@@ -7,6 +7,8 @@ import textwrap
 
 from balancer.scene import STAGES
 
+from support.cli import run_module
+
 
 def test_cli_json_and_exit_codes(tmp_path):
     path = tmp_path / "s.toml"
@@ -30,9 +32,9 @@ def test_cli_json_and_exit_codes(tmp_path):
     # seed 004: 285.5 N at the optimum (crank_drive.md)
     assert abs(doc["results"]["compressor"]["max_force_n"] - 285.5) < 0.05
     path.write_text("[outputs]\ntables = ['compressor']\n")
-    bad = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
+    bad = run_module(*cmd[2:])  # the same main, in this process
     assert bad.returncode == 1 and bad.stderr.count("\n") == 1 and "s.toml" in bad.stderr
-    usage = subprocess.run([sys.executable, "-m", "balancer", "run"], capture_output=True, text=True, timeout=60)
+    usage = run_module("balancer", "run")
     assert usage.returncode == 2
 
 

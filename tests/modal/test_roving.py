@@ -18,6 +18,7 @@ import modal
 from modal.roving import CORRELATION_TOLERANCE, RovingEstimate, _response_part, join_estimates
 from modal.synthetic_time import random_record
 from modal.time_frf import frf_from_time
+from support.cli import run_module
 from support.paths import ROOT
 
 from support.roving import hits as _hits, plant as _plant, roving_files, write as _write
@@ -111,7 +112,7 @@ def test_points_whose_hits_give_other_record_lengths_are_cut_alike(roving, tmp_p
 ])
 def test_files_that_are_not_one_roving_test_are_refused_on_one_line(roving, tmp_path, change, fragment):
     other = _write(tmp_path / "p2.csv", _hits(1, seed=3, **change))
-    out = run("fit", roving[0], other, "--impact")
+    out = run_module("modal", "fit", roving[0], other, "--impact", cwd=ROOT)  # in-process: the first test runs it
     assert out.returncode == 1 and out.stderr.count("\n") == 1, out.stderr
     assert out.stderr.startswith(f"error: {other}: ") and fragment.format(first=roving[0]) in out.stderr
 
@@ -222,7 +223,7 @@ def test_a_point_labelled_twice_is_averaged_as_takes_and_the_disagreement_said(r
     text = roving[2].read_text().splitlines()
     mislabelled = tmp_path / "p3.csv"
     mislabelled.write_text("\n".join([text[0].replace("3+Z [N]", "2+Z [N]")] + text[1:]) + "\n")
-    out = run("fit", roving[0], roving[1], mislabelled, "--impact")
+    out = run_module("modal", "fit", roving[0], roving[1], mislabelled, "--impact", cwd=ROOT)
     assert out.returncode == 0, out.stderr
     assert f"{roving[1]}, {mislabelled}: all hit at 2+Z: averaged as takes of that point" in out.stderr
     warning = [ln for ln in out.stderr.splitlines() if "the takes' FRFs differ beyond their noise" in ln]

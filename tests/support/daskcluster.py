@@ -14,7 +14,8 @@ DASK = Path(sys.executable).with_name("dask")
 #: diagnostics for a dashboard nobody opens, the profiler sampling every worker's threads every 10 ms, the
 #: event-loop health check every 20 ms, the system monitor every 0.5 s, made an idle scheduler with two
 #: nanny workers burn 5.8 CPU-s a minute (1.6 without them), taken from the tests running beside it; the
-#: tests of dashboards and of ``modal batch``'s own cluster start theirs without these
+#: tests of dashboards and of ``modal batch``'s own cluster as configured by default
+#: (tests/modal/batch/test_cluster.py) start theirs without these
 QUIET = {"DASK_DISTRIBUTED__WORKER__PROFILE__ENABLED": "False",
          "DASK_DISTRIBUTED__ADMIN__TICK__INTERVAL": "1s",
          "DASK_DISTRIBUTED__ADMIN__SYSTEM_MONITOR__INTERVAL": "5s"}

@@ -16,6 +16,7 @@ from balancer.influence.job import balance, load_job
 from balancer.influence.readings import amplitude_phase
 from modal.errors import ParameterError, QualityWarning
 from support.balancing import READINGS, inline_scene
+from support.cli import run_module
 from support.paths import ROOT
 
 
@@ -155,7 +156,7 @@ def test_cli_shows_the_check_run_and_names_the_mistake(tmp_path):
     assert "measured after" in out.stdout and "flags: check_run_disagrees" in out.stdout
     assert CAUSES["added_where_removed"] in out.stdout and "trim (add)" not in out.stdout
     assert "warning:" in out.stderr
-    doc = json.loads(subprocess.run(cmd + ["--json"], capture_output=True, text=True, cwd=ROOT, timeout=120).stdout)
+    doc = json.loads(run_module(*cmd[2:], "--json", cwd=ROOT).stdout)  # the same main, in this process
     check = doc["check_run"]
     assert check["cause"] == "added_where_removed" and check["agrees"] is False and check["trim"] == []
     assert check["discrepancy"] > check["discrepancy_limit"]
@@ -165,8 +166,7 @@ def test_cli_shows_the_check_run_and_names_the_mistake(tmp_path):
 def test_cli_refuses_a_reading_noise_meant_as_percent(tmp_path):
     """--reading-noise is a fraction (0.05 for 5 %); 5 (meant as percent) is refused in one line."""
     path = _after_file(tmp_path, lambda r: r.correction_kg_m)
-    out = subprocess.run([sys.executable, "-m", "balancer", "influence", str(path), "--reading-noise", "5"],
-                         capture_output=True, text=True, cwd=ROOT, timeout=120)
+    out = run_module("balancer", "influence", path, "--reading-noise", 5, cwd=ROOT)
     assert out.returncode == 1 and out.stdout == ""
     assert out.stderr.startswith("error: reading_noise = 5") and len(out.stderr.strip().splitlines()) == 1
 
@@ -241,8 +241,7 @@ def test_every_output_says_how_far_the_readings_let_the_prediction_be_trusted(tm
     summary say so, and the archive keeps it with units."""
     report = balance(load_job(READINGS), "minmax")
     assert report.spread.worst_residual_p90 > 5 * report.worst_residual
-    out = subprocess.run([sys.executable, "-m", "balancer", "influence", str(READINGS), "--json"], capture_output=True,
-                         text=True, cwd=ROOT, timeout=120)
+    out = run_module("balancer", "influence", READINGS, "--json", cwd=ROOT)
     spread = json.loads(out.stdout)["spread"]
     assert spread["reading_noise"] == 0.05 and len(spread["mass_std"]) == 2
     assert spread["worst_residual_p90"] == pytest.approx(report.spread.worst_residual_p90 * 1e6, rel=1e-9)  # µm

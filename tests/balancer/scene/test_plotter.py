@@ -1,7 +1,9 @@
 """Plots drawn by forked plotting processes while the scene runs on (balancer.scene.plotter).
 
-Each case runs in a fresh interpreter: the test process may have threads alive (Dask
-clients of other tests), and run_scene then rightly declines to fork.
+Each forking case runs in a fresh interpreter's process (a child of one forked per case, the fixture
+``fresh``): the test process may have threads alive (Dask clients of other tests), and run_scene then
+rightly declines to fork. The serial drawing they are compared with is one run of the demo scene in the
+test process (serial_demo).
 """
 from __future__ import annotations
 
@@ -32,39 +34,68 @@ demo = {str(DEMO)!r}
 """
 
 
-def _run(tmp_path: Path, body: str) -> dict:
-    script = PRELUDE + body + "\nprint(json.dumps(out))\n"
-    proc = subprocess.run([sys.executable, "-c", script], cwd=tmp_path, capture_output=True, text=True, timeout=300,
-                          env={**os.environ, "MPLBACKEND": "Agg"})
+@pytest.fixture(scope="module")
+def fresh():
+    """A fresh interpreter that has run :data:`PRELUDE` and forks a copy of itself for each case
+    (support.forkserver): each case's process is the one ``python -c PRELUDE + case`` would be, without
+    paying the interpreter's start and the prelude's imports again."""
+    from support.forkserver import ForkServer
+
+    server = ForkServer(PRELUDE, env={**os.environ, "MPLBACKEND": "Agg"})
+    yield server
+    server.close()
+
+
+def _run(fresh, tmp_path: Path, body: str) -> dict:
+    proc = fresh.run(body + "\nprint(json.dumps(out))\n", cwd=tmp_path, timeout=300)
     assert proc.returncode == 0, proc.stderr[-2000:]
     return json.loads(proc.stdout.strip().splitlines()[-1])
 
 
-def test_plots_from_child_processes_are_the_same_files_and_the_parent_never_draws(tmp_path):
-    # the forked run first, in a fresh interpreter: the parent computes while its plotting process imports
+@pytest.fixture(scope="module")
+def serial_demo(tmp_path_factory):
+    """The demo scene run once here with the default ``plot_jobs`` (every figure drawn in this process): the
+    files the forked, command-line and per-stage drawings are compared with, byte for byte. Returns the run
+    and its plots folder, and the forks the run asked for: with forking allowed (``_can_fork`` true, as in a
+    process without threads), each one recorded and refused."""
+    from balancer.scene import plotter, run_scene
+
+    folder = tmp_path_factory.mktemp("serial_demo")
+    forks = []
+
+    def refused_fork():
+        forks.append(1)
+        raise OSError("the default run must not fork")
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(plotter, "_can_fork", lambda: True)
+        patch.setattr(os, "fork", refused_fork)
+        run = run_scene(DEMO, out=folder / "a.h5", plots_dir=folder / "a")
+    return run, folder / "a", len(forks)
+
+
+def test_plots_from_child_processes_are_the_same_files_and_the_parent_never_draws(fresh, tmp_path, serial_demo):
+    # the forked run in a fresh interpreter: the parent computes while its plotting process imports
     # matplotlib's figure machinery (about 0.6 s), so the parent itself must not import it, or the two costs
-    # add up instead of overlapping; then the serial run, which draws in the parent
-    out = _run(tmp_path, """
+    # add up instead of overlapping; the serial run (serial_demo) draws in its own process
+    out = _run(fresh, tmp_path, """
 forked = run_scene(demo, out="b.h5", plots_dir="b", plot_jobs=2)
-after_forked = forks[0]
-parent_drew = "matplotlib.figure" in sys.modules
-serial = run_scene(demo, out="a.h5", plots_dir="a")
-out = {"serial": list(serial.plot_paths), "forked": list(forked.plot_paths), "forks": [after_forked, forks[0]],
-       "parent_drew": parent_drew}
+out = {"forked": list(forked.plot_paths), "forks": forks[0], "parent_drew": "matplotlib.figure" in sys.modules}
 """)
-    assert out["forks"][0] >= 1 and out["forks"][1] == out["forks"][0]  # plot_jobs=2 did fork, the default did not
+    serial, serial_folder, serial_forks = serial_demo
+    assert out["forks"] >= 1 and serial_forks == 0  # plot_jobs=2 did fork, the default did not
     assert out["parent_drew"] is False
-    names = [Path(p).name for p in out["serial"]]
+    names = [Path(p).name for p in serial.plot_paths]
     assert names == [Path(p).name for p in out["forked"]] and len(names) == 6
     for name in names:  # Agg output is deterministic: byte for byte
-        assert (tmp_path / "a" / name).read_bytes() == (tmp_path / "b" / name).read_bytes(), name
+        assert (serial_folder / name).read_bytes() == (tmp_path / "b" / name).read_bytes(), name
     assert not list((tmp_path / "b").glob("*.tmp"))
 
 
-def test_a_failing_plot_in_a_child_is_reported(tmp_path):
+def test_a_failing_plot_in_a_child_is_reported(fresh, tmp_path):
     # the identify plot is the one handed to a child as soon as its stage is done (no child
     # is running yet then), so the failure happens in the child and must reach the caller
-    out = _run(tmp_path, """
+    out = _run(fresh, tmp_path, """
 from balancer.scene import plots
 def broken(results):
     raise ValueError("no figure today")
@@ -79,10 +110,10 @@ except RuntimeError as exc:
     assert "identify" in out["error"] and "ValueError: no figure today" in out["error"]
 
 
-def test_a_failing_stage_leaves_no_plots_drawn_early(tmp_path):
+def test_a_failing_stage_leaves_no_plots_drawn_early(fresh, tmp_path):
     # the identify plot is drawn by a child while the later stages run; when one of them
     # fails, the run writes nothing: no archive and no plot (as without plot_jobs)
-    out = _run(tmp_path, """
+    out = _run(fresh, tmp_path, """
 from balancer.scene import stages
 def broken(scene, **kwargs):
     raise SceneError("mounts: broken on purpose")
@@ -124,7 +155,7 @@ def test_every_stage_figure_declares_the_results_it_reads():
     assert all(not stage.plot_inputs and not stage.plot_modules for stage in REGISTRY.values() if not stage.figures)
 
 
-def test_every_figure_draws_the_same_in_a_plotting_process_with_only_the_drawing_modules(tmp_path):
+def test_every_figure_draws_the_same_in_a_plotting_process_with_only_the_drawing_modules(tmp_path, serial_demo):
     # `python -m balancer run` forks its plotting process before modal is imported, and the process loads
     # only modal's submodules that drawing needs (balancer.scene.plotter._drawing_modal), then the plot_modules
     # of its stages once, before it forks its helper. Each stage's plot inputs are pickled by a run here,
@@ -146,7 +177,10 @@ def test_every_figure_draws_the_same_in_a_plotting_process_with_only_the_drawing
     for k, scene in enumerate(scenes):
         # each scene's own plots folder: the run draws the plots its scene lists in this process (plot_jobs=1),
         # the serial drawing the child's files are compared with; a stage it does not draw is drawn here
-        run = run_scene(scene, out=tmp_path / "x.h5", plots_dir=tmp_path / f"p{k}")
+        if scene == DEMO:
+            run, drawn_in = serial_demo[:2]
+        else:
+            run, drawn_in = run_scene(scene, out=tmp_path / "x.h5", plots_dir=tmp_path / f"p{k}"), tmp_path / f"p{k}"
         drawn = {Path(p).name for p in run.plot_paths}
         for stage in figured:
             if stage in run.results and stage not in pickled:
@@ -157,7 +191,7 @@ def test_every_figure_draws_the_same_in_a_plotting_process_with_only_the_drawing
                 modules[stage] = list(result_modules(checked, [stage]))
                 pickled[stage] = str(tmp_path / f"{stage}.pickle")
                 Path(pickled[stage]).write_bytes(pickle.dumps(given))
-                serial[stage] = sorted(tmp_path / f"p{k}" / name for name in drawn if name.startswith(stage + "_"))
+                serial[stage] = sorted(drawn_in / name for name in drawn if name.startswith(stage + "_"))
                 if not serial[stage]:
                     (tmp_path / "serial").mkdir(exist_ok=True)
                     serial[stage] = plots.save_stage_plot(stage, given, tmp_path / "serial")
@@ -201,12 +235,10 @@ print(json.dumps(out))
             assert (tmp_path / stage / path.name).read_bytes() == path.read_bytes(), path.name
 
 
-def test_the_command_line_draws_the_same_files_from_its_early_plotting_process(tmp_path):
+def test_the_command_line_draws_the_same_files_from_its_early_plotting_process(tmp_path, serial_demo):
     # `python -m balancer run` starts its plotting process before it imports modal; the run takes it over:
     # the same files, byte for byte, as drawn in one process
-    from balancer.scene import run_scene
-
-    serial = run_scene(DEMO, out=tmp_path / "a.h5", plots_dir=tmp_path / "a")
+    serial, serial_folder, _ = serial_demo
     proc = subprocess.run([sys.executable, "-m", "balancer", "run", str(DEMO), "--out", str(tmp_path / "b.h5"),
                            "--plots", str(tmp_path / "b")], cwd=ROOT, capture_output=True, text=True, timeout=300,
                           env={**os.environ, "MPLBACKEND": "Agg"})
@@ -214,10 +246,10 @@ def test_the_command_line_draws_the_same_files_from_its_early_plotting_process(t
     names = [Path(p).name for p in serial.plot_paths]
     assert sorted(p.name for p in (tmp_path / "b").iterdir()) == sorted(names) and len(names) == 6
     for name in names:
-        assert (tmp_path / "a" / name).read_bytes() == (tmp_path / "b" / name).read_bytes(), name
+        assert (serial_folder / name).read_bytes() == (tmp_path / "b" / name).read_bytes(), name
 
 
-def test_an_early_plotting_process_reports_a_failed_figure_and_is_dismissed_when_unused(tmp_path):
+def test_an_early_plotting_process_reports_a_failed_figure_and_is_dismissed_when_unused(fresh, tmp_path):
     # taken over by a run: a figure that fails there reaches the caller with its stage; not taken over (no
     # plots, or the run failed first): dismiss_early ends it and no child process is left behind
     script = f"""
@@ -243,8 +275,7 @@ except ChildProcessError:
     out["children"] = "none"
 print(json.dumps(out))
 """
-    proc = subprocess.run([sys.executable, "-c", script], cwd=tmp_path, capture_output=True, text=True, timeout=300,
-                          env={**os.environ, "MPLBACKEND": "Agg"})
+    proc = fresh.run(script, cwd=tmp_path, timeout=300)
     assert proc.returncode == 0, proc.stderr[-2000:]
     out = json.loads(proc.stdout.strip().splitlines()[-1])
     assert out["started"] and out["taken"] and out["second"]

@@ -27,7 +27,7 @@ from modal.io import write_frf
 from modal.synthetic import add_noise, modal_frf
 
 from support.cli import run_module
-from support.daskcluster import free_port, start_worker, wait_for_workers
+from support.daskcluster import free_port, quiet_environment, start_worker, wait_for_workers
 
 FREQ = np.linspace(20.0, 200.0, 301)  # 0.6 Hz lines; the modes are 2.4 and 5 Hz wide (>= 4 lines per bandwidth)
 NOISE = 1e-3  # of the peak magnitude: the NLS standard errors of f_n are ~1e-5 relative
@@ -53,8 +53,11 @@ def write_files(folder: Path, n: int, start: int = 0) -> list[Path]:
 
 
 def run_cli(*args, cwd=None):
+    """``python -m modal batch ARGS``, a process of its own; an embedded cluster it starts has the session
+    cluster's quiet settings (support.daskcluster.QUIET): its subject here is the table, not Dask's defaults
+    (tests/modal/batch/test_cluster.py runs the embedded cluster as configured by default)."""
     return subprocess.run([sys.executable, "-m", "modal", "batch", *map(str, args)], capture_output=True, text=True,
-                          cwd=cwd, timeout=300)
+                          cwd=cwd, timeout=300, env=quiet_environment())
 
 
 def run_here(*args):

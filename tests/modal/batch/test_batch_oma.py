@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from support.ambient import FN, anchor_record
+from support.cli import run_module
 from support.paths import ROOT
 
 
@@ -26,6 +27,11 @@ def _write(path, rec):
 def _batch(*args):
     return subprocess.run([sys.executable, "-m", "modal", "batch", *map(str, args)], capture_output=True, text=True,
                           timeout=600, cwd=ROOT)
+
+
+def _batch_here(*args):
+    """``modal batch ARGS`` in this process (support.cli): a run after the first of its test, and usage errors."""
+    return run_module("modal", "batch", *args, cwd=ROOT)
 
 
 def test_a_folder_of_ambient_records(dask_cluster, tmp_path):
@@ -48,10 +54,10 @@ def test_a_folder_of_ambient_records(dask_cluster, tmp_path):
         assert len(found) == 6 and np.allclose(found, FN, rtol=5e-3)  # the six modes, no tone among them
         assert {r["method"] for r in mine} == {"ssi"}
         assert all(r["mass_kg"] == "" for r in mine)  # unscaled: no k, c, m (an empty cell)
-    again = _batch(folder, "--oma", "--band", 1, 30, "--rotor-speed-hz", 4.8, "--out", out, "--scheduler",
+    again = _batch_here(folder, "--oma", "--band", 1, 30, "--rotor-speed-hz", 4.8, "--out", out, "--scheduler",
                    dask_cluster[0], "--json")
     assert json.loads(again.stdout)["reused"] == 2  # same files, same options: nothing identified again
-    other = _batch(folder, "--oma", "--band", 1, 25, "--out", out, "--scheduler", dask_cluster[0], "--json")
+    other = _batch_here(folder, "--oma", "--band", 1, 25, "--out", out, "--scheduler", dask_cluster[0], "--json")
     assert json.loads(other.stdout)["fitted"] == 2  # other OMA options: a new settings hash
 
 
@@ -62,7 +68,7 @@ def test_a_folder_of_ambient_records(dask_cluster, tmp_path):
 ])
 def test_bad_oma_options_exit_2(tmp_path, args, message):
     _write(tmp_path / "a.h5", anchor_record(63, noise=0.1, tones=False, duration_s=300))
-    done = _batch(tmp_path, "--out", tmp_path / "r.h5", *args)
+    done = _batch_here(tmp_path, "--out", tmp_path / "r.h5", *args)
     assert done.returncode == 2 and message in done.stderr and "Traceback" not in done.stderr
 
 
@@ -77,7 +83,8 @@ def test_the_files_warnings_are_printed_on_every_run(dask_cluster, tmp_path):
     _write(folder / "clean.h5", anchor_record(64, noise=0.1, tones=False, duration_s=300))
     out = tmp_path / "survey.h5"
     for status in ("fitted", "reused"):  # the warnings come with the results, reused ones too
-        done = _batch(folder, "--oma", "--band", 1, 30, "--out", out, "--scheduler", dask_cluster[0], "--json")
+        done = (_batch if status == "fitted" else _batch_here)(folder, "--oma", "--band", 1, 30, "--out", out,
+                                                                "--scheduler", dask_cluster[0], "--json")
         assert done.returncode == 0 and json.loads(done.stdout)[status] == 2, done.stderr
         lines = [line for line in done.stderr.splitlines() if line.startswith("warning: ")]
         dropout = [line for line in lines if "a dropout or a stuck converter" in line]
@@ -85,7 +92,7 @@ def test_the_files_warnings_are_printed_on_every_run(dask_cluster, tmp_path):
         assert dropout[0].startswith(f"warning: {folder / 'dropout.h5'}: every channel holds the value 0 for 1500 "
                                      "samples")
     # the same folder without --oma: each record refused, pointing to the batch's own option
-    fit = _batch(folder, "--out", tmp_path / "fit.h5", "--scheduler", dask_cluster[0])
+    fit = _batch_here(folder, "--out", tmp_path / "fit.h5", "--scheduler", dask_cluster[0])
     failed = [line for line in fit.stderr.splitlines() if line.startswith("failed: ")]
     assert fit.returncode == 1 and len(failed) == 2
     assert all("responses only" in line and "modal batch --oma" in line for line in failed), fit.stderr

@@ -19,12 +19,15 @@ from modal.batch import file_sha256
 
 from support.batchfiles import FRF_MODES_HZ, write_crashing_mat, write_every_format, write_hanging_hdf5, mobility
 from support.cli import run_module
+from support.daskcluster import quiet_environment
 
 
 def run_cli(*args):
-    """``python -m modal batch ARGS``: a process of its own, whose stderr holds whatever Dask logs."""
+    """``python -m modal batch ARGS``: a process of its own, whose stderr holds whatever Dask logs; an embedded
+    cluster it starts has the session cluster's quiet settings (support.daskcluster.QUIET): the formats are the
+    subject here (tests/modal/batch/test_cluster.py runs the embedded cluster as configured by default)."""
     return subprocess.run([sys.executable, "-m", "modal", "batch", *map(str, args)], capture_output=True, text=True,
-                          timeout=300)
+                          timeout=300, env=quiet_environment())
 
 
 def frequencies_by_file(table: Path) -> dict[str, list[tuple[float, float]]]:
