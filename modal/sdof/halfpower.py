@@ -279,14 +279,11 @@ def _interpolation_shift(omega, power, plan: _Plan, pole, crossings):
             exact.append(fitted)
             continue
         a, b = sorted(side[1:3])
-        fine = np.linspace(omega[a], omega[b], 2001)
-        curve = _model_db(fine, power, pole, reference=omega)
         if not (min(model[a], model[b]) <= level <= max(model[a], model[b])):
             return np.zeros(2)
         t = (level - model[a]) / (model[b] - model[a])
         linear.append(omega[a] + t * (omega[b] - omega[a]))
-        order = np.argsort(curve)
-        exact.append(float(np.interp(level, curve[order], fine[order])))
+        exact.append(_exact_crossing(omega[a], omega[b], power, pole, omega, level))
     return np.abs(np.array(invert_half_power(*linear, power)) - np.array(invert_half_power(*exact, power)))
 
 
@@ -302,11 +299,69 @@ def _same_plan(a: _Plan, b: _Plan) -> bool:
     return a.peak_lines == b.peak_lines and key(a.left) == key(b.left) and key(a.right) == key(b.right)
 
 
+#: samples of a model curve: its peak over a band, and each side's crossing between two lines
+PEAK_SAMPLES = 4001
+CROSSING_SAMPLES = 2001
+#: every how many samples the coarse pass looks, before the samples that matter are computed
+_STRIDE = 50
+
+
+def _model_abs(fine, wn: float, zeta: float, power: int) -> np.ndarray:
+    """|φ| of one viscous mode on the samples ``fine`` (rad/s)."""
+    return np.abs(mode_basis(fine, wn, zeta, power)[0])
+
+
+def _peak_location(power: int, wn: float, zeta: float) -> float:
+    """ω (rad/s) of the peak of |φ| over ω ≥ 0 (0 or inf where |φ| is monotone there)."""
+    if power == 1:
+        return wn
+    shrink = 1 - 2 * zeta**2
+    if not shrink > 0:
+        return 0.0 if power == 0 else np.inf
+    return wn * np.sqrt(shrink) if power == 0 else wn / np.sqrt(shrink)
+
+
 @functools.lru_cache(maxsize=16)
 def _model_peak(first: float, last: float, power: int, wn: float, zeta: float) -> float:
-    """Peak |φ| of one viscous mode (ωn, ζ) of kind ``power`` between two frequencies, sampled finely
-    (cached: the interpolation check asks for the same mode's peak once per side, after its own curve)."""
-    return float(np.abs(mode_basis(np.linspace(first, last, 4001), wn, zeta, power)[0]).max())
+    """Peak |φ| of one viscous mode (ωn, ζ) of kind ``power`` between two frequencies (rad/s), the
+    largest of ``PEAK_SAMPLES`` samples (cached: the interpolation check asks for the same mode's peak
+    once per side, after its own curve).
+
+    |φ| has one peak over ω ≥ 0, so every ``_STRIDE``-th sample locates it and only the samples
+    between the coarse maximum's neighbours are computed: elementwise, the same values as those
+    of the whole grid, whose largest lies there."""
+    fine = np.linspace(first, last, PEAK_SAMPLES)
+    if not first >= 0:  # one peak on each side of ω = 0: the whole grid
+        return float(_model_abs(fine, wn, zeta, power).max())
+    coarse = np.arange(0, PEAK_SAMPLES, _STRIDE)
+    k = int(np.argmax(_model_abs(fine[coarse], wn, zeta, power)))
+    lo, hi = coarse[max(k - 1, 0)], coarse[min(k + 1, coarse.size - 1)]
+    return float(_model_abs(fine[lo:hi + 1], wn, zeta, power).max())
+
+
+def _exact_crossing(first: float, last: float, power: int, pole, reference, level: float) -> float:
+    """Where the model dB curve (relative to its peak over ``reference``) crosses ``level`` between
+    two lines (rad/s): linear interpolation between ``CROSSING_SAMPLES`` samples.
+
+    Where the mode's peak lies outside the two lines the curve is monotone between them: every
+    ``_STRIDE``-th sample brackets the crossing and only the samples around it are computed
+    (elementwise the same values, and the same two samples enter the interpolation)."""
+    fine = np.linspace(first, last, CROSSING_SAMPLES)
+    window = slice(None)
+    if first >= 0 and not first < _peak_location(power, *pole) < last:
+        coarse = np.arange(0, CROSSING_SAMPLES, _STRIDE)
+        values = _model_db(fine[coarse], power, pole, reference=reference)
+        steps = np.diff(values)
+        above = np.flatnonzero(values >= level)
+        if (np.all(steps > 0) or np.all(steps < 0)) and 0 < above.size < coarse.size:
+            # the last coarse sample below the level and the first above it, one stride wider
+            # each way (a sample equal to the level is in either bracket)
+            edge = above[0] if steps[0] > 0 else above[-1]
+            window = slice(coarse[max(edge - 2, 0)], coarse[min(edge + 2, coarse.size - 1)] + 1)
+    fine = fine[window]
+    curve = _model_db(fine, power, pole, reference=reference)
+    order = np.argsort(curve)
+    return float(np.interp(level, curve[order], fine[order]))
 
 
 def _model_db(omega, power, pole, reference=None):
@@ -315,7 +370,7 @@ def _model_db(omega, power, pole, reference=None):
     wn, zeta = pole
     span = omega if reference is None else reference
     peak = _model_peak(float(span[0]), float(span[-1]), power, float(wn), float(zeta))
-    return 20 * np.log10(np.abs(mode_basis(omega, wn, zeta, power)[0]) / peak)
+    return 20 * np.log10(_model_abs(omega, wn, zeta, power) / peak)
 
 
 def _model_crossing(omega, curve, level_db):
