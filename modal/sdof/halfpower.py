@@ -210,20 +210,26 @@ def _side_value(omega, db, level_db, side):
 
 def _evaluate(omega, mag, power, plan: _Plan):
     """(ωn, ζ), each shape (B,), for a batch of magnitudes ``mag`` (B, n) with the choices held."""
+    return _evaluate_sides(omega, mag, power, plan)[:2]
+
+
+def _evaluate_sides(omega, mag, power, plan: _Plan):
+    """(ωn, ζ, ω1, ω2), each shape (B,): :func:`_evaluate` and the crossings it found (NaN for a side
+    without one)."""
     u_peak, peak2 = _peak_values(omega, mag, plan, power)
     db = 20 * np.log10(np.maximum(mag, np.finfo(float).tiny))
     level_db = 10 * np.log10(peak2 / 2)
     w1 = _side_value(omega, db, level_db, plan.left)
     w2 = _side_value(omega, db, level_db, plan.right)
     if plan.left is not None and plan.right is not None:
-        return invert_half_power(w1, w2, power)
+        return (*invert_half_power(w1, w2, power), w1, w2)
     if plan.left is not None or plan.right is not None:
         wc = w1 if plan.left is not None else w2
-        return _one_sided(u_peak, wc**2, power)
+        return (*_one_sided(u_peak, wc**2, power), w1, w2)
     # no crossing at all: the band holds less than the half-power width
     spacing = np.min(np.diff(omega)) if omega.size > 1 else np.nan
     wn = np.sqrt(u_peak)
-    return wn, np.maximum((omega[-1] - omega[0]) / (2 * wn), spacing / (2 * wn))
+    return wn, np.maximum((omega[-1] - omega[0]) / (2 * wn), spacing / (2 * wn)), w1, w2
 
 
 def _jacobian(omega, mag, power, plan: _Plan, lines):
@@ -383,15 +389,17 @@ def _model_crossing(omega, curve, level_db):
     return float(_crossing(omega, curve, level_db, j, j + 1))
 
 
-def _plan(omega, mag, db, power, i, peak_lines, noise_std, model=None):
+def _plan(omega, mag, db, power, i, peak_lines, noise_std, model=None, peak2=None):
     """The choices of the crossings for a given peak fit; and the lines above the level.
 
     ``model``: a first estimate (ωn, ζ) whose curve chooses the lines of each fitted
     crossing (within ±1 dB of −3 dB on the model), so that the noise on a line does not
     decide whether it enters (selecting on the noisy dB trims the noise the fit sees).
+    ``peak2``: the peak fit's |H|² on these lines, when the caller has it.
     """
     n = mag.size
-    _, peak2 = (float(v[0]) for v in _peak_values(omega, mag[None, :], _Plan(i, peak_lines, None, None), power))
+    if peak2 is None:
+        _, peak2 = (float(v[0]) for v in _peak_values(omega, mag[None, :], _Plan(i, peak_lines, None, None), power))
     level = np.sqrt(peak2 / 2)
     level_db = 10 * np.log10(peak2 / 2)
     lo = i
@@ -453,6 +461,7 @@ def half_power_curve(omega: np.ndarray, h: np.ndarray, power: int, noise_std: fl
         flags.append("band_edge_peak")
     db = 20 * np.log10(np.maximum(mag, np.finfo(float).tiny))
     plan, n_above = _plan(omega, mag, db, power, i, _choose_peak(omega, mag, i, power), noise_std)
+    evaluated = None  # the last plan evaluated, with its (ωn, ζ, ω1, ω2)
     for _ in range(MODEL_PASSES):
         # further passes: the peak fit on the lines within 1 dB of the last estimate's model
         # peak (|ω − ωn| ≤ ζωn/2), and the crossing fits on the lines within ±1 dB of −3 dB on
@@ -462,7 +471,9 @@ def half_power_curve(omega: np.ndarray, h: np.ndarray, power: int, noise_std: fl
         if plan.left is None or plan.right is None:
             break
         with np.errstate(all="ignore"):
-            wn1, zeta1 = (float(v[0]) for v in _evaluate(omega, mag[None, :], power, plan))
+            values = tuple(float(v[0]) for v in _evaluate_sides(omega, mag[None, :], power, plan))
+        evaluated = (plan, values)
+        wn1, zeta1 = values[:2]
         if not (np.isfinite(wn1) and np.isfinite(zeta1) and zeta1 > 0):
             break
         near = np.flatnonzero(np.abs(omega - wn1) <= 0.5 * zeta1 * wn1)
@@ -473,14 +484,17 @@ def half_power_curve(omega: np.ndarray, h: np.ndarray, power: int, noise_std: fl
         if not (np.isfinite(u_star) and omega[lines[0]] ** 2 <= u_star <= omega[lines[1]] ** 2 and peak2 > 0):
             break
         previous = plan
-        plan, n_above = _plan(omega, mag, db, power, i, lines, noise_std, (wn1, zeta1))
+        plan, n_above = _plan(omega, mag, db, power, i, lines, noise_std, (wn1, zeta1), peak2)
         if _same_plan(plan, previous):
             break
     if n_above < 3:
         flags.append("resolution_limited")
     if plan.left is None or plan.right is None:
         flags.append("missing_crossing")
-    wn, zeta = (float(v[0]) for v in _evaluate(omega, mag[None, :], power, plan))
+    if evaluated is not None and _same_plan(evaluated[0], plan):  # the same lines: the same numbers
+        wn, zeta, *crossings = evaluated[1]
+    else:
+        wn, zeta, *crossings = (float(v[0]) for v in _evaluate_sides(omega, mag[None, :], power, plan))
     std_wn = std_zeta = np.nan
     if not errors:
         return HalfPowerEstimate(float(wn), float(zeta), std_wn, std_zeta, n_above, tuple(flags), None)
@@ -490,9 +504,6 @@ def half_power_curve(omega: np.ndarray, h: np.ndarray, power: int, noise_std: fl
         var = (noise_std**2 / 2) * np.sum(jac**2, axis=1)
         std_wn, std_zeta = float(np.sqrt(var[0])), float(np.sqrt(var[1]))
     with np.errstate(all="ignore"):
-        mag_db = 20 * np.log10(np.maximum(mag, np.finfo(float).tiny))[None, :]
-        level_now = 10 * np.log10(_peak_values(omega, mag[None, :], plan, power)[1] / 2)
-        crossings = [float(_side_value(omega, mag_db, level_now, side)[0]) for side in (plan.left, plan.right)]
         shift = _interpolation_shift(omega, power, plan, (wn, zeta), crossings)
     if np.any(shift != 0) and np.isfinite(std_wn) and np.isfinite(std_zeta):
         # a crossing interpolated linearly in dB between two lines is off by the curvature of
