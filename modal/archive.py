@@ -261,7 +261,7 @@ def _check_units(group, obj, children=None, kinds=None) -> None:
         kind = _str_type(node) if kinds is None else kinds[name]
         if not isinstance(node, h5py.Dataset) or kind not in _NUMBER_TYPES:
             continue
-        unit = node.attrs.get("units")
+        unit = _text_attr(node, "units")
         unit = unit.decode() if isinstance(unit, bytes) else unit
         if isinstance(explicit.get(name), str):  # a unit the name cannot say: earlier versions wrote none
             expected = (explicit[name], *_name_units(name)) if unit is not None else ()
@@ -275,10 +275,32 @@ def _check_units(group, obj, children=None, kinds=None) -> None:
 
 
 _NUMBER_TYPES = ("int", "float", "complex", "npscalar", "ndarray")
+_TEXT = h5py.string_dtype()
+
+
+def _text_attr(node, name: str):
+    """``node.attrs.get(name)`` (a missing attribute: None), read by h5py's low-level calls where it is one
+    variable-length string, as :func:`write_node` writes them: ``attrs.get`` builds the attribute's memory type
+    and its NumPy type afresh on every read (two thirds of a small archive's reading time went to attributes)."""
+    try:
+        attr = h5py.h5a.open(node.id, name.encode())
+    except KeyError:
+        return None
+    stored = attr.get_type()
+    if not (isinstance(stored, h5py.h5t.TypeStringID) and stored.is_variable_str()
+            and stored.get_cset() == h5py.h5t.CSET_UTF8 and attr.shape == ()):
+        return node.attrs.get(name)
+    value = np.zeros((), dtype=_TEXT)
+    attr.read(value, mtype=_TEXT_TYPE)
+    value = value[()]
+    return value.decode("utf-8", "surrogateescape") if isinstance(value, bytes) else value
+
+
+_TEXT_TYPE = h5py.h5t.py_create(_TEXT)
 
 
 def _str_type(node) -> str | None:
-    kind = node.attrs.get("__type__")
+    kind = _text_attr(node, "__type__")
     return kind.decode() if isinstance(kind, bytes) else kind
 
 
@@ -307,7 +329,8 @@ def read_node(node, kind: str | None = None) -> Any:
     if kind == "frf":
         return read_frf_group(node, source=node.file.filename)
     if kind == "dataclass":
-        cls = _class_from(str(node.attrs["__class__"]))
+        stored_class = _text_attr(node, "__class__")
+        cls = _class_from(str(node.attrs["__class__"] if stored_class is None else stored_class))
         children = {name: node[name] for name in node.keys()}
         kinds = {name: _str_type(child) for name, child in children.items()}
         values = {name: read_node(child, kinds[name]) for name, child in children.items()}

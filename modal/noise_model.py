@@ -23,6 +23,7 @@ stationary excitation gives ρ(τ) = 1 − τ/N, a Hann window ≈ 1 − (2π²/
 """
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -154,8 +155,15 @@ class NoiseModel:
         if lines <= 1 or self.line_correlation is None:
             return 1.0
         m = np.arange(1, min(lines, self.n_lags + 1))
-        rho = np.median(np.abs(self.line_correlation[m - 1]), axis=1) if m.size else np.zeros(0)
+        rho = self._lag_correlation[m - 1]
         return 1.0 + 2.0 * float(np.sum((1 - m / lines) * rho**2))
+
+    @functools.cached_property
+    def _lag_correlation(self) -> np.ndarray:
+        """|ρ(m)| of every lag m = 1 … n_lags, the median over the lines (each row's own median: the
+        same values whichever lags are asked; :func:`modal.sdof.bands.smoothing_lines` asks for one more
+        lag at each of up to 20 steps)."""
+        return np.median(np.abs(self.line_correlation), axis=1)
 
     def cropped(self, keep: np.ndarray) -> "NoiseModel":
         """The model on the lines ``keep`` (bool over the lines, a contiguous run keeps every correlation).

@@ -51,10 +51,30 @@ class LineWhitening:
             raise np.linalg.LinAlgError("the lines' correlation matrix is far from positive definite")
         self.bandwidth = bandwidth
         self.ridge = ridge
+        self._lu = None  # LAPACK's band LU of the factor, formed at the first whitening
 
     def __call__(self, values: np.ndarray) -> np.ndarray:
-        from scipy.linalg import solve_banded
-
         if self.bandwidth == 0:
             return values / self._factor[0][:, None] if values.ndim == 2 else values / self._factor[0]
-        return solve_banded((self.bandwidth, 0), self._factor, values)
+        if self._factor.shape[1] == 1:  # one line: scipy's solve_banded divides by the diagonal
+            from scipy.linalg import solve_banded
+
+            return solve_banded((self.bandwidth, 0), self._factor, values)
+        # solve_banded (LAPACK gbsv) factors the band afresh on every call; gbsv is gbtrf then gbtrs, so the
+        # factorisation is kept and gbtrs alone solves each call: the same numbers, without the refactoring
+        from scipy.linalg import get_lapack_funcs
+
+        values = np.asarray_chkfinite(values)  # as solve_banded checks its right-hand side
+        gbtrf, gbtrs = get_lapack_funcs(("gbtrf", "gbtrs"), (self._factor, values))
+        if self._lu is None or self._lu[0].dtype != gbtrf.dtype:
+            stored = np.zeros((2 * self.bandwidth + 1, self._factor.shape[1]), dtype=gbtrf.dtype)
+            stored[self.bandwidth:] = self._factor
+            lu, pivots, info = gbtrf(stored, self.bandwidth, 0, overwrite_ab=True)
+            self._lu = (lu, pivots, info)
+        lu, pivots, info = self._lu
+        if info > 0:
+            raise np.linalg.LinAlgError("singular matrix")
+        solved, info = gbtrs(lu, self.bandwidth, 0, values.reshape(values.shape[0], -1), pivots)
+        if info != 0:
+            raise ValueError(f"illegal value in {-info}-th argument of internal gbtrs")
+        return solved.reshape(values.shape)

@@ -210,20 +210,26 @@ def _side_value(omega, db, level_db, side):
 
 def _evaluate(omega, mag, power, plan: _Plan):
     """(ωn, ζ), each shape (B,), for a batch of magnitudes ``mag`` (B, n) with the choices held."""
+    return _evaluate_sides(omega, mag, power, plan)[:2]
+
+
+def _evaluate_sides(omega, mag, power, plan: _Plan):
+    """(ωn, ζ, ω1, ω2), each shape (B,): :func:`_evaluate` and the crossings it found (NaN for a side
+    without one)."""
     u_peak, peak2 = _peak_values(omega, mag, plan, power)
     db = 20 * np.log10(np.maximum(mag, np.finfo(float).tiny))
     level_db = 10 * np.log10(peak2 / 2)
     w1 = _side_value(omega, db, level_db, plan.left)
     w2 = _side_value(omega, db, level_db, plan.right)
     if plan.left is not None and plan.right is not None:
-        return invert_half_power(w1, w2, power)
+        return (*invert_half_power(w1, w2, power), w1, w2)
     if plan.left is not None or plan.right is not None:
         wc = w1 if plan.left is not None else w2
-        return _one_sided(u_peak, wc**2, power)
+        return (*_one_sided(u_peak, wc**2, power), w1, w2)
     # no crossing at all: the band holds less than the half-power width
     spacing = np.min(np.diff(omega)) if omega.size > 1 else np.nan
     wn = np.sqrt(u_peak)
-    return wn, np.maximum((omega[-1] - omega[0]) / (2 * wn), spacing / (2 * wn))
+    return wn, np.maximum((omega[-1] - omega[0]) / (2 * wn), spacing / (2 * wn)), w1, w2
 
 
 def _jacobian(omega, mag, power, plan: _Plan, lines):
@@ -279,14 +285,11 @@ def _interpolation_shift(omega, power, plan: _Plan, pole, crossings):
             exact.append(fitted)
             continue
         a, b = sorted(side[1:3])
-        fine = np.linspace(omega[a], omega[b], 2001)
-        curve = _model_db(fine, power, pole, reference=omega)
         if not (min(model[a], model[b]) <= level <= max(model[a], model[b])):
             return np.zeros(2)
         t = (level - model[a]) / (model[b] - model[a])
         linear.append(omega[a] + t * (omega[b] - omega[a]))
-        order = np.argsort(curve)
-        exact.append(float(np.interp(level, curve[order], fine[order])))
+        exact.append(_exact_crossing(omega[a], omega[b], power, pole, omega, level))
     return np.abs(np.array(invert_half_power(*linear, power)) - np.array(invert_half_power(*exact, power)))
 
 
@@ -302,11 +305,69 @@ def _same_plan(a: _Plan, b: _Plan) -> bool:
     return a.peak_lines == b.peak_lines and key(a.left) == key(b.left) and key(a.right) == key(b.right)
 
 
+#: samples of a model curve: its peak over a band, and each side's crossing between two lines
+PEAK_SAMPLES = 4001
+CROSSING_SAMPLES = 2001
+#: every how many samples the coarse pass looks, before the samples that matter are computed
+_STRIDE = 50
+
+
+def _model_abs(fine, wn: float, zeta: float, power: int) -> np.ndarray:
+    """|φ| of one viscous mode on the samples ``fine`` (rad/s)."""
+    return np.abs(mode_basis(fine, wn, zeta, power)[0])
+
+
+def _peak_location(power: int, wn: float, zeta: float) -> float:
+    """ω (rad/s) of the peak of |φ| over ω ≥ 0 (0 or inf where |φ| is monotone there)."""
+    if power == 1:
+        return wn
+    shrink = 1 - 2 * zeta**2
+    if not shrink > 0:
+        return 0.0 if power == 0 else np.inf
+    return wn * np.sqrt(shrink) if power == 0 else wn / np.sqrt(shrink)
+
+
 @functools.lru_cache(maxsize=16)
 def _model_peak(first: float, last: float, power: int, wn: float, zeta: float) -> float:
-    """Peak |φ| of one viscous mode (ωn, ζ) of kind ``power`` between two frequencies, sampled finely
-    (cached: the interpolation check asks for the same mode's peak once per side, after its own curve)."""
-    return float(np.abs(mode_basis(np.linspace(first, last, 4001), wn, zeta, power)[0]).max())
+    """Peak |φ| of one viscous mode (ωn, ζ) of kind ``power`` between two frequencies (rad/s), the
+    largest of ``PEAK_SAMPLES`` samples (cached: the interpolation check asks for the same mode's peak
+    once per side, after its own curve).
+
+    |φ| has one peak over ω ≥ 0, so every ``_STRIDE``-th sample locates it and only the samples
+    between the coarse maximum's neighbours are computed: elementwise, the same values as those
+    of the whole grid, whose largest lies there."""
+    fine = np.linspace(first, last, PEAK_SAMPLES)
+    if not first >= 0:  # one peak on each side of ω = 0: the whole grid
+        return float(_model_abs(fine, wn, zeta, power).max())
+    coarse = np.arange(0, PEAK_SAMPLES, _STRIDE)
+    k = int(np.argmax(_model_abs(fine[coarse], wn, zeta, power)))
+    lo, hi = coarse[max(k - 1, 0)], coarse[min(k + 1, coarse.size - 1)]
+    return float(_model_abs(fine[lo:hi + 1], wn, zeta, power).max())
+
+
+def _exact_crossing(first: float, last: float, power: int, pole, reference, level: float) -> float:
+    """Where the model dB curve (relative to its peak over ``reference``) crosses ``level`` between
+    two lines (rad/s): linear interpolation between ``CROSSING_SAMPLES`` samples.
+
+    Where the mode's peak lies outside the two lines the curve is monotone between them: every
+    ``_STRIDE``-th sample brackets the crossing and only the samples around it are computed
+    (elementwise the same values, and the same two samples enter the interpolation)."""
+    fine = np.linspace(first, last, CROSSING_SAMPLES)
+    window = slice(None)
+    if first >= 0 and not first < _peak_location(power, *pole) < last:
+        coarse = np.arange(0, CROSSING_SAMPLES, _STRIDE)
+        values = _model_db(fine[coarse], power, pole, reference=reference)
+        steps = np.diff(values)
+        above = np.flatnonzero(values >= level)
+        if (np.all(steps > 0) or np.all(steps < 0)) and 0 < above.size < coarse.size:
+            # the last coarse sample below the level and the first above it, one stride wider
+            # each way (a sample equal to the level is in either bracket)
+            edge = above[0] if steps[0] > 0 else above[-1]
+            window = slice(coarse[max(edge - 2, 0)], coarse[min(edge + 2, coarse.size - 1)] + 1)
+    fine = fine[window]
+    curve = _model_db(fine, power, pole, reference=reference)
+    order = np.argsort(curve)
+    return float(np.interp(level, curve[order], fine[order]))
 
 
 def _model_db(omega, power, pole, reference=None):
@@ -315,7 +376,7 @@ def _model_db(omega, power, pole, reference=None):
     wn, zeta = pole
     span = omega if reference is None else reference
     peak = _model_peak(float(span[0]), float(span[-1]), power, float(wn), float(zeta))
-    return 20 * np.log10(np.abs(mode_basis(omega, wn, zeta, power)[0]) / peak)
+    return 20 * np.log10(_model_abs(omega, wn, zeta, power) / peak)
 
 
 def _model_crossing(omega, curve, level_db):
@@ -328,15 +389,17 @@ def _model_crossing(omega, curve, level_db):
     return float(_crossing(omega, curve, level_db, j, j + 1))
 
 
-def _plan(omega, mag, db, power, i, peak_lines, noise_std, model=None):
+def _plan(omega, mag, db, power, i, peak_lines, noise_std, model=None, peak2=None):
     """The choices of the crossings for a given peak fit; and the lines above the level.
 
     ``model``: a first estimate (ωn, ζ) whose curve chooses the lines of each fitted
     crossing (within ±1 dB of −3 dB on the model), so that the noise on a line does not
     decide whether it enters (selecting on the noisy dB trims the noise the fit sees).
+    ``peak2``: the peak fit's |H|² on these lines, when the caller has it.
     """
     n = mag.size
-    _, peak2 = (float(v[0]) for v in _peak_values(omega, mag[None, :], _Plan(i, peak_lines, None, None), power))
+    if peak2 is None:
+        _, peak2 = (float(v[0]) for v in _peak_values(omega, mag[None, :], _Plan(i, peak_lines, None, None), power))
     level = np.sqrt(peak2 / 2)
     level_db = 10 * np.log10(peak2 / 2)
     lo = i
@@ -398,6 +461,7 @@ def half_power_curve(omega: np.ndarray, h: np.ndarray, power: int, noise_std: fl
         flags.append("band_edge_peak")
     db = 20 * np.log10(np.maximum(mag, np.finfo(float).tiny))
     plan, n_above = _plan(omega, mag, db, power, i, _choose_peak(omega, mag, i, power), noise_std)
+    evaluated = None  # the last plan evaluated, with its (ωn, ζ, ω1, ω2)
     for _ in range(MODEL_PASSES):
         # further passes: the peak fit on the lines within 1 dB of the last estimate's model
         # peak (|ω − ωn| ≤ ζωn/2), and the crossing fits on the lines within ±1 dB of −3 dB on
@@ -407,7 +471,9 @@ def half_power_curve(omega: np.ndarray, h: np.ndarray, power: int, noise_std: fl
         if plan.left is None or plan.right is None:
             break
         with np.errstate(all="ignore"):
-            wn1, zeta1 = (float(v[0]) for v in _evaluate(omega, mag[None, :], power, plan))
+            values = tuple(float(v[0]) for v in _evaluate_sides(omega, mag[None, :], power, plan))
+        evaluated = (plan, values)
+        wn1, zeta1 = values[:2]
         if not (np.isfinite(wn1) and np.isfinite(zeta1) and zeta1 > 0):
             break
         near = np.flatnonzero(np.abs(omega - wn1) <= 0.5 * zeta1 * wn1)
@@ -418,14 +484,17 @@ def half_power_curve(omega: np.ndarray, h: np.ndarray, power: int, noise_std: fl
         if not (np.isfinite(u_star) and omega[lines[0]] ** 2 <= u_star <= omega[lines[1]] ** 2 and peak2 > 0):
             break
         previous = plan
-        plan, n_above = _plan(omega, mag, db, power, i, lines, noise_std, (wn1, zeta1))
+        plan, n_above = _plan(omega, mag, db, power, i, lines, noise_std, (wn1, zeta1), peak2)
         if _same_plan(plan, previous):
             break
     if n_above < 3:
         flags.append("resolution_limited")
     if plan.left is None or plan.right is None:
         flags.append("missing_crossing")
-    wn, zeta = (float(v[0]) for v in _evaluate(omega, mag[None, :], power, plan))
+    if evaluated is not None and _same_plan(evaluated[0], plan):  # the same lines: the same numbers
+        wn, zeta, *crossings = evaluated[1]
+    else:
+        wn, zeta, *crossings = (float(v[0]) for v in _evaluate_sides(omega, mag[None, :], power, plan))
     std_wn = std_zeta = np.nan
     if not errors:
         return HalfPowerEstimate(float(wn), float(zeta), std_wn, std_zeta, n_above, tuple(flags), None)
@@ -435,9 +504,6 @@ def half_power_curve(omega: np.ndarray, h: np.ndarray, power: int, noise_std: fl
         var = (noise_std**2 / 2) * np.sum(jac**2, axis=1)
         std_wn, std_zeta = float(np.sqrt(var[0])), float(np.sqrt(var[1]))
     with np.errstate(all="ignore"):
-        mag_db = 20 * np.log10(np.maximum(mag, np.finfo(float).tiny))[None, :]
-        level_now = 10 * np.log10(_peak_values(omega, mag[None, :], plan, power)[1] / 2)
-        crossings = [float(_side_value(omega, mag_db, level_now, side)[0]) for side in (plan.left, plan.right)]
         shift = _interpolation_shift(omega, power, plan, (wn, zeta), crossings)
     if np.any(shift != 0) and np.isfinite(std_wn) and np.isfinite(std_zeta):
         # a crossing interpolated linearly in dB between two lines is off by the curvature of

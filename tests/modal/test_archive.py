@@ -167,3 +167,17 @@ def test_every_renamed_class_has_a_home(old):
 
     cls = _class_from(old)
     assert f"{cls.__module__}:{cls.__qualname__}" == RENAMED_CLASSES[old]
+
+
+def test_attributes_stored_as_other_strings_read_alike(tmp_path, result):
+    # the reader takes its text attributes (types, units, classes) by h5py's low-level calls where they are one
+    # UTF-8 variable-length string, as the toolkit writes them; an archive whose tool stored them otherwise
+    # (fixed-length ASCII, variable-length ASCII) must read the same
+    path = tmp_path / "a.h5"
+    write_archive(path, {"identify": result})
+    with h5py.File(path, "r+") as f:
+        mode = f["identify/modes/0"]
+        mode.attrs["__type__"] = np.bytes_("dataclass")  # fixed-length
+        mode.attrs.create("__class__", str(mode.attrs["__class__"]).encode(), dtype=h5py.string_dtype("ascii"))
+        f["identify/modes/0/mass_kg"].attrs["units"] = np.bytes_("kg")
+    assert _equal(read_archive(path)["identify"], result)

@@ -30,3 +30,21 @@ def test_whitening_keeps_a_long_correlation_as_it_is():
     assert abs(np.mean(np.abs(whitened) ** 2) - 1) < 5 * 0.0035
     lag1 = np.vdot(whitened[:-1], whitened[1:]) / np.vdot(whitened, whitened)
     assert abs(lag1) < 5 * 0.0025 * np.sqrt(2)
+
+
+def test_whitening_solves_as_solve_banded_on_every_call():
+    # the band LU of the factor is formed once and reused (gbsv is gbtrf then gbtrs): every call, a matrix or
+    # a vector, real or complex, must give solve_banded's numbers bit for bit
+    from scipy.linalg import solve_banded
+
+    n, rng = 60, np.random.default_rng(4)
+    band = np.zeros((4, n), complex)
+    band[0] = 1.0
+    band[1, :-1], band[2, :-2], band[3, :-3] = 0.4 + 0.1j, 0.15 - 0.05j, 0.05
+    whitening = LineWhitening(band)
+    assert whitening.bandwidth == 3
+    for values in (rng.standard_normal((n, 5)) + 1j * rng.standard_normal((n, 5)), rng.standard_normal(n),
+                   rng.standard_normal((n, 2)), rng.standard_normal(n) + 1j * rng.standard_normal(n)):
+        expected = solve_banded((3, 0), whitening._factor, values)
+        got = whitening(values)
+        assert got.shape == values.shape and np.array_equal(got, expected)

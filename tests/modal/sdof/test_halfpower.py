@@ -39,3 +39,28 @@ def test_half_power_crossing_stays_on_its_side_of_the_peak():
     for mode, band in zip(result, [(0.16, 2.66), (34.48, 271.86)]):
         assert np.isfinite(mode.natural_frequency_hz) and np.isfinite(mode.damping_ratio)
         assert band[0] <= mode.natural_frequency_hz <= band[1]
+
+
+def test_model_curves_are_those_of_every_sample():
+    # the model's peak and its exact −3 dB crossings are computed on the samples around them (a coarse pass
+    # locates them): the same numbers as the largest of all the samples and the interpolation over all of them
+    from modal.model import mode_basis
+    from modal.sdof.halfpower import CROSSING_SAMPLES, PEAK_SAMPLES, _exact_crossing, _model_db, _model_peak
+
+    rng = np.random.default_rng(8)
+    level = -10 * np.log10(2)
+    for _ in range(200):
+        power, wn = int(rng.integers(0, 3)), float(rng.uniform(10, 1e4))
+        zeta = float(10 ** rng.uniform(-4, np.log10(0.75)))
+        first, last = sorted(rng.uniform(0.2, 1.8, 2) * wn)
+        peak = _model_peak.__wrapped__(first, last, power, wn, zeta)
+        assert peak == np.abs(mode_basis(np.linspace(first, last, PEAK_SAMPLES), wn, zeta, power)[0]).max()
+        lines = np.linspace(first, last, int(rng.integers(5, 40)))
+        model = _model_db(lines, power, (wn, zeta))
+        for a in range(lines.size - 1):
+            if min(model[a], model[a + 1]) <= level <= max(model[a], model[a + 1]):
+                fine = np.linspace(lines[a], lines[a + 1], CROSSING_SAMPLES)
+                curve = _model_db(fine, power, (wn, zeta), reference=lines)
+                order = np.argsort(curve)
+                expected = float(np.interp(level, curve[order], fine[order]))
+                assert _exact_crossing(lines[a], lines[a + 1], power, (wn, zeta), lines, level) == expected
