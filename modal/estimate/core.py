@@ -36,6 +36,7 @@ from .periodic import repeats_every, shortest_period
 from .quiet import quiet_noise
 from .takes import find_hits_in_takes, hit_labels, segment_starts, take_bounds
 from .takes import take_names as _take_names
+from .rise import rise_tests
 from .unrelated import chance_tests, warn_unrelated
 from .windows import WINDOWS, exponential_window, force_window, segment_window
 
@@ -97,9 +98,11 @@ class EstimatedFRF(FRF):
         Impact records reject the hits they touch; continuous records warn.
     unrelated : list of dict
         Response channels unrelated to the force (a dead or unplugged sensor: their coherence no higher
-        than chance, :mod:`modal.estimate.unrelated`), warned: ``channel``, ``mean_coherence`` (over the
-        ``lines`` driven lines), ``chance`` and ``chance_se`` (its mean and standard error under no
-        relation), ``records``.
+        than chance, :mod:`modal.estimate.unrelated`, and for hits no rise of their power at the triggers,
+        :mod:`modal.estimate.rise`), warned: ``channel``, ``mean_coherence`` (over the ``lines`` driven
+        lines), ``chance`` and ``chance_se`` (its mean and standard error under no relation), ``records``
+        (None where too few records or lines), ``rise`` and ``rise_log_se`` (hits: the power ratio and the
+        standard error of its log under no relation; None otherwise).
     """
 
     coherence: np.ndarray | None = None
@@ -652,8 +655,9 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
     factor = spectra.overlap_variance_factor(out_w, step) if not impact else 1.0
     estimate = {"H1": spectra.h1, "H2": spectra.h2, "Hv": spectra.hv}[estimator]
     frf3, coherence3, multiple, variance3 = estimate(sums, source)
+    rises = rise_tests(y, hits.trigger_index, hits.accepted, length, hits.pulse_samples, fs) if impact else []
     unrelated = warn_unrelated(chance_tests(sums, multiple, output_correlation, factor),
-                               labels[x.shape[0]:], x.shape[0], impact, source)
+                               labels[x.shape[0]:], x.shape[0], impact, source, rises)
     n_out, n_in, n_lines = frf3.shape
     frequency = np.fft.rfftfreq(length, 1.0 / fs)
     response_lines = frf3.reshape(n_out * n_in, n_lines)
