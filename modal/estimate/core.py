@@ -30,7 +30,7 @@ from .common_error import common_error_factor
 from .error_correlation import LEAKAGE_LAGS, MIN_RECORDS, measured_line_correlation
 from .record_influence import MAX_INFLUENCE_VALUES, channel_influence, overlapping_records, record_influence
 from .hits import find_hits, pulse_train, reject_pulses_the_window_cuts
-from .levels import change_dependence, level_dependence, take_dependence
+from .levels import FAMILY_LEVEL, MIN_HITS, change_dependence, hit_spectra, level_dependence, take_dependence
 from .overload import find_overloads
 from .periodic import repeats_every, shortest_period
 from .quiet import quiet_noise
@@ -385,9 +385,9 @@ def _refuse_swapped_channels(force, response, sample_rate_hz, labels, source) ->
 
 
 def _warn_level_dependence(force, response, starts, length, input_window, output_window, sample_rate_hz, labels,
-                           source) -> None:
+                           source, spectra) -> None:
     """Warn where the hits' FRFs change with their force level beyond the noise (:mod:`.levels`)."""
-    test = level_dependence(force, response, starts, length, input_window, output_window, sample_rate_hz)
+    test = level_dependence(force, response, starts, length, input_window, output_window, sample_rate_hz, spectra)
     if test is None or not test.level_dependent:
         return
     low, high = test.force_range
@@ -399,25 +399,43 @@ def _warn_level_dependence(force, response, starts, length, input_window, output
 
 
 def _warn_change_dependence(force, response, starts, hit_numbers, hit_times_s, length, input_window, output_window,
-                            sample_rate_hz, labels, source) -> None:
-    """Warn where one record's hits change FRF part way through beyond the noise
+                            sample_rate_hz, labels, source, spectra, take: str = "", family_level=FAMILY_LEVEL) -> None:
+    """Warn where one record's (or one ``take``'s) hits change FRF part way through beyond the noise
     (:func:`.levels.change_dependence`)."""
-    test = change_dependence(force, response, starts, length, input_window, output_window, sample_rate_hz)
+    test = change_dependence(force, response, starts, length, input_window, output_window, sample_rate_hz, spectra,
+                             family_level)
     if test is None or not test.changed:
         return
     before, after = hit_numbers[test.first_after - 1], hit_numbers[test.first_after]
     at, where = hit_times_s[test.first_after], labels[len(labels) - response.shape[0] + test.output]
-    warn(f"{source}: the hits' FRF changes between hit {before} and hit {after} (at {at:.3f} s) beyond its noise "
+    warn(f"{source}: {take}the hits' FRF changes between hit {before} and hit {after} (at {at:.3f} s) beyond its noise "
          f"({where} at {test.frequency_hz:.4g} Hz by {100 * test.change:.0f} %, F-test p = {test.p_value:.2g} "
          f"against {test.limit:.2g} over {test.n_lines} {'resonant ' if test.resonant else ''}lines and "
          f"{test.n_hits - 1} places): the hammer or a sensor moved, or the structure changed, during the record, "
          "and the average mixes two FRFs; estimate the hits before and after apart", QualityWarning)
 
 
+def _warn_changes_within_takes(force, response, starts, take_of_hit, hits, bounds, take_names, length, input_window,
+                               output_window, sample_rate_hz, labels, source, spectra) -> None:
+    """Test each take of :data:`.levels.MIN_HITS` hits or more for a change part way through, as one record's hits
+    are, the family-wise level spread over those takes; hits and times counted within the take."""
+    counts = np.bincount(take_of_hit, minlength=bounds.size - 1)
+    tested = np.flatnonzero(counts >= MIN_HITS)
+    named = hit_labels(hits, bounds, take_names, sample_rate_hz)
+    named = [item for item, kept in zip(named, hits.accepted) if kept]
+    for t in tested:
+        index = np.flatnonzero(take_of_hit == t)
+        _warn_change_dependence(force, response, starts[index], [named[i]["hit"] for i in index],
+                                [named[i]["time_s"] for i in index], length, input_window, output_window,
+                                sample_rate_hz, labels, source, None if spectra is None else spectra.of_hits(index),
+                                take=f"{take_names[t]}: ", family_level=FAMILY_LEVEL / tested.size)
+
+
 def _warn_take_dependence(force, response, starts, take_of_hit, length, input_window, output_window,
-                          sample_rate_hz, labels, take_names, source) -> None:
+                          sample_rate_hz, labels, take_names, source, spectra) -> None:
     """Warn where the takes' hits do not share one FRF beyond the noise (:func:`.levels.take_dependence`)."""
-    test = take_dependence(force, response, starts, take_of_hit, length, input_window, output_window, sample_rate_hz)
+    test = take_dependence(force, response, starts, take_of_hit, length, input_window, output_window, sample_rate_hz,
+                           spectra)
     if test is None or not test.takes_differ:
         return
     names = ", ".join(take_names[t] for t in sorted(set(int(t) for t in take_of_hit)))
@@ -629,14 +647,18 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
             warn(f"{source}: {item.describe(labels[item.channel])}: the spectra are distorted where it clipped; "
                  "lower the gain or the excitation level", QualityWarning)
 
-    if impact:
-        _warn_level_dependence(x[0], y, starts, length, in_w, out_w, fs, labels, source)
+    if impact and starts.size >= MIN_HITS:  # the hits' spectra over the force's band, once for all three tests
+        band = hit_spectra(x[0], y, starts, length, in_w, out_w)
+        _warn_level_dependence(x[0], y, starts, length, in_w, out_w, fs, labels, source, band)
         if bounds.size <= 2:  # one record: did its FRF change part way through?
             _warn_change_dependence(x[0], y, starts, np.flatnonzero(hits.accepted) + 1, hit_times, length, in_w,
-                                    out_w, fs, labels, source)
-        else:  # several takes: do they measure one FRF?
-            _warn_take_dependence(x[0], y, starts, np.searchsorted(bounds, starts, side="right") - 1, length, in_w,
-                                  out_w, fs, labels, names_of_takes, source)
+                                    out_w, fs, labels, source, band)
+        else:  # several takes: do they measure one FRF, and did one's change part way through?
+            take_of_hit = np.searchsorted(bounds, starts, side="right") - 1
+            _warn_take_dependence(x[0], y, starts, take_of_hit, length, in_w, out_w, fs, labels, names_of_takes, source,
+                                  band)
+            _warn_changes_within_takes(x[0], y, starts, take_of_hit, hits, bounds, names_of_takes, length, in_w, out_w,
+                                       fs, labels, source, band)
     output_correlation = window_line_correlation(out_w)
     window_lags = lags_carried(output_correlation, length // 2 + 1)
     # continuous records, enough of them: the errors' correlation is also measured over the records
