@@ -83,6 +83,11 @@ class HitSpectra:
     lines: np.ndarray
     peaks: np.ndarray
 
+    @property
+    def force_power(self) -> np.ndarray:
+        """|force|² of each hit's line, (hits, band lines)."""
+        return np.abs(self.force) ** 2
+
     def of_hits(self, index) -> "HitSpectra":
         """The spectra of the hits ``index`` (a take's) alone, on the same lines."""
         return HitSpectra(self.force[index], self.responses[:, index], self.lines, self.peaks[index])
@@ -90,19 +95,8 @@ class HitSpectra:
 
 def hit_spectra(force, response, starts, length: int, input_window, output_window) -> HitSpectra | None:
     """The hits' spectra over the force's band (:class:`HitSpectra`), or None where the band is empty or the
-    spectra would exceed :data:`MAX_SPECTRUM_VALUES` (hits × lines × channels).
-
-    Parameters
-    ----------
-    force : ndarray, shape (n_samples,)
-    response : array_like, shape (n_outputs, n_samples)
-    starts : ndarray of int
-        First sample of each accepted hit's record.
-    length : int
-        Samples per record.
-    input_window, output_window : ndarray, shape (length,)
-        The windows the estimate applied.
-    """
+    spectra would exceed :data:`MAX_SPECTRUM_VALUES` (hits × lines × channels). Parameters as
+    :func:`level_dependence`'s."""
     starts = np.asarray(starts, int)
     n_out = np.shape(response)[0]
     if starts.size * (length // 2 + 1) * (n_out + 1) > MAX_SPECTRUM_VALUES:
@@ -193,12 +187,10 @@ def level_dependence(force, response, starts, length: int, input_window, output_
     n = np.size(starts)
     if n < MIN_HITS:
         return None
+    spectra = spectra or hit_spectra(force, response, starts, length, input_window, output_window)
     if spectra is None:
-        spectra = hit_spectra(force, response, starts, length, input_window, output_window)
-        if spectra is None:
-            return None
-    peaks, lines, Xb = spectra.peaks, spectra.lines, spectra.force
-    n_out = spectra.responses.shape[0]
+        return None
+    peaks, lines, Xb, n_out = spectra.peaks, spectra.lines, spectra.force, spectra.responses.shape[0]
     if not (np.all(peaks > 0) and peaks.max() >= MIN_LEVEL_RATIO * peaks.min()):
         return None
     u = np.log(peaks) - np.mean(np.log(peaks))
@@ -275,13 +267,10 @@ def take_dependence(force, response, starts, take_of_hit, length: int, input_win
     n_takes = labels.size
     if n_takes < 2 or n - n_takes < 2:
         return None
+    spectra = spectra or hit_spectra(force, response, starts, length, input_window, output_window)
     if spectra is None:
-        spectra = hit_spectra(force, response, starts, length, input_window, output_window)
-        if spectra is None:
-            return None
-    lines, Xb = spectra.lines, spectra.force
-    n_out = spectra.responses.shape[0]
-    Pb = np.abs(Xb) ** 2
+        return None
+    lines, Xb, Pb, n_out = spectra.lines, spectra.force, spectra.force_power, spectra.responses.shape[0]
     member = np.eye(n_takes)[takes]  # (hits, takes)
     s_xx_t = member.T @ Pb  # (takes, lines)
     best = (np.inf, 0.0, 0)
@@ -367,13 +356,10 @@ def change_dependence(force, response, starts, length: int, input_window, output
     n = np.size(starts)
     if n < MIN_HITS:
         return None
+    spectra = spectra or hit_spectra(force, response, starts, length, input_window, output_window)
     if spectra is None:
-        spectra = hit_spectra(force, response, starts, length, input_window, output_window)
-        if spectra is None:
-            return None
-    lines, Xb = spectra.lines, spectra.force
-    n_out = spectra.responses.shape[0]
-    Pb = np.abs(Xb) ** 2
+        return None
+    lines, Xb, Pb, n_out = spectra.lines, spectra.force, spectra.force_power, spectra.responses.shape[0]
     # the hits before each place j = 1 … n − 1 (rows), summed over the hits by running sums
     p_before = np.cumsum(Pb, axis=0)[:-1]
     p_total = p_before[-1] + Pb[-1]
