@@ -41,16 +41,17 @@ __all__ = ["RiseTest", "rise_tests", "RISE_SIGMAS", "AFTER_FRACTION", "GUARD_PUL
 #: normal (its windows hold tens to hundreds of degrees of freedom), so 5 are passed by chance less than once
 #: in a million channels, and an error of 2 in the variance (a mis-estimated ν) still leaves chance below 1e-3
 RISE_SIGMAS = 5.0
-#: the after-window is this fraction of the hit record from the trigger: a lightly damped mode keeps ringing
-#: past it, a well damped one has decayed within it; a shorter window would hold fewer degrees of freedom
+#: the after-window is this fraction of the hit record, centred on the trigger: a lightly damped mode keeps
+#: ringing past it, a well damped one has decayed within it; a shorter window would hold fewer degrees of freedom
 AFTER_FRACTION = 1.0 / 8.0
 #: the before-window ends this many pulse widths before the after-window, and starts as many after the previous
 #: hit's after-window (the force, and so the response, starts below the trigger level)
 GUARD_PULSES = 2
 #: a line of the before-windows' mean spectrum above this many times its neighbours' median is a tone. Lines
-#: are dropped by the before-windows' own power, so a noise line dropped by chance biases R upwards: the mean of
-#: K exponential variables exceeds 10 times their median with probability 5e-5 (K = 1) or below (K ≥ 2), about
-#: one line in a channel's hundreds; a weaker tone holds too little of the power to matter
+#: are dropped by the before-windows' own power, so a noise line dropped by chance biases R upwards: one
+#: exponential variable exceeds 10 times the median of its kind (6.9 times its mean) with probability 1e-3, the
+#: mean of 2 with 1e-6 (a dead channel of 1 hit loses about one line in eight channels of 128 lines, and with it
+#: about 5 % of one line's share of Ē_b); a weaker tone holds too little of the power to matter
 TONE_RATIO = 10.0
 #: before-windows shorter than this are not read (the periodogram of fewer samples tells ν poorly)
 MIN_BEFORE_SAMPLES = 32
