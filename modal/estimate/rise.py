@@ -50,8 +50,8 @@ GUARD_PULSES = 2
 #: a line of the before-windows' mean spectrum above this many times its neighbours' median is a tone. Lines
 #: are dropped by the before-windows' own power, so a noise line dropped by chance biases R upwards: one
 #: exponential variable exceeds 10 times the median of its kind (6.9 times its mean) with probability 1e-3, the
-#: mean of 2 with 1e-6 (a dead channel of 1 hit loses about one line in eight channels of 128 lines, and with it
-#: about 5 % of one line's share of Ē_b); a weaker tone holds too little of the power to matter
+#: mean of 2 with 1e-6 (one before-window of 128 lines: a noise line lost in one dead channel of eight, Ē_b
+#: then low by about 5 %); a weaker tone holds too little of the power to matter
 TONE_RATIO = 10.0
 #: before-windows shorter than this are not read (the periodogram of fewer samples tells ν poorly)
 MIN_BEFORE_SAMPLES = 32
