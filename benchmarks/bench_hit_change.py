@@ -1,6 +1,6 @@
 """One hammer record whose FRF changes part way through: false alarms and detection of the estimate's warning.
 
-Run ``python -m benchmarks.bench_hit_change [--records N]``.
+Run ``python -m benchmarks.bench_hit_change [--records N] [--takes]``.
 
 Three modes (40, 95 and 170 Hz; ζ 3, 2 and 1.5 %) seen by two accelerometers, hits 3-3.5 s apart (jittered, as
 a hand's are: hits in step with the mains would make its hum look like a change with the force) at 2048 Hz,
@@ -13,6 +13,10 @@ warning "the hits' FRF changes between hit ..." (:func:`modal.estimate.levels.ch
 False alarms: one point throughout. Detection: from hit n/2 + 1 on, sensor 2's first modal constant is
 multiplied by ``change`` (a sensor sliding towards a node or knocked loose), or every constant of both sensors
 changes (the hammer moved to another point).
+
+``--takes``: each record two takes of ``hits`` hits joined (``take_lengths``, as files of one point), the
+change (if any) within the second take from its hit n/2 + 1 on; counted are the change warning (each take of
+4 hits or more tested for a change part way through) and the takes' warning ("the takes' FRFs differ").
 """
 from __future__ import annotations
 
@@ -78,11 +82,54 @@ def warned(records: int, first_seed: int, **case) -> int:
     return count
 
 
+def warned_in_takes(records: int, first_seed: int, change, **case) -> tuple[int, int]:
+    """Of ``records`` two-take records: how many raise the change warning, and how many the takes' warning."""
+    counts = [0, 0]
+    for seed in range(first_seed, first_seed + records):
+        rng = np.random.default_rng(seed)
+        f1, r1 = hammer_record(rng, change=None, **case)
+        f2, r2 = hammer_record(rng, change=change, **case)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            modal.estimate_frf(np.concatenate([f1, f2]), np.hstack([r1, r2]), SAMPLE_RATE_HZ, impact=True,
+                               window="force", kind="accelerance", take_lengths=[f1.size, f2.size])
+        said = [str(w.message) for w in caught]
+        counts[0] += any(MESSAGE in m for m in said)
+        counts[1] += any("the takes' FRFs differ" in m for m in said)
+    return counts[0], counts[1]
+
+
+def takes_table(n: int) -> None:
+    """The two-take table (``--takes``)."""
+    print("| hits per take | constants' scatter | hum, AC | force / response noise | change | change warned "
+          "| takes differ |")
+    print("|---|---|---|---|---|---|---|")
+    for hits in (4, 6, 10):
+        for scatter in (0.0, 0.03):
+            for hum, ac in ((0.0, 0.0), (0.005, 0.3)):
+                for force_noise, response_noise in ((0.002, 0.002), (0.01, 0.03)):
+                    found, differ = warned_in_takes(n, 2000, None, n_hits=hits, scatter=scatter, hum=hum, ac_s=ac,
+                                                    force_noise=force_noise, response_noise=response_noise)
+                    print(f"| {hits} | {scatter:.0%} | {'yes' if hum else 'no'} | {force_noise:.1%} / "
+                          f"{response_noise:.1%} | none | {found} of {n} | {differ} of {n} |", flush=True)
+    for hits in (4, 6, 10):
+        for change in (0.5, 0.7, 0.9):
+            factor = np.array([[1.0, 1.0, 1.0], [change, 1.0, 1.0]])
+            found, differ = warned_in_takes(n, 3000, factor, n_hits=hits, scatter=0.0, hum=0.0, ac_s=0.0,
+                                            force_noise=0.002, response_noise=0.002)
+            print(f"| {hits} | 0% | no | 0.2% / 0.2% | take 2, sensor 2, mode 1 × {change:g} | {found} of {n} | "
+                  f"{differ} of {n} |", flush=True)
+
+
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--records", type=int, default=20, help="records per case")
+    parser.add_argument("--takes", action="store_true", help="two-take records, the change within the second")
     args = parser.parse_args(argv)
     n = args.records
+    if args.takes:
+        takes_table(n)
+        return
     print("| hits | constants' scatter | hum, AC | force / response noise | change | warned |")
     print("|---|---|---|---|---|---|")
     case_index = 0

@@ -32,12 +32,15 @@ from .error_correlation import LEAKAGE_LAGS, MIN_RECORDS, measured_line_correlat
 from .record_influence import MAX_INFLUENCE_VALUES, channel_influence, overlapping_records, record_influence
 from .hits import find_hits, pulse_train, reject_pulses_the_window_cuts
 from .roles import refuse_swapped_channels, warn_impulsive_responses
-from .levels import change_dependence, level_dependence, take_dependence
+from .levels import MIN_HITS, hit_spectra
+from .level_warnings import (warn_change_dependence, warn_changes_within_takes, warn_level_dependence,
+                             warn_take_dependence)
 from .overload import find_overloads
 from .periodic import repeats_every, shortest_period
 from .quiet import quiet_noise
 from .takes import find_hits_in_takes, hit_labels, segment_starts, take_bounds
 from .takes import take_names as _take_names
+from .rise import rise_tests
 from .unrelated import chance_tests, warn_unrelated
 from .windows import WINDOWS, exponential_window, force_window, segment_window
 
@@ -99,9 +102,11 @@ class EstimatedFRF(FRF):
         Impact records reject the hits they touch; continuous records warn.
     unrelated : list of dict
         Response channels unrelated to the force (a dead or unplugged sensor: their coherence no higher
-        than chance, :mod:`modal.estimate.unrelated`), warned: ``channel``, ``mean_coherence`` (over the
-        ``lines`` driven lines), ``chance`` and ``chance_se`` (its mean and standard error under no
-        relation), ``records``.
+        than chance, :mod:`modal.estimate.unrelated`, and for hits no rise of their power at the triggers,
+        :mod:`modal.estimate.rise`), warned: ``channel``, ``mean_coherence`` (over the ``lines`` driven
+        lines), ``chance`` and ``chance_se`` (its mean and standard error under no relation), ``records``
+        (None where too few records or lines), ``rise`` and ``rise_log_se`` (hits: the power ratio and the
+        standard error of its log under no relation; None otherwise).
     """
 
     coherence: np.ndarray | None = None
@@ -364,50 +369,6 @@ def _warn_excitation_noise(sums, name: str, source: str) -> None:
              "longer segments", QualityWarning)
 
 
-def _warn_level_dependence(force, response, starts, length, input_window, output_window, sample_rate_hz, labels,
-                           source) -> None:
-    """Warn where the hits' FRFs change with their force level beyond the noise (:mod:`.levels`)."""
-    test = level_dependence(force, response, starts, length, input_window, output_window, sample_rate_hz)
-    if test is None or not test.level_dependent:
-        return
-    low, high = test.force_range
-    warn(f"{source}: the FRF changes with the force of the hit beyond its noise (nonlinearity: {test.n_hits} hits "
-         f"from {low:.3g} to {high:.3g} in the force's unit; {labels[len(labels) - response.shape[0] + test.output]} "
-         f"at {test.frequency_hz:.4g} Hz, F-test p = {test.p_value:.2g} against {test.limit:.2g} over "
-         f"{test.n_lines} lines): the average mixes the structure's states; estimate hits of one force level "
-         "together, or hit alike", QualityWarning)
-
-
-def _warn_change_dependence(force, response, starts, hit_numbers, hit_times_s, length, input_window, output_window,
-                            sample_rate_hz, labels, source) -> None:
-    """Warn where one record's hits change FRF part way through beyond the noise
-    (:func:`.levels.change_dependence`)."""
-    test = change_dependence(force, response, starts, length, input_window, output_window, sample_rate_hz)
-    if test is None or not test.changed:
-        return
-    before, after = hit_numbers[test.first_after - 1], hit_numbers[test.first_after]
-    at, where = hit_times_s[test.first_after], labels[len(labels) - response.shape[0] + test.output]
-    warn(f"{source}: the hits' FRF changes between hit {before} and hit {after} (at {at:.3f} s) beyond its noise "
-         f"({where} at {test.frequency_hz:.4g} Hz by {100 * test.change:.0f} %, F-test p = {test.p_value:.2g} "
-         f"against {test.limit:.2g} over {test.n_lines} {'resonant ' if test.resonant else ''}lines and "
-         f"{test.n_hits - 1} places): the hammer or a sensor moved, or the structure changed, during the record, "
-         "and the average mixes two FRFs; estimate the hits before and after apart", QualityWarning)
-
-
-def _warn_take_dependence(force, response, starts, take_of_hit, length, input_window, output_window,
-                          sample_rate_hz, labels, take_names, source) -> None:
-    """Warn where the takes' hits do not share one FRF beyond the noise (:func:`.levels.take_dependence`)."""
-    test = take_dependence(force, response, starts, take_of_hit, length, input_window, output_window, sample_rate_hz)
-    if test is None or not test.takes_differ:
-        return
-    names = ", ".join(take_names[t] for t in sorted(set(int(t) for t in take_of_hit)))
-    warn(f"{source}: the takes' FRFs differ beyond their noise ({names}: "
-         f"{labels[len(labels) - response.shape[0] + test.output]} at {test.frequency_hz:.4g} Hz, F-test p = "
-         f"{test.p_value:.2g} against {test.limit:.2g} over {test.n_lines} lines): they do not measure one FRF "
-         "(a hit point labelled twice, a sensor moved or the structure changed between them); estimate them apart",
-         QualityWarning)
-
-
 def _default_segment_length(n_samples: int) -> int:
     """Largest power of two giving at least 16 half-overlapping segments (at least 16 samples)."""
     return 1 << max(4, int(np.floor(np.log2(max(n_samples / 8.5, 16)))))
@@ -620,14 +581,18 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
             warn(f"{source}: {item.describe(labels[item.channel])}: the spectra are distorted where it clipped; "
                  "lower the gain or the excitation level", QualityWarning)
 
-    if impact:
-        _warn_level_dependence(x[0], y, starts, length, in_w, out_w, fs, labels, source)
+    if impact and starts.size >= MIN_HITS:  # the hits' spectra over the force's band, once for all three tests
+        band = hit_spectra(x[0], y, starts, length, in_w, out_w)
+        warn_level_dependence(x[0], y, starts, length, in_w, out_w, fs, labels, source, band)
         if bounds.size <= 2:  # one record: did its FRF change part way through?
-            _warn_change_dependence(x[0], y, starts, np.flatnonzero(hits.accepted) + 1, hit_times, length, in_w,
-                                    out_w, fs, labels, source)
-        else:  # several takes: do they measure one FRF?
-            _warn_take_dependence(x[0], y, starts, np.searchsorted(bounds, starts, side="right") - 1, length, in_w,
-                                  out_w, fs, labels, names_of_takes, source)
+            warn_change_dependence(x[0], y, starts, np.flatnonzero(hits.accepted) + 1, hit_times, length, in_w,
+                                    out_w, fs, labels, source, band)
+        else:  # several takes: do they measure one FRF, and did one's change part way through?
+            take_of_hit = np.searchsorted(bounds, starts, side="right") - 1
+            warn_take_dependence(x[0], y, starts, take_of_hit, length, in_w, out_w, fs, labels, names_of_takes, source,
+                                  band)
+            warn_changes_within_takes(x[0], y, starts, take_of_hit, hits, bounds, names_of_takes, length, in_w, out_w,
+                                       fs, labels, source, band)
     output_correlation = window_line_correlation(out_w)
     window_lags = lags_carried(output_correlation, length // 2 + 1)
     # continuous records, enough of them: the errors' correlation is also measured over the records
@@ -646,8 +611,9 @@ def estimate_frf(excitation, response, sample_rate_hz: float, *, estimator: str 
     factor = spectra.overlap_variance_factor(out_w, step) if not impact else 1.0
     estimate = {"H1": spectra.h1, "H2": spectra.h2, "Hv": spectra.hv}[estimator]
     frf3, coherence3, multiple, variance3 = estimate(sums, source)
+    rises = rise_tests(y, hits.trigger_index, hits.accepted, length, hits.pulse_samples, fs) if impact else []
     unrelated = warn_unrelated(chance_tests(sums, multiple, output_correlation, factor),
-                               labels[x.shape[0]:], x.shape[0], impact, source)
+                               labels[x.shape[0]:], x.shape[0], impact, source, rises)
     n_out, n_in, n_lines = frf3.shape
     frequency = np.fft.rfftfreq(length, 1.0 / fs)
     response_lines = frf3.reshape(n_out * n_in, n_lines)

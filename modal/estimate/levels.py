@@ -33,7 +33,8 @@ import numpy as np
 
 from ..quantiles import f_survival
 
-__all__ = ["LevelTest", "TakeTest", "ChangeTest", "level_dependence", "take_dependence", "change_dependence",
+__all__ = ["HitSpectra", "hit_spectra", "LevelTest", "TakeTest", "ChangeTest", "level_dependence", "take_dependence",
+           "change_dependence",
            "FAMILY_LEVEL", "MIN_LEVEL_RATIO", "MIN_HITS", "MATERIAL_CHANGE", "MAX_SPECTRUM_VALUES",
            "RESONANT_POWER_RATIO"]
 
@@ -59,6 +60,54 @@ MAX_SPECTRUM_VALUES = 1 << 22
 #: lines tested: those where every hit's force spectrum is at least this fraction of its largest (the hammer's
 #: band; above it the force is noise and the FRF undefined)
 FORCE_BAND_FRACTION = 0.1
+
+
+@dataclass(frozen=True)
+class HitSpectra:
+    """The hits' transforms over the force's band, computed once for the level, take and change tests.
+
+    Attributes
+    ----------
+    force : ndarray, shape (hits, band lines)
+        The windowed force records' transforms on the band's lines.
+    responses : ndarray, shape (outputs, hits, band lines)
+        The windowed response records' transforms on the same lines.
+    lines : ndarray of int
+        The band's lines (:func:`_force_band`).
+    peaks : ndarray, shape (hits,)
+        Each hit record's largest |force|, the force's unit (before windowing).
+    """
+
+    force: np.ndarray
+    responses: np.ndarray
+    lines: np.ndarray
+    peaks: np.ndarray
+
+    @property
+    def force_power(self) -> np.ndarray:
+        """|force|² of each hit's line, (hits, band lines)."""
+        return np.abs(self.force) ** 2
+
+    def of_hits(self, index) -> "HitSpectra":
+        """The spectra of the hits ``index`` (a take's) alone, on the same lines."""
+        return HitSpectra(self.force[index], self.responses[:, index], self.lines, self.peaks[index])
+
+
+def hit_spectra(force, response, starts, length: int, input_window, output_window) -> HitSpectra | None:
+    """The hits' spectra over the force's band (:class:`HitSpectra`), or None where the band is empty or the
+    spectra would exceed :data:`MAX_SPECTRUM_VALUES` (hits × lines × channels). Parameters as
+    :func:`level_dependence`'s."""
+    starts = np.asarray(starts, int)
+    n_out = np.shape(response)[0]
+    if starts.size * (length // 2 + 1) * (n_out + 1) > MAX_SPECTRUM_VALUES:
+        return None
+    segments = _records(force, starts, length)
+    X, lines = _force_band(segments, input_window)
+    if lines.size == 0:
+        return None
+    Y = np.stack([np.fft.rfft(_records(response[o], starts, length) * output_window, axis=1)[:, lines]
+                  for o in range(n_out)]) if n_out else np.zeros((0, starts.size, lines.size), complex)
+    return HitSpectra(X[:, lines], Y, lines, np.max(np.abs(segments), axis=1))
 
 
 def _records(channel, starts: np.ndarray, length: int) -> np.ndarray:
@@ -112,7 +161,7 @@ class LevelTest:
 
 
 def level_dependence(force, response, starts, length: int, input_window, output_window,
-                     sample_rate_hz: float) -> LevelTest | None:
+                     sample_rate_hz: float, spectra: HitSpectra | None = None) -> LevelTest | None:
     """Test the hits' FRFs against their force levels (see the module), or None where the test cannot say.
 
     Parameters
@@ -126,6 +175,8 @@ def level_dependence(force, response, starts, length: int, input_window, output_
     input_window, output_window : ndarray, shape (length,)
         The windows the estimate applied.
     sample_rate_hz : float
+    spectra : HitSpectra, optional
+        These hits' spectra (:func:`hit_spectra`) where already computed.
 
     Returns
     -------
@@ -133,27 +184,21 @@ def level_dependence(force, response, starts, length: int, input_window, output_
         None with fewer than :data:`MIN_HITS` hits, peak forces within :data:`MIN_LEVEL_RATIO` of each other,
         no line in the force's band, or spectra above :data:`MAX_SPECTRUM_VALUES`.
     """
-    starts = np.asarray(starts, int)
-    n = starts.size
-    n_out = np.shape(response)[0]
-    n_lines = length // 2 + 1
-    if n < MIN_HITS or n * n_lines * (n_out + 1) > MAX_SPECTRUM_VALUES:
+    n = np.size(starts)
+    if n < MIN_HITS:
         return None
-    segments = _records(force, starts, length)
-    peaks = np.max(np.abs(segments), axis=1)
+    spectra = spectra or hit_spectra(force, response, starts, length, input_window, output_window)
+    if spectra is None:
+        return None
+    peaks, lines, Xb, n_out = spectra.peaks, spectra.lines, spectra.force, spectra.responses.shape[0]
     if not (np.all(peaks > 0) and peaks.max() >= MIN_LEVEL_RATIO * peaks.min()):
         return None
-    X, lines = _force_band(segments, input_window)
-    if lines.size == 0:
-        return None
     u = np.log(peaks) - np.mean(np.log(peaks))
-    Xb = X[:, lines]
     Pb = np.abs(Xb) ** 2
     s_xx, s_ux, s_uu = Pb.sum(axis=0), (u[:, None] * Pb).sum(axis=0), (u[:, None] ** 2 * Pb).sum(axis=0)
     det = s_xx * s_uu - s_ux**2
     best = (np.inf, 0.0, 0)
-    for o in range(n_out):
-        Y = np.fft.rfft(_records(response[o], starts, length) * output_window, axis=1)[:, lines]
+    for o, Y in enumerate(spectra.responses):
         cross = np.conj(Xb) * Y
         r0, r1 = cross.sum(axis=0), (u[:, None] * cross).sum(axis=0)
         s_yy = (np.abs(Y) ** 2).sum(axis=0)
@@ -206,7 +251,7 @@ class TakeTest:
 
 
 def take_dependence(force, response, starts, take_of_hit, length: int, input_window, output_window,
-                    sample_rate_hz: float) -> TakeTest | None:
+                    sample_rate_hz: float, spectra: HitSpectra | None = None) -> TakeTest | None:
     """Test whether the takes' hits share one FRF (see the module), or None where the test cannot say.
 
     Parameters
@@ -217,24 +262,19 @@ def take_dependence(force, response, starts, take_of_hit, length: int, input_win
     Other parameters as :func:`level_dependence`. None with fewer than two takes, no take of two hits or more
     (no noise left once each take has its FRF), no line in the force's band, or spectra too large.
     """
-    starts, takes = np.asarray(starts, int), np.asarray(take_of_hit, int)
-    n = starts.size
-    labels, takes = np.unique(takes, return_inverse=True)
+    n = np.size(starts)
+    labels, takes = np.unique(np.asarray(take_of_hit, int), return_inverse=True)
     n_takes = labels.size
-    n_out = np.shape(response)[0]
-    n_lines = length // 2 + 1
-    if n_takes < 2 or n - n_takes < 2 or n * n_lines * (n_out + 1) > MAX_SPECTRUM_VALUES:
+    if n_takes < 2 or n - n_takes < 2:
         return None
-    X, lines = _force_band(_records(force, starts, length), input_window)
-    if lines.size == 0:
+    spectra = spectra or hit_spectra(force, response, starts, length, input_window, output_window)
+    if spectra is None:
         return None
-    Xb = X[:, lines]
-    Pb = np.abs(Xb) ** 2
+    lines, Xb, Pb, n_out = spectra.lines, spectra.force, spectra.force_power, spectra.responses.shape[0]
     member = np.eye(n_takes)[takes]  # (hits, takes)
     s_xx_t = member.T @ Pb  # (takes, lines)
     best = (np.inf, 0.0, 0)
-    for o in range(n_out):
-        Y = np.fft.rfft(_records(response[o], starts, length) * output_window, axis=1)[:, lines]
+    for o, Y in enumerate(spectra.responses):
         cross = np.conj(Xb) * Y
         s_yy = (np.abs(Y) ** 2).sum(axis=0)
         cross_t = member.T @ cross
@@ -293,7 +333,8 @@ class ChangeTest:
 
 
 def change_dependence(force, response, starts, length: int, input_window, output_window,
-                      sample_rate_hz: float) -> ChangeTest | None:
+                      sample_rate_hz: float, spectra: HitSpectra | None = None,
+                      family_level: float = FAMILY_LEVEL) -> ChangeTest | None:
     """Test one record's hits for a change of FRF part way through (see the module), or None where the test
     cannot say.
 
@@ -307,18 +348,18 @@ def change_dependence(force, response, starts, length: int, input_window, output
     Σ|Y_k|² = |Σ X̄_k Y_k|²/S_xx + RSS₀ (the fitted part and the residual's two parts are independent, and a
     ratio of independent χ² is independent of their sum).
 
-    Parameters as :func:`level_dependence`'s, ``starts`` in time order. None with fewer than :data:`MIN_HITS`
-    hits, no line in the force's band, or spectra above :data:`MAX_SPECTRUM_VALUES`.
+    Parameters as :func:`level_dependence`'s, ``starts`` in time order, and ``family_level`` the chance of a
+    warning for an unchanged record (:data:`FAMILY_LEVEL`; a record of several takes tested take by take spreads it
+    over them). None with fewer than :data:`MIN_HITS` hits, no line in the force's band, or spectra above
+    :data:`MAX_SPECTRUM_VALUES`.
     """
-    starts = np.asarray(starts, int)
-    n = starts.size
-    n_out = np.shape(response)[0]
-    if n < MIN_HITS or n * (length // 2 + 1) * (n_out + 1) > MAX_SPECTRUM_VALUES:
+    n = np.size(starts)
+    if n < MIN_HITS:
         return None
-    X, lines = _force_band(_records(force, starts, length), input_window)
-    if lines.size == 0:
+    spectra = spectra or hit_spectra(force, response, starts, length, input_window, output_window)
+    if spectra is None:
         return None
-    Xb, Pb = X[:, lines], np.abs(X[:, lines]) ** 2
+    lines, Xb, Pb, n_out = spectra.lines, spectra.force, spectra.force_power, spectra.responses.shape[0]
     # the hits before each place j = 1 … n − 1 (rows), summed over the hits by running sums
     p_before = np.cumsum(Pb, axis=0)[:-1]
     p_total = p_before[-1] + Pb[-1]
@@ -327,8 +368,7 @@ def change_dependence(force, response, starts, length: int, input_window, output
     # family's largest F (and where) is kept per response, and p computed for it alone
     largest = [None, None]  # per family: (F, output, place, line index, change)
     resonant_lines = 0
-    for o in range(n_out):
-        Y = np.fft.rfft(_records(response[o], starts, length) * output_window, axis=1)[:, lines]
+    for o, Y in enumerate(spectra.responses):
         cross = np.conj(Xb) * Y
         s_yy = (np.abs(Y) ** 2).sum(axis=0)
         c_before = np.cumsum(cross, axis=0)[:-1]
@@ -354,7 +394,7 @@ def change_dependence(force, response, starts, length: int, input_window, output
             continue
         F_max, o, place, k, size = largest[family]
         p = float(f_survival(2.0, 2.0 * (n - 2), np.array([F_max]))[0])
-        limit = FAMILY_LEVEL / 2 / (max(n_tests, 1) * (n - 1))
+        limit = family_level / 2 / (max(n_tests, 1) * (n - 1))
         if best is None or p / limit < best[0] / best[1]:
             best = (p, limit, float(lines[k] * sample_rate_hz / length), o, place + 1, size, n_tests, bool(family))
     if best is None:

@@ -30,7 +30,8 @@ import numpy as np
 from ..errors import QualityWarning, warn
 from .excitation_noise import POWERED_LINE_FRACTION
 
-__all__ = ["ChanceTest", "chance_tests", "warn_unrelated", "RELATED_SIGMAS", "MIN_RECORDS", "MIN_LINES"]
+__all__ = ["ChanceTest", "chance_tests", "tones", "near_tones", "warn_unrelated", "RELATED_SIGMAS", "MIN_RECORDS",
+           "MIN_LINES"]
 
 #: a channel whose mean coherence is more than this many standard errors above chance is related to the force.
 #: Under no relation the mean over hundreds of lines is nearly normal: 5 standard errors are passed by chance
@@ -103,6 +104,19 @@ class ChanceTest:
                 "chance_se": self.chance_se, "records": self.records, "lines": self.lines}
 
 
+def tones(power: np.ndarray, ratio: float = TONE_RATIO) -> np.ndarray:
+    """The lines of each row of ``power`` (rows, lines) above ``ratio`` times the median of their
+    2 × :data:`TONE_HALF_WIDTH` + 1 neighbours: a tone's, not a broad spectrum's."""
+    padded = np.pad(power, ((0, 0), (TONE_HALF_WIDTH, TONE_HALF_WIDTH)), mode="edge")
+    local = np.median(np.lib.stride_tricks.sliding_window_view(padded, 2 * TONE_HALF_WIDTH + 1, axis=1), axis=2)
+    return power > ratio * local
+
+
+def near_tones(tone: np.ndarray) -> np.ndarray:
+    """The lines within :data:`TONE_SPREAD` of a line of ``tone`` (bool, lines), the tone's own included."""
+    return np.convolve(tone, np.ones(2 * TONE_SPREAD + 1), mode="same") > 0
+
+
 def chance_tests(sums, multiple_coherence: np.ndarray, output_correlation: np.ndarray,
                  overlap_factor: float = 1.0) -> list[ChanceTest]:
     """Each response channel's mean coherence over the driven lines, against chance.
@@ -141,10 +155,7 @@ def chance_tests(sums, multiple_coherence: np.ndarray, output_correlation: np.nd
     driven = inner & np.all(power >= POWERED_LINE_FRACTION * largest, axis=0) & np.all(power > 0, axis=0)
     # a tone in a force (mains hum, a shaker's harmonic) is no excitation of the structure, and a dead channel
     # that picks up the same hum is coherent with it there: such lines are not counted
-    padded = np.pad(power, ((0, 0), (TONE_HALF_WIDTH, TONE_HALF_WIDTH)), mode="edge")
-    local = np.median(np.lib.stride_tricks.sliding_window_view(padded, 2 * TONE_HALF_WIDTH + 1, axis=1), axis=2)
-    tone = np.any(power > TONE_RATIO * local, axis=0)
-    driven &= np.convolve(tone, np.ones(2 * TONE_SPREAD + 1), mode="same") == 0
+    driven &= ~near_tones(np.any(tones(power), axis=0))
     lines = int(driven.sum())
     if lines < MIN_LINES:
         return []
@@ -173,13 +184,19 @@ def chance_tests(sums, multiple_coherence: np.ndarray, output_correlation: np.nd
             for o in range(coherence.shape[0])]
 
 
-def warn_unrelated(tests: list[ChanceTest], names, n_inputs: int, impact: bool, source: str) -> list[dict]:
-    """Warn of each unrelated channel among ``tests`` (a :class:`~modal.errors.QualityWarning` naming it and
-    its figures) and return them as ``EstimatedFRF.unrelated`` lists them.
+def warn_unrelated(tests: list[ChanceTest], names, n_inputs: int, impact: bool, source: str,
+                   rises=()) -> list[dict]:
+    """Warn of each response channel that neither test finds related to the force (a
+    :class:`~modal.errors.QualityWarning` naming it and its figures) and return them as
+    ``EstimatedFRF.unrelated`` lists them.
+
+    A channel is related when its mean coherence lies :data:`RELATED_SIGMAS` standard errors above chance or,
+    for hits, its power rises after them (:mod:`.rise`); a channel neither test could be made on is not warned.
 
     Parameters
     ----------
     tests : list of ChanceTest
+        One per output, or none (too few records or driven lines).
     names : sequence of str
         The response channels' names, by output.
     n_inputs : int
@@ -188,19 +205,33 @@ def warn_unrelated(tests: list[ChanceTest], names, n_inputs: int, impact: bool, 
         The records are hits (messages count hits).
     source : str
         Name used in messages (the file).
+    rises : sequence of modal.estimate.rise.RiseTest
+        One per output, or none (not hits, or no room before them).
     """
     found = []
     force = "the force" if n_inputs == 1 else "the forces"
     records = "hits" if impact else "records"
-    for test in tests:
-        if not test.unrelated:
+    chance = {t.output: t for t in tests}
+    rise = {r.output: r for r in rises}
+    for output in sorted(set(chance) | set(rise)):
+        test, up = chance.get(output), rise.get(output)
+        if (test is not None and not test.unrelated) or (up is not None and up.rises):
             continue
-        name = names[test.output]
-        warn(f"{source}: {name} shows no relation to {force}: mean coherence {test.mean_coherence:.3g} over its "
-             f"{test.lines} driven lines, chance {test.chance:.3g} ± {test.chance_se:.2g} with {test.records} "
-             f"{records} ({test.sigmas:+.1f} standard errors; a response would show with about "
-             f"{100 * test.detectable_share:.2g} % of these lines coherent): an unplugged or dead sensor, a cable at "
-             "another input, a channel listed that was not measured, or a response buried in its noise; its FRF is "
-             "noise (fits weigh it by that noise): check the sensor and its cable", QualityWarning)
-        found.append(test.as_dict(name))
+        name = names[output]
+        figures = []
+        if test is not None:
+            figures.append(f"mean coherence {test.mean_coherence:.3g} over its {test.lines} driven lines, chance "
+                           f"{test.chance:.3g} ± {test.chance_se:.2g} with {test.records} {records} "
+                           f"({test.sigmas:+.1f} standard errors; a response would show with about "
+                           f"{100 * test.detectable_share:.2g} % of these lines coherent)")
+        if up is not None:
+            figures.append(f"its power in {1e3 * up.window_s:.0f} ms about the {up.hits} trigger(s) "
+                           f"{up.ratio:.3g} times that before them ({up.sigmas:+.1f} standard errors of chance)")
+        warn(f"{source}: {name} shows no relation to {force}: {'; '.join(figures)}: an unplugged or dead sensor, "
+             "a cable at another input, a channel listed that was not measured, or a response buried in its noise; "
+             "its FRF is noise (fits weigh it by that noise): check the sensor and its cable", QualityWarning)
+        item = {"channel": name, "mean_coherence": None, "chance": None, "chance_se": None, "records": None,
+                "lines": None} if test is None else test.as_dict(name)
+        item.update(rise=None if up is None else up.ratio, rise_log_se=None if up is None else up.log_se)
+        found.append(item)
     return found

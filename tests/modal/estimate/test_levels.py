@@ -1,6 +1,7 @@
 """The hits' FRFs tested against their force levels (modal.estimate.levels): nonlinearity in an impact test."""
 from __future__ import annotations
 
+import re
 import warnings
 
 import numpy as np
@@ -157,3 +158,38 @@ def test_the_resonant_lines_find_a_change_every_lines_family_misses(monkeypatch)
     monkeypatch.setattr(levels, "RESONANT_POWER_RATIO", np.inf)  # no resonant line: every line's family alone ...
     monkeypatch.setattr(levels, "FAMILY_LEVEL", 2 * FAMILY_LEVEL)  # ... at the whole level
     assert not change_dependence(force, response, starts, 2048, window, window, FS).changed
+
+
+def test_a_change_within_one_take_of_several_is_warned_of():
+    # two takes (files) of six hits at one point; in the second the sensor's second constant falls from 0.5 to 0.25
+    # from its hit 4 on. The takes' test compares the takes' averages (the second's a mix of the two) and said
+    # nothing; each take of four hits or more is now tested as one record is, the level spread over the takes
+    first = impact_record(DigitalModes([40.0, 95.0], [0.01, 0.02], [[1.0, 0.5]], FS), [0.5 + 4 * k for k in range(6)],
+                          25.0, seed=7, response_noise=1e-3, force_noise=1e-3).record
+    for second_mode, changed in ((0.25, True), (0.5, False)):
+        force, response, _ = _sensor_changed(6, second_mode, seed=8)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            modal.estimate_frf(np.concatenate([first.signals[0], force]),
+                               np.concatenate([first.signals[1:], response], axis=1), FS, impact=True,
+                               window="force", kind="accelerance", take_lengths=[first.n_samples, force.size],
+                               take_names=["a.csv", "b.csv"])
+        said = [str(w.message) for w in caught if issubclass(w.category, modal.QualityWarning)]
+        found = [m for m in said if "the hits' FRF changes between" in m]
+        if changed:
+            assert len(found) == 1 and re.search(r"b\.csv: the hits' FRF changes between hit 3 and hit 4 "
+                                                 r"\(at 12\.50\d s\)", found[0])
+        else:
+            assert said == []
+
+
+def test_the_hits_spectra_are_computed_once_for_the_level_and_change_tests(monkeypatch):
+    # the level and change tests read the same transforms of the hits' records: each channel's records are cut once
+    import modal.estimate.levels as levels
+
+    force, response, _ = _sensor_changed(6, 0.5, seed=9)
+    cut = []
+    original = levels._records
+    monkeypatch.setattr(levels, "_records", lambda channel, *args: cut.append(1) or original(channel, *args))
+    modal.estimate_frf(force, response, FS, impact=True, window="force", kind="accelerance")
+    assert len(cut) == 1 + response.shape[0]
