@@ -165,34 +165,26 @@ def _judged_channel(estimate: PoleEstimate, prepared: Prepared) -> int:
     return int(np.argmax(np.abs(estimate.shape) / prepared.scale))
 
 
-#: the channels judged on are transformed this many at a time: pocketfft (scipy.fft) runs the transforms of a 2-D
-#: array's rows a vector register's width of rows at once (4 single-precision rows with SSE2), each row's numbers
-#: those of its transform alone; 4 rows of 10⁶ samples took 26 ms where one at a time took 62 (one thread)
-SPECTRA_TOGETHER = 4
-
-
-def _channel_spectra(prepared: Prepared, channels) -> tuple[np.ndarray, int]:
-    """Record-long FFTs of some channels, centred: (spectra, one row per channel, samples transformed).
+def _channel_spectrum(prepared: Prepared, channel: int) -> tuple[np.ndarray, int]:
+    """A record-long FFT of one channel, centred: (spectrum, samples transformed).
 
     The samples transformed are the record's first ``n``, ``n`` the longest FFT length at most the record's
     whose factors are 2, 3 and 5 (at most a few tenths of a percent shorter): a length with a large prime factor
     would cost ten times as much (a record of 999 983 samples, prime). The mean comes off in double precision
     as the samples are rounded to single (an offset costs no precision); the scale is left on (the tests only
-    compare lines of one channel). The rows are transformed together (:data:`SPECTRA_TOGETHER`)."""
+    compare lines of one channel)."""
     from scipy.fft import prev_fast_len, rfft
 
     n = prev_fast_len(prepared.n_samples, real=True)
-    channels = list(channels)
-    centred = np.empty((len(channels), n), np.float32)
-    for row, ch in zip(centred, channels):
-        np.subtract(prepared.signals[ch, :n], prepared.mean[ch], out=row, casting="same_kind")
-    return rfft(centred, axis=-1, overwrite_x=True), n
+    centred = np.empty(n, np.float32)
+    np.subtract(prepared.signals[channel, :n], prepared.mean[channel], out=centred, casting="same_kind")
+    return rfft(centred, overwrite_x=True), n
 
 
 def _band_is_peaky(estimate: PoleEstimate, prepared: Prepared, spectra: dict, resolution_hz: float | None) -> bool:
     """Whether the response band-passed around one estimate's strongest line is non-Gaussian (kurtosis below
     :data:`KURTOSIS_LIMIT`); ``spectra`` holds the FFT of each channel judged on
-    (:func:`_judged_channel`) and the samples it transformed (:func:`_channel_spectra`).
+    (:func:`_judged_channel`) and the samples it transformed (:func:`_channel_spectrum`).
 
     The band spans :data:`MIN_BANDWIDTH_TIME` lines around the strongest line of the channel where the pole is
     strongest, looked for within the pole's half-power band ±ζf (or three of its frequency's standard errors, at
@@ -237,15 +229,9 @@ def separate_tones(estimates: list[PoleEstimate], prepared: Prepared, rotor_spee
     (is_tone, estimates) : (list of bool, list of PoleEstimate)
         The estimates in the same order, those that are not tones with their flags added.
     """
-    # a record-long FFT per channel judged on, shared by its poles, on threads in turn: the channels in groups of
-    # SPECTRA_TOGETHER, those left over one by one (a short group gains nothing, and alone each can take a thread)
+    # a record-long FFT per channel judged on, shared by its poles; the channels' on threads in turn
     judged = sorted({_judged_channel(e, prepared) for e in estimates})
-    whole = len(judged) - len(judged) % SPECTRA_TOGETHER
-    groups = [judged[k:k + SPECTRA_TOGETHER] for k in range(0, whole, SPECTRA_TOGETHER)]
-    groups += [[ch] for ch in judged[whole:]]
-    spectra = {}
-    for group, (rows, n) in zip(groups, map_over_threads(lambda g: _channel_spectra(prepared, g), groups, workers)):
-        spectra.update((ch, (row, n)) for ch, row in zip(group, rows))
+    spectra = dict(zip(judged, map_over_threads(lambda ch: _channel_spectrum(prepared, ch), judged, workers)))
     peaky = [_band_is_peaky(e, prepared, spectra, resolution_hz) for e in estimates]
 
     def is_peaky(k: int) -> bool:

@@ -3,7 +3,6 @@ it needs to tell a lightly damped mode from a tone, and tones with no mode near 
 from __future__ import annotations
 
 import warnings
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -13,7 +12,7 @@ from modal.operational.inputs import prepare
 from modal.operational.pole import PoleEstimate
 from modal.errors import QualityWarning
 from modal.operational.tones import (HUM_LINE_RATIO, HUM_TOLERANCE, KURTOSIS_LIMIT, MIN_BANDWIDTH_TIME, MIN_DECAYS,
-                                    _channel_spectra, band_kurtosis, line_ratio, separate_tones,
+                                    _channel_spectrum, band_kurtosis, line_ratio, separate_tones,
                                     strongest_line_hz, warn_speed_off_the_tones)
 from modal.synthetic import ambient_modal_response
 from modal.units import TWO_PI
@@ -89,8 +88,7 @@ def test_a_record_of_prime_length_is_judged_on_a_fast_fft_length():
     # 2, 3 and 5 only, here 27 648 samples (1.2 % shorter), and still judges the pole between the two tones one
     signals, fs = _two_tone_record()
     prepared = prepare(signals[:, :27_997], fs, (5.0, 150.0))
-    spectra, n = _channel_spectra(prepared, [0])
-    spectrum = spectra[0]
+    spectrum, n = _channel_spectrum(prepared, 0)
     factors = n
     for p in (2, 3, 5):
         while factors % p == 0:
@@ -99,49 +97,6 @@ def test_a_record_of_prime_length_is_judged_on_a_fast_fft_length():
     between = _estimate(82.23, 0.0004, 0.0006, 2)
     assert separate_tones([between], prepared, None, resolution_hz=fs / 80)[0] == [True]
 
-
-def _tones_on_some_channels(n_channels: int = 6, fs: float = 400.0, duration_s: float = 70.0):
-    """Random response of one mode at 30 Hz on ``n_channels`` channels (offsets added), a steady tone at 40 Hz on
-    channel 1 and one at 57 Hz (no harmonic of it) on channel 4, each 3 RMS, prepared over 5-150 Hz."""
-    n = int(fs * duration_s)
-    shapes = np.linspace(1.0, 0.5, n_channels)[:, None]
-    rec = ambient_modal_response([30.0], [0.02], shapes, fs, n, noise=0.1, seed=6)
-    signals = rec.signals + 0.5 * np.arange(n_channels)[:, None]  # offsets, which the spectra take off
-    t = np.arange(n) / fs
-    for ch, f in ((1, 40.0), (4, 57.0)):
-        signals[ch] += 3 * rec.signals.std() * np.sin(TWO_PI * f * t)
-    return prepare(signals, fs, (5.0, 150.0))
-
-
-def test_spectra_transformed_together_are_each_channels_own():
-    # the channels are transformed several rows at a time: each row is the FFT of its channel alone (centred, in
-    # single precision), bit for bit, in the order the channels were asked for
-    from scipy.fft import rfft
-
-    prepared = _tones_on_some_channels()
-    channels = [4, 0, 5, 2, 1]
-    spectra, n = _channel_spectra(prepared, channels)
-    assert spectra.shape == (len(channels), n // 2 + 1)
-    for row, ch in zip(spectra, channels):
-        alone = (prepared.signals[ch, :n] - prepared.mean[ch]).astype(np.float32)
-        assert np.array_equal(row, rfft(alone))
-
-
-def test_poles_judged_on_many_channels_each_get_their_channels_band():
-    # nearly undamped poles at the two tones' frequencies, each strongest on another channel (six spectra: a group
-    # transformed together and two alone): only the pole judged on the channel that holds its tone is a tone; the
-    # bands of the others hold Gaussian response (kurtosis near 3, above the limit)
-    prepared = _tones_on_some_channels()
-    estimates, expected = [], []
-    for f, tone_channel in ((40.0, 1), (57.0, 4)):
-        for ch in range(6):
-            shape = np.full(6, 0.1, complex)
-            shape[ch] = 1.0
-            estimates.append(replace(_estimate(f, 0.0004, 0.0006, 6), shape=shape))
-            expected.append(ch == tone_channel)
-    for workers in (1, 2):
-        is_tone, _ = separate_tones(estimates, prepared, None, resolution_hz=400.0 / 80, workers=workers)
-        assert is_tone == expected
 
 def test_a_damped_pole_between_two_close_tones_is_a_tone_where_the_record_resolves_its_damping(two_tones):
     # SSI and EFDD can return the pair as one pole damped by their beat (the shipped record: 0.3-0.5 % at 182 Hz,
