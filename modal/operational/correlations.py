@@ -244,11 +244,15 @@ def correlations(signals: np.ndarray, sample_rate_hz: float, references, max_lag
     def block_correlations(first_block: int, stop_block: int) -> None:
         """The correlation sums of blocks ``first_block``…``stop_block − 1``, into ``lagged``."""
         spectra = np.empty((n_fft // 2 + 1, n_out, refs.size), np.complex64)
+        most = int(np.diff(edges[first_block:stop_block + 1]).max())  # segments in the share's longest block
         if mean is not None:  # each block's samples centred into one buffer, reused
-            longest = int(np.diff(edges[first_block:stop_block + 1]).max()) * n_seg + max_lag
-            buffer = np.empty((n_out, longest), np.float32)
+            buffer = np.empty((n_out, most * n_seg + max_lag), np.float32)
+        # the references' segments, each followed by the zeros that pad it to n_fft (written once): transformed as
+        # they lie, with no gathering copy of the reference rows and no padded copy of it
+        padded = np.zeros((refs.size, most, n_fft), np.float32)
         for b in range(first_block, stop_block):
             first, stop = edges[b] * n_seg, edges[b + 1] * n_seg + max_lag
+            segments = edges[b + 1] - edges[b]
             if mean is None:
                 data = record[:, first:stop]
             else:
@@ -259,7 +263,9 @@ def correlations(signals: np.ndarray, sample_rate_hz: float, references, max_lag
             windows = np.lib.stride_tricks.sliding_window_view(data, n_seg + max_lag, axis=1)
             ext = windows[:, ::n_seg].transpose(2, 0, 1)
             future = sfft.rfft(ext, n=n_fft, axis=0)  # every output, extended by the longest lag
-            past = sfft.rfft(ext[:n_seg, refs], n=n_fft, axis=0)  # the references' segments, zero-padded
+            for row, r in zip(padded, refs):
+                row[:segments, :n_seg] = data[r, :segments * n_seg].reshape(segments, n_seg)
+            past = sfft.rfft(padded[:, :segments].transpose(2, 0, 1), axis=0)  # the references' segments, padded
             # Σ over the block's segments of Y_o(f) conj(X_r(f)): one (outputs × segments)(segments × refs)
             # product per line
             np.matmul(future, past.conj().transpose(0, 2, 1), out=spectra)

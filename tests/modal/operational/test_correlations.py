@@ -27,6 +27,22 @@ def test_correlations_equal_the_direct_sums_per_block():
 
 
 
+def test_references_out_of_order_and_blocks_of_unequal_length_in_one_share():
+    # the references' segments are padded in a buffer per share, sized for its longest block: a shorter block after
+    # a longer one, and references given out of order, must still give each block's direct sums (22 segments of
+    # 244 samples in 3 blocks of 7, 8 and 7 segments, all on one thread); tolerance as in the test above
+    rng = np.random.default_rng(7)
+    y = rng.standard_normal((4, 22 * 244 + 12))
+    y[2] += 0.7 * np.roll(y[3], 2)
+    refs = [3, 0, 2]
+    c = correlations(y, 50.0, refs, 12, max_blocks=3, workers=1)
+    edges = np.concatenate([[0], np.cumsum(c.weights)]).astype(int)
+    assert np.diff(edges).tolist() == [7 * 244, 8 * 244, 7 * 244]
+    for b in range(3):
+        for k in range(13):
+            assert np.allclose(c.blocks[b, k], _direct(y, refs, edges[b], edges[b + 1], k), atol=2e-6)
+
+
 def test_a_block_alone_in_its_group_is_kept_as_it_is():
     # 6 blocks in 5 groups: [0], [1], [2, 3], [4], [5]; a block alone is its group's mean exactly (not rounded
     # through its weight), two blocks of one weight their plain mean
