@@ -75,12 +75,14 @@ def _refuse_same_samples(records: Sequence[TimeRecord]) -> None:
     exported twice (as CSV and again at another precision, or in two formats) would be averaged with itself,
     its noise looking smaller than it is. Byte-identical copies are refused before reading
     (:func:`modal.io._common.refuse_copies`)."""
+    signals = [np.asarray(record.signals, float) for record in records]
+    peaks = [np.abs(x).max(axis=1) if x.size else np.zeros(x.shape[0]) for x in signals]
     for j, later in enumerate(records):
-        for earlier in records[:j]:
-            if later.signals.shape != earlier.signals.shape:
+        for i, earlier in enumerate(records[:j]):
+            a, b = signals[i], signals[j]
+            if a.shape != b.shape or a.shape[1] == 0:
                 continue
-            a, b = np.asarray(earlier.signals, float), np.asarray(later.signals, float)
-            peak = np.maximum(np.abs(a).max(axis=1), np.abs(b).max(axis=1))
+            peak = np.maximum(peaks[i], peaks[j])
             head = slice(0, min(64, a.shape[1]))  # most pairs differ at once
             if np.any(np.abs(a[:, head] - b[:, head]).max(axis=1) > SAME_SAMPLES_TOLERANCE * peak):
                 continue
